@@ -1,0 +1,43 @@
+#include "scene/scene.h"
+
+namespace streamrt {
+
+const char* shape_kind_name(ShapeKind k) {
+    switch (k) {
+        case ShapeKind::Sphere: return "sphere";
+        case ShapeKind::Cube: return "cube";
+        case ShapeKind::Cylinder: return "cylinder";
+        case ShapeKind::Cone: return "cone";
+        case ShapeKind::Torus: return "torus";
+        case ShapeKind::Plane: return "plane";
+    }
+    return "?";
+}
+
+}  // namespace streamrt
+
+#include <cmath>
+#include <numbers>
+
+namespace streamrt {
+
+glm::dmat4 Camera::world_from_canonical(int width, int height) const {
+    if (!look_at) return md;
+    // Homothety (rx, ry, df) with df = 1: the screen's half-height is tan(fov/2) at unit
+    // distance from the eye; then a rotation taking -z to the view direction and +y to up,
+    // then a translation putting the canonical eye (0,0,1) on `eye`.
+    const double ry = std::tan(fov * std::numbers::pi / 360.0);
+    const double rx = ry * double(width) / double(height);
+    const glm::dvec3 forward = glm::normalize(look - eye);
+    const glm::dvec3 right = glm::normalize(glm::cross(forward, up));
+    const glm::dvec3 true_up = glm::cross(right, forward);
+    glm::dmat4 rot(1.0);
+    rot[0] = glm::dvec4(right, 0.0);
+    rot[1] = glm::dvec4(true_up, 0.0);
+    rot[2] = glm::dvec4(-forward, 0.0);
+    const double df = 1.0;
+    const glm::dmat4 m = translate_matrix(eye - df * (-forward)) * rot * scale_matrix({rx, ry, df});
+    return m;
+}
+
+}  // namespace streamrt

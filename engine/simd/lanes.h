@@ -1,0 +1,65 @@
+#pragma once
+// Shims so one template compiles for scalars (float, double) and xsimd batches.
+// xsimd 8.1 has scalar sqrt/fma but no scalar select/any/all.
+#include <xsimd/xsimd.hpp>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace streamrt::simd {
+
+inline float select(bool m, float a, float b) { return m ? a : b; }
+inline double select(bool m, double a, double b) { return m ? a : b; }
+inline bool any(bool m) { return m; }
+inline bool all(bool m) { return m; }
+inline float abs(float a) { return std::fabs(a); }
+inline double abs(double a) { return std::fabs(a); }
+inline float min(float a, float b) { return a < b ? a : b; }
+inline double min(double a, double b) { return a < b ? a : b; }
+inline float max(float a, float b) { return a > b ? a : b; }
+inline double max(double a, double b) { return a > b ? a : b; }
+inline float sign_of(float a) { return std::copysign(1.f, a); }
+inline double sign_of(double a) { return std::copysign(1.0, a); }
+
+template <class T, class A>
+inline xsimd::batch<T, A> select(const xsimd::batch_bool<T, A>& m, const xsimd::batch<T, A>& a,
+                                 const xsimd::batch<T, A>& b) {
+    return xsimd::select(m, a, b);
+}
+template <class T, class A>
+inline bool any(const xsimd::batch_bool<T, A>& m) { return xsimd::any(m); }
+template <class T, class A>
+inline bool all(const xsimd::batch_bool<T, A>& m) { return xsimd::all(m); }
+template <class T, class A>
+inline xsimd::batch<T, A> abs(const xsimd::batch<T, A>& a) { return xsimd::abs(a); }
+template <class T, class A>
+inline xsimd::batch<T, A> min(const xsimd::batch<T, A>& a, const xsimd::batch<T, A>& b) { return xsimd::min(a, b); }
+template <class T, class A>
+inline xsimd::batch<T, A> max(const xsimd::batch<T, A>& a, const xsimd::batch<T, A>& b) { return xsimd::max(a, b); }
+template <class T, class A>
+inline xsimd::batch<T, A> sign_of(const xsimd::batch<T, A>& a) {
+    return xsimd::copysign(xsimd::batch<T, A>(T(1)), a);
+}
+
+using std::sqrt;
+using xsimd::sqrt;
+
+/// The element type behind V (float for batch<float>, double for double, ...).
+template <class V>
+struct scalar_of { using type = V; };
+template <class T, class A>
+struct scalar_of<xsimd::batch<T, A>> { using type = T; };
+template <class V>
+using scalar_t = typename scalar_of<V>::type;
+
+/// Widest batch we build (AVX-512: 16 floats). Streams are padded to it in every build so the
+/// layout is the same at 4, 8 and 16 lanes and aligned loads are always legal.
+inline constexpr std::size_t kMaxLanes = 16;
+inline constexpr std::size_t kAlign = 64;
+template <class T>
+using AlignedVec = std::vector<T, xsimd::aligned_allocator<T, kAlign>>;
+constexpr std::size_t round_up_lanes(std::size_t n) { return (n + kMaxLanes - 1) / kMaxLanes * kMaxLanes; }
+
+}  // namespace streamrt::simd
