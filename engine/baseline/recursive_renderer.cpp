@@ -1,0 +1,145 @@
+#include "baseline/recursive_renderer.h"
+
+#include <limits>
+
+#include "render/sampling.h"
+#include "shapes/shapes.h"
+
+namespace streamrt {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+inline Vec3d apply_point(const glm::dmat4& m, const Vec3d& p) { return to_vec(transform_point(m, to_glm(p))); }
+inline Vec3d apply_vector(const glm::dmat4& m, const Vec3d& v) { return to_vec(transform_vector(m, to_glm(v))); }
+}  // namespace
+
+RecursiveRenderer::RecursiveRenderer(const Scene& scene)
+    : scene_(scene), camera_(CameraRays<double>::from(scene)) {
+    for (const Object& o : scene.objects) {
+        objects_.push_back({o.kind, o.minor, o.xf.mi, o.xf.md, o.xf.mn});
+        materials_.push_back(MaterialT<double>::from(o.material));
+    }
+    for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(l));
+}
+
+bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max, HitD& hit) const {
+    // The handout: intersect in each object's canonical space, [Mi A, Mi u). The direction is
+    // not renormalised there, so t means the same distance along the world ray for every
+    // object and the closest hit is a plain comparison of t.
+    int best = -1;
+    double best_t = t_max;
+    Vec3d best_o{}, best_d{};
+    for (std::size_t i = 0; i < objects_.size(); ++i) {
+        const PreparedObject& ob = objects_[i];
+        const Vec3d o = apply_point(ob.mi, ray.origin);
+        const Vec3d d = apply_vector(ob.mi, ray.dir);
+        const double t = visit_shape(ob.kind, [&](auto shape) {
+            return shape.template hit_t<double>(o, d, ob.param, t_min, best_t);
+        });
+        if (t < best_t) {
+            best_t = t;
+            best = int(i);
+            best_o = o;
+            best_d = d;
+        }
+    }
+    if (best < 0) return false;
+    const PreparedObject& ob = objects_[std::size_t(best)];
+    const Vec3d pc = best_o + best_d * best_t;
+    const Vec3d nc = visit_shape(ob.kind, [&](auto shape) { return shape.template normal<double>(pc, ob.param); });
+    hit.object = best;
+    hit.t = best_t;
+    hit.point = apply_point(ob.md, pc);
+    hit.normal = to_vec(transform_normal(ob.mn, to_glm(nc)));
+    return true;
+}
+
+bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
+    for (const PreparedObject& ob : objects_) {
+        const Vec3d o = apply_point(ob.mi, ray.origin);
+        const Vec3d d = apply_vector(ob.mi, ray.dir);
+        const double t = visit_shape(ob.kind, [&](auto shape) {
+            return shape.template hit_t<double>(o, d, ob.param, 0.0, t_max);
+        });
+        if (t < t_max) return true;
+    }
+    return false;
+}
+
+ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& counts) const {
+    const RenderSettings& s = scene_.settings;
+    HitD hit;
+    if (!closest_hit(ray, 0.0, kInf, hit)) return {s.background.x, s.background.y, s.background.z};
+
+    const MaterialT<double>& m = materials_[std::size_t(hit.object)];
+    const ColorT<double> base = surface_color(m, hit.point);
+    if (s.degree == 0) return base;
+
+    // Light on the side the ray arrives from (a camera inside a room or a sphere sees the
+    // inner faces lit).
+    const Vec3d n_out = hit.normal;
+    const Vec3d n = dot(n_out, ray.dir) < 0 ? n_out : -n_out;
+    ColorT<double> color = ambient_light(s.degree, s.ambient, m, base);
+    for (const LightT<double>& l : lights_) {
+        const LightSample<double> ls = sample_light(l, hit.point);
+        const ColorT<double> c = direct_light(s.degree, m, base, n, ray.dir, l, ls);
+        if (c.x == 0 && c.y == 0 && c.z == 0) continue;
+        if (s.degree >= 5) {
+            const Vec3d from = offset_ray_origin(hit.point, n);
+            const Vec3d to = l.kind == LightKind::Directional ? ls.to_light : l.pos - from;
+            ++counts.shadow;
+            if (occluded({from, to}, ls.t_max)) continue;
+        }
+        color = color + c;
+    }
+    if (depth >= s.depth) return color;
+
+    if (s.degree >= 3 && m.refl > 0) {
+        const Vec3d r = reflect(ray.dir, n);
+        ++counts.reflected;
+        color = color + trace({offset_ray_origin(hit.point, n), r}, depth + 1, counts) * m.refl;
+    }
+    if (s.degree >= 4 && m.trans > 0) {
+        const Vec3d t = refract(ray.dir, n_out, m.ior);
+        const Vec3d side = dot(t, n_out) > 0 ? n_out : -n_out;
+        ++counts.refracted;
+        color = color + trace({offset_ray_origin(hit.point, side), t}, depth + 1, counts) * m.trans;
+    }
+    return color;
+}
+
+ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) const {
+    const RenderSettings& s = scene_.settings;
+    const CameraRays<double>& cam = camera_;
+    const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(s.width) + std::uint64_t(x);
+    ColorT<double> sum{0, 0, 0};
+    for (int k = 0; k < s.spp; ++k) {
+        const PixelSample ps = pixel_sample(s.pattern, s.spp, pixel, k);
+        const RayD ray{cam.origin, cam.direction(x + ps.x, y + ps.y)};
+        ++counts.primary;
+        sum = sum + trace(ray, 0, counts);
+    }
+    return sum * (1.0 / s.spp);
+}
+
+Framebuffer RecursiveRenderer::render(Parallelism& par, RenderProgress* progress) const {
+    const RenderSettings& s = scene_.settings;
+    Framebuffer fb(s.width, s.height);
+    constexpr int kTile = 16;
+    par.for_each_tile(s.width, s.height, kTile, [&](int, Tile tile) {
+        if (progress && progress->cancelled()) return;
+        RayCounts counts;
+        for (int y = tile.y0; y < tile.y1; ++y)
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                const ColorT<double> c = render_pixel(x, y, counts);
+                float* px = fb.pixel(x, y);
+                px[0] = float(c.x);
+                px[1] = float(c.y);
+                px[2] = float(c.z);
+            }
+        if (progress) progress->add(counts);
+    });
+    return fb;
+}
+
+}  // namespace streamrt

@@ -1,0 +1,62 @@
+#pragma once
+// The handout's algorithm as written: scalar, double precision, one ray at a time, closest
+// hit over every object, colour gathered recursively by degree. Kept as a first-class
+// renderer: it is the reference the stream engine is measured against.
+#include <vector>
+
+#include "core/vec3.h"
+#include "image/framebuffer.h"
+#include "parallel/parallelism.h"
+#include "render/camera_rays.h"
+#include "render/render_stats.h"
+#include "render/shading.h"
+#include "scene/scene.h"
+
+namespace streamrt {
+
+struct RayD {
+    Vec3d origin, dir;  ///< world space; dir is unit for camera, reflected and refracted rays
+};
+
+/// The ray's "memory" of its closest hit (handout): object, distance, point and normal.
+struct HitD {
+    int object = -1;
+    double t = 0;
+    Vec3d point;   ///< world space, Md applied to the canonical hit point
+    Vec3d normal;  ///< world space, unit, outward (Mn applied to the canonical normal)
+};
+
+class RecursiveRenderer {
+  public:
+    explicit RecursiveRenderer(const Scene& scene);
+
+    /// Renders the whole image; tiles in parallel, each pixel independent of -j.
+    Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr) const;
+
+    /// Colour brought back by one ray (the handout's recursive procedure).
+    ColorT<double> trace(const RayD& ray, int depth, RayCounts& counts) const;
+
+    /// Closest hit over all objects, t in (t_min, t_max); false for a miss.
+    bool closest_hit(const RayD& ray, double t_min, double t_max, HitD& hit) const;
+
+    /// True if anything lies on the ray for t in (0, t_max) (shadow rays).
+    bool occluded(const RayD& ray, double t_max) const;
+
+    /// One pixel's colour: the average over its samples.
+    ColorT<double> render_pixel(int x, int y, RayCounts& counts) const;
+
+  private:
+    struct PreparedObject {
+        ShapeKind kind;
+        double param;
+        glm::dmat4 mi, md;
+        glm::dmat3 mn;
+    };
+    const Scene& scene_;
+    CameraRays<double> camera_;
+    std::vector<PreparedObject> objects_;
+    std::vector<MaterialT<double>> materials_;
+    std::vector<LightT<double>> lights_;
+};
+
+}  // namespace streamrt

@@ -1,0 +1,69 @@
+#pragma once
+// The one owner of threads: every parallel loop goes through here, so -j is honoured.
+// The only header that includes TBB.
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/global_control.h>
+#include <oneapi/tbb/info.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <cstddef>
+
+namespace streamrt {
+
+/// A rectangle of pixels [x0, x1) x [y0, y1).
+struct Tile {
+    int x0, y0, x1, y1;
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+};
+
+class Parallelism {
+  public:
+    /// jobs <= 0 means all cores.
+    explicit Parallelism(int jobs)
+        : jobs_(jobs > 0 ? jobs : oneapi::tbb::info::default_concurrency()),
+          limit_(oneapi::tbb::global_control::max_allowed_parallelism, std::size_t(jobs_)),
+          arena_(jobs_) {}
+
+    int jobs() const { return jobs_; }
+
+    /// body(tile_index, Tile) for every tile of a width x height image cut into tile x tile
+    /// squares. Tiles depend only on the image size, never on -j, and are handed out
+    /// dynamically (grain 1), so the picture is the same for every thread count.
+    template <class Body>
+    void for_each_tile(int width, int height, int tile, Body&& body) {
+        const int nx = (width + tile - 1) / tile, ny = (height + tile - 1) / tile;
+        arena_.execute([&] {
+            oneapi::tbb::parallel_for(
+                oneapi::tbb::blocked_range<int>(0, nx * ny, 1),
+                [&](const oneapi::tbb::blocked_range<int>& r) {
+                    for (int i = r.begin(); i != r.end(); ++i) {
+                        const int tx = i % nx, ty = i / nx;
+                        body(i, Tile{tx * tile, ty * tile, std::min(width, (tx + 1) * tile),
+                                     std::min(height, (ty + 1) * tile)});
+                    }
+                },
+                oneapi::tbb::simple_partitioner());
+        });
+    }
+
+    /// body(i) for i in [0, n), in chunks of `grain`.
+    template <class Body>
+    void for_each_index(std::size_t n, std::size_t grain, Body&& body) {
+        arena_.execute([&] {
+            oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, grain),
+                                      [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                                          for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+                                      });
+        });
+    }
+
+  private:
+    int jobs_;
+    oneapi::tbb::global_control limit_;
+    oneapi::tbb::task_arena arena_;
+};
+
+}  // namespace streamrt

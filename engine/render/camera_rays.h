@@ -1,0 +1,34 @@
+#pragma once
+// Primary rays of the handout's canonical camera: eye E = (0,0,1), screen [-1,1]^2 in z = 0,
+// both placed in the world by Md. The ray through screen point P is [Md E, Md (P - E)).
+#include <glm/glm.hpp>
+
+#include "core/vec3.h"
+#include "scene/scene.h"
+
+namespace streamrt {
+
+template <class T>
+struct CameraRays {
+    Vec3T<T> origin;         ///< Md E
+    Vec3T<T> du, dv, dback;  ///< Md's linear part applied to x, y and -z
+    T inv_width, inv_height;
+
+    static CameraRays from(const Scene& scene) {
+        const RenderSettings& s = scene.settings;
+        const glm::dmat4 md = scene.camera.world_from_canonical(s.width, s.height);
+        const glm::dvec3 e = transform_point(md, {0.0, 0.0, 1.0});
+        const auto v = [](const glm::dvec3& a) { return Vec3T<T>{T(a.x), T(a.y), T(a.z)}; };
+        return {v(e), v(glm::dvec3(md[0])), v(glm::dvec3(md[1])), v(-glm::dvec3(md[2])),
+                T(1.0 / s.width), T(1.0 / s.height)};
+    }
+
+    /// Unit direction through image position (px, py), in pixels from the top-left corner.
+    Vec3T<T> direction(T px, T py) const {
+        const T u = T(2) * px * inv_width - T(1);
+        const T w = T(1) - T(2) * py * inv_height;
+        return normalize(du * u + dv * w + dback);
+    }
+};
+
+}  // namespace streamrt

@@ -1,0 +1,38 @@
+#pragma once
+// What a render did, for the summary line and the profile.
+#include <atomic>
+#include <cstdint>
+
+namespace streamrt {
+
+struct RayCounts {
+    std::uint64_t primary = 0, shadow = 0, reflected = 0, refracted = 0;
+    std::uint64_t total() const { return primary + shadow + reflected + refracted; }
+    RayCounts& operator+=(const RayCounts& o) {
+        primary += o.primary;
+        shadow += o.shadow;
+        reflected += o.reflected;
+        refracted += o.refracted;
+        return *this;
+    }
+};
+
+/// Shared between tiles: counts added once per tile, progress read by the display thread.
+struct RenderProgress {
+    std::atomic<std::uint64_t> primary{0}, shadow{0}, reflected{0}, refracted{0};
+    std::atomic<int> tiles_done{0};
+    int tiles_total = 0;
+    std::atomic<bool>* cancel = nullptr;  ///< set from a signal handler to stop early
+
+    void add(const RayCounts& c) {
+        primary += c.primary;
+        shadow += c.shadow;
+        reflected += c.reflected;
+        refracted += c.refracted;
+        ++tiles_done;
+    }
+    RayCounts counts() const { return {primary.load(), shadow.load(), reflected.load(), refracted.load()}; }
+    bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
+};
+
+}  // namespace streamrt

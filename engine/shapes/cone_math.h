@@ -1,0 +1,47 @@
+#pragma once
+// Canonical cone: base radius 1 at y = -1, apex at y = +1, base capped.
+#include "core/vec3.h"
+#include "shapes/quadratic.h"
+
+namespace streamrt {
+
+struct ConeMath {
+    /// Side: x^2 + z^2 = (k (1 - y))^2 with k = 1/2, for y in [-1, 1]. A ray parallel to a
+    /// generator has a = 0: solve_quadratic's c/q is then the single linear root.
+    template <class V>
+    static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
+        using namespace simd;
+        const V k2(0.25);
+        const V w = V(1) - o.y;  // height below the apex
+        const V a = d.x * d.x + d.z * d.z - k2 * d.y * d.y;
+        const V b = o.x * d.x + o.z * d.z + k2 * w * d.y;
+        const V c = o.x * o.x + o.z * o.z - k2 * w * w;
+        const auto r = solve_quadratic(a, b, c, b * b - a * c);
+        V best = t_max;
+        for (const V& t : {r.t0, r.t1}) {
+            const V y = o.y + d.y * t;
+            best = keep_closest(best, t, r.valid && y >= V(-1) && y <= V(1), t_min);
+        }
+        const V t = (V(-1) - o.y) / d.y;
+        const V x = o.x + d.x * t, z = o.z + d.z * t;
+        best = keep_closest(best, t, x * x + z * z <= V(1), t_min);
+        return miss_if_unchanged(best, t_max);
+    }
+    /// Gradient of the side, (x, k^2 (1 - y), z); the base cap below; +y at the apex itself.
+    template <class V>
+    static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) {
+        using namespace simd;
+        const V rho = sqrt(p.x * p.x + p.z * p.z);
+        // Signed distances: to the cap plane, and (scaled by 1/sqrt(1 + k^2)) to the side.
+        const V cap_dist = V(-1) - p.y;
+        const V side_dist = (rho - V(0.5) * (V(1) - p.y)) * V(0.894427190999916);
+        const auto on_cap = cap_dist > side_dist;
+        const V sy = V(0.25) * (V(1) - p.y);
+        const auto at_apex = (p.x * p.x + p.z * p.z + sy * sy) == V(0);
+        return {select(on_cap || at_apex, V(0), p.x),
+                select(on_cap, V(-1), select(at_apex, V(1), sy)),
+                select(on_cap || at_apex, V(0), p.z)};
+    }
+};
+
+}  // namespace streamrt

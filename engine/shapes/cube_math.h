@@ -1,0 +1,43 @@
+#pragma once
+// Canonical cube: [-1,1]^3.
+#include "core/vec3.h"
+#include "shapes/quadratic.h"
+
+namespace streamrt {
+
+struct CubeMath {
+    /// Slab test (Kay & Kajiya). A zero direction component gives +-inf slab distances; an
+    /// origin exactly on that slab's face gives 0*inf = NaN, which the select-based max/min
+    /// below ignore (the slab is then treated as not limiting, a grazing hit).
+    template <class V>
+    static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
+        using namespace simd;
+        V t_near = -infinity_v<V>(), t_far = infinity_v<V>();
+        const V o_arr[3] = {o.x, o.y, o.z}, d_arr[3] = {d.x, d.y, d.z};
+        for (int axis = 0; axis < 3; ++axis) {
+            const V inv = V(1) / d_arr[axis];
+            const V ta = (V(-1) - o_arr[axis]) * inv;
+            const V tb = (V(1) - o_arr[axis]) * inv;
+            const V lo = select(ta < tb, ta, tb), hi = select(ta < tb, tb, ta);
+            t_near = select(lo > t_near, lo, t_near);
+            t_far = select(hi < t_far, hi, t_far);
+        }
+        const auto spans = t_near <= t_far;
+        V best = keep_closest(t_max, t_near, spans, t_min);
+        best = keep_closest(best, t_far, spans, t_min);  // from inside, t_near < t_min
+        return miss_if_unchanged(best, t_max);
+    }
+    /// The face whose axis has the largest |coordinate|.
+    template <class V>
+    static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) {
+        using namespace simd;
+        const V ax = abs(p.x), ay = abs(p.y), az = abs(p.z);
+        const auto x_wins = (ax >= ay) && (ax >= az);
+        const auto y_wins = !x_wins && (ay >= az);
+        const auto z_wins = !x_wins && !y_wins;
+        return {select(x_wins, sign_of(p.x), V(0)), select(y_wins, sign_of(p.y), V(0)),
+                select(z_wins, sign_of(p.z), V(0))};
+    }
+};
+
+}  // namespace streamrt

@@ -1,0 +1,43 @@
+#pragma once
+// Canonical cylinder: radius 1 around the y axis, y in [-1,1], both ends capped.
+#include "core/vec3.h"
+#include "shapes/quadratic.h"
+
+namespace streamrt {
+
+struct CylinderMath {
+    template <class V>
+    static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
+        using namespace simd;
+        // Side: (ox + t dx)^2 + (oz + t dz)^2 = 1. A ray along the axis has a = 0, so q/a is
+        // inf and c/q is NaN (0 / 0) or a root outside |y| <= 1: no side hit, as it should.
+        const V a = d.x * d.x + d.z * d.z;
+        const V b = o.x * d.x + o.z * d.z;
+        const V c = o.x * o.x + o.z * o.z - V(1);
+        const V t_mid = -b / a;
+        const V px = o.x + d.x * t_mid, pz = o.z + d.z * t_mid;
+        const V disc = a * (V(1) - (px * px + pz * pz));
+        const auto r = solve_quadratic(a, b, c, disc);
+        V best = t_max;
+        best = keep_closest(best, r.t0, r.valid && abs(o.y + d.y * r.t0) <= V(1), t_min);
+        best = keep_closest(best, r.t1, r.valid && abs(o.y + d.y * r.t1) <= V(1), t_min);
+        // Caps y = +-1; dy = 0 gives +-inf or NaN, which fail the range test.
+        for (const float cap : {-1.f, 1.f}) {
+            const V t = (V(cap) - o.y) / d.y;
+            const V x = o.x + d.x * t, z = o.z + d.z * t;
+            best = keep_closest(best, t, x * x + z * z <= V(1), t_min);
+        }
+        return miss_if_unchanged(best, t_max);
+    }
+    /// Cap or side, whichever the point is closer to being outside of.
+    template <class V>
+    static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) {
+        using namespace simd;
+        const V rho = sqrt(p.x * p.x + p.z * p.z);
+        const auto on_cap = (abs(p.y) - V(1)) > (rho - V(1));
+        return {select(on_cap, V(0), p.x), select(on_cap, sign_of(p.y), V(0)),
+                select(on_cap, V(0), p.z)};
+    }
+};
+
+}  // namespace streamrt

@@ -1,0 +1,22 @@
+#pragma once
+// Canonical plane: y = 0, normal +y, infinite.
+#include "core/vec3.h"
+#include "shapes/quadratic.h"
+
+namespace streamrt {
+
+struct PlaneMath {
+    /// A ray parallel to the plane gives t = +-inf (or NaN when it lies in it): both miss.
+    template <class V>
+    static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
+        const V t = -o.y / d.y;
+        // The other components do not enter t; x - x == 0 is false for NaN and inf, so a
+        // poisoned ray misses instead of producing a NaN hit point.
+        const V rest = o.x + o.z + d.x + d.z;
+        return miss_if_unchanged(keep_closest(t_max, t, rest - rest == V(0), t_min), t_max);
+    }
+    template <class V>
+    static Vec3T<V> normal(const Vec3T<V>& /*p*/, V /*param*/) { return {V(0), V(1), V(0)}; }
+};
+
+}  // namespace streamrt

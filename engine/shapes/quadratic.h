@@ -1,0 +1,48 @@
+#pragma once
+// Shared root finding for the quadric shapes.
+#include <limits>
+
+#include "simd/lanes.h"
+
+namespace streamrt {
+
+template <class V>
+inline V infinity_v() {
+    return V(std::numeric_limits<simd::scalar_t<V>>::infinity());
+}
+
+/// Roots of a t^2 + 2 b t + c = 0 given disc = b^2 - a c computed by the caller (who can
+/// often compute it without cancellation). Uses q = -(b + sign(b) sqrt(disc)), t = q/a and
+/// t = c/q, which never subtracts nearly equal numbers (Numerical Recipes 5.6). a may be 0
+/// (a linear equation): then q/a is +-inf and c/q is the one root. Lanes with disc < 0 or
+/// NaN have `valid` false. Returns the roots unordered.
+template <class V>
+struct QuadraticRoots {
+    V t0, t1;
+    decltype(V(0) < V(0)) valid;
+};
+
+template <class V>
+inline QuadraticRoots<V> solve_quadratic(V a, V b, V c, V disc) {
+    using namespace simd;
+    const auto valid = disc >= V(0);  // false on NaN, on purpose
+    const V root = sqrt(select(valid, disc, V(0)));
+    const V q = -(b + sign_of(b) * root);
+    return {q / a, c / q, valid};
+}
+
+/// Keeps, per lane, the smallest candidate t with ok && t_min < t < best. NaN never wins.
+template <class V, class M>
+inline V keep_closest(V best, V t, M ok, V t_min) {
+    using namespace simd;
+    return select(ok && (t > t_min) && (t < best), t, best);
+}
+
+/// best started at t_max; lanes that kept it report a miss (+inf).
+template <class V>
+inline V miss_if_unchanged(V best, V t_max) {
+    using namespace simd;
+    return select(best < t_max, best, infinity_v<V>());
+}
+
+}  // namespace streamrt

@@ -1,0 +1,31 @@
+#pragma once
+// Canonical sphere: unit radius, centred at the origin.
+#include "core/vec3.h"
+#include "shapes/quadratic.h"
+
+namespace streamrt {
+
+struct SphereMath {
+    /// Nearest t in (t_min, t_max) with |o + t d| = 1, or +inf. d need not be unit length.
+    template <class V>
+    static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
+        const V a = dot(d, d);
+        const V b = dot(o, d);
+        const V c = dot(o, o) - V(1);
+        // b^2 - a c written about the closest-approach point (Hearn & Baker; Ray Tracing Gems
+        // ch. 7): a (1 - |perp|^2) loses nothing when the ray passes far from the centre.
+        const V t_mid = -b / a;
+        const Vec3T<V> perp = o + d * t_mid;
+        const V disc = a * (V(1) - dot(perp, perp));
+        const auto r = solve_quadratic(a, b, c, disc);
+        V best = t_max;
+        best = keep_closest(best, r.t0, r.valid, t_min);
+        best = keep_closest(best, r.t1, r.valid, t_min);
+        return miss_if_unchanged(best, t_max);
+    }
+    /// Outward normal (not unit) at a surface point.
+    template <class V>
+    static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) { return p; }
+};
+
+}  // namespace streamrt
