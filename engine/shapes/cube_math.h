@@ -22,7 +22,9 @@ struct CubeMath {
             t_near = select(lo > t_near, lo, t_near);
             t_far = select(hi < t_far, hi, t_far);
         }
-        const auto spans = t_near <= t_far;
+        // The NaN-tolerant max/min above would also swallow NaN inputs: reject those here.
+        const V all = o.x + o.y + o.z + d.x + d.y + d.z;
+        const auto spans = (t_near <= t_far) && (all - all == V(0));
         V best = keep_closest(t_max, t_near, spans, t_min);
         best = keep_closest(best, t_far, spans, t_min);  // from inside, t_near < t_min
         return miss_if_unchanged(best, t_max);
