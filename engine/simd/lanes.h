@@ -23,21 +23,8 @@ inline double max(double a, double b) { return a > b ? a : b; }
 inline float sign_of(float a) { return std::copysign(1.f, a); }
 inline double sign_of(double a) { return std::copysign(1.0, a); }
 
-template <class T, class A>
-inline xsimd::batch<T, A> select(const xsimd::batch_bool<T, A>& m, const xsimd::batch<T, A>& a,
-                                 const xsimd::batch<T, A>& b) {
-    return xsimd::select(m, a, b);
-}
-template <class T, class A>
-inline bool any(const xsimd::batch_bool<T, A>& m) { return xsimd::any(m); }
-template <class T, class A>
-inline bool all(const xsimd::batch_bool<T, A>& m) { return xsimd::all(m); }
-template <class T, class A>
-inline xsimd::batch<T, A> abs(const xsimd::batch<T, A>& a) { return xsimd::abs(a); }
-template <class T, class A>
-inline xsimd::batch<T, A> min(const xsimd::batch<T, A>& a, const xsimd::batch<T, A>& b) { return xsimd::min(a, b); }
-template <class T, class A>
-inline xsimd::batch<T, A> max(const xsimd::batch<T, A>& a, const xsimd::batch<T, A>& b) { return xsimd::max(a, b); }
+// Batch overloads of select/any/all/abs/min/max are xsimd's own, found by argument-dependent
+// lookup; declaring our own would make the calls ambiguous.
 template <class T, class A>
 inline xsimd::batch<T, A> sign_of(const xsimd::batch<T, A>& a) {
     return xsimd::copysign(xsimd::batch<T, A>(T(1)), a);

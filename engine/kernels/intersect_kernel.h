@@ -1,0 +1,112 @@
+#pragma once
+// The kernel bodies, templated on the xsimd arch and the shape. Included only by the
+// kernels/isa_*.cpp files, each inside its own namespace so that no inline function built
+// with one level's flags can be picked by the linker for another's callers.
+#include <xsimd/xsimd.hpp>
+
+#include "kernels/kernel_table.h"
+#include "shapes/shapes.h"
+
+namespace streamrt::STREAMRT_ISA_NAMESPACE {
+
+/// The precision each shape is solved in: float, except the torus, whose quartic needs
+/// double lanes (8 per AVX-512 register instead of 16).
+template <class Shape>
+struct ComputeType { using type = float; };
+template <>
+struct ComputeType<TorusMath> { using type = double; };
+
+template <class B>
+struct RayPacket {
+    Vec3T<B> o, d;
+};
+
+template <class B>
+inline B load_lanes(const float* p) {
+    return B::load_aligned(p);  // converts float -> double for double batches
+}
+
+/// World ray -> object's canonical space with Mi (12 broadcast FMAs per component set).
+template <class B, class T>
+inline RayPacket<B> to_canonical(const RayPacket<B>& r, const ObjectXf& ob) {
+    const auto m = [&](int i) { return B(T(ob.m[i])); };
+    RayPacket<B> c;
+    c.o.x = xsimd::fma(m(0), r.o.x, xsimd::fma(m(1), r.o.y, xsimd::fma(m(2), r.o.z, m(3))));
+    c.o.y = xsimd::fma(m(4), r.o.x, xsimd::fma(m(5), r.o.y, xsimd::fma(m(6), r.o.z, m(7))));
+    c.o.z = xsimd::fma(m(8), r.o.x, xsimd::fma(m(9), r.o.y, xsimd::fma(m(10), r.o.z, m(11))));
+    c.d.x = xsimd::fma(m(0), r.d.x, xsimd::fma(m(1), r.d.y, m(2) * r.d.z));
+    c.d.y = xsimd::fma(m(4), r.d.x, xsimd::fma(m(5), r.d.y, m(6) * r.d.z));
+    c.d.z = xsimd::fma(m(8), r.d.x, xsimd::fma(m(9), r.d.y, m(10) * r.d.z));
+    return c;
+}
+
+template <class Arch, class Shape>
+void closest_hit(RayView rays, std::int32_t* object, const ObjectXf* objs, std::size_t n_objs) {
+    using T = typename ComputeType<Shape>::type;
+    using B = xsimd::batch<T, Arch>;
+    constexpr std::size_t W = B::size;
+    for (std::size_t i = 0; i < rays.count; i += W) {  // padding makes the last packet safe
+        const RayPacket<B> r{{load_lanes<B>(rays.ox + i), load_lanes<B>(rays.oy + i), load_lanes<B>(rays.oz + i)},
+                             {load_lanes<B>(rays.dx + i), load_lanes<B>(rays.dy + i), load_lanes<B>(rays.dz + i)}};
+        B best = load_lanes<B>(rays.t_max + i);
+        const B start = best;
+        // Ids travel as T lanes (exact below 2^24 objects in float) so that the select shares
+        // the distance mask's type at every width.
+        B best_id(T(-1));
+        for (std::size_t k = 0; k < n_objs; ++k) {
+            const RayPacket<B> c = to_canonical<B, T>(r, objs[k]);
+            const B t = Shape::template hit_t<B>(c.o, c.d, B(T(objs[k].param)), B(T(0)), best);
+            const auto closer = t < best;
+            best = xsimd::select(closer, t, best);
+            best_id = xsimd::select(closer, B(T(objs[k].id)), best_id);
+        }
+        if (!xsimd::any(best < start)) continue;
+        alignas(64) T t_out[W], id_out[W];
+        best.store_aligned(t_out);
+        best_id.store_aligned(id_out);
+        for (std::size_t l = 0; l < W && i + l < rays.count; ++l) {
+            if (id_out[l] >= T(0)) {
+                rays.t_max[i + l] = float(t_out[l]);
+                object[i + l] = static_cast<std::int32_t>(id_out[l]);
+            }
+        }
+    }
+}
+
+template <class Arch, class Shape>
+void any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
+    using T = typename ComputeType<Shape>::type;
+    using B = xsimd::batch<T, Arch>;
+    constexpr std::size_t W = B::size;
+    for (std::size_t i = 0; i < rays.count; i += W) {
+        B t_max = load_lanes<B>(rays.t_max + i);
+        auto open = t_max > B(T(0));  // lanes not yet blocked (padding lanes have t_max < 0)
+        if (!xsimd::any(open)) continue;
+        const RayPacket<B> r{{load_lanes<B>(rays.ox + i), load_lanes<B>(rays.oy + i), load_lanes<B>(rays.oz + i)},
+                             {load_lanes<B>(rays.dx + i), load_lanes<B>(rays.dy + i), load_lanes<B>(rays.dz + i)}};
+        for (std::size_t k = 0; k < n_objs; ++k) {
+            const RayPacket<B> c = to_canonical<B, T>(r, objs[k]);
+            const B t = Shape::template hit_t<B>(c.o, c.d, B(T(objs[k].param)), B(T(0)), t_max);
+            open = open && !(t < t_max);
+            t_max = xsimd::select(open, t_max, B(T(0)));
+            if (!xsimd::any(open)) break;  // early exit: the whole packet is in shadow
+        }
+        alignas(64) T out[W];
+        t_max.store_aligned(out);
+        for (std::size_t l = 0; l < W && i + l < rays.count; ++l)
+            if (out[l] <= T(0)) rays.t_max[i + l] = 0.f;
+    }
+}
+
+template <class Arch>
+KernelTable make_table(Isa isa, const char* name) {
+    return KernelTable{isa,
+                       name,
+                       int(xsimd::batch<float, Arch>::size),
+                       {&closest_hit<Arch, SphereMath>, &closest_hit<Arch, CubeMath>, &closest_hit<Arch, CylinderMath>,
+                        &closest_hit<Arch, ConeMath>, &closest_hit<Arch, TorusMath>, &closest_hit<Arch, PlaneMath>},
+                       {&any_hit<Arch, SphereMath>, &any_hit<Arch, CubeMath>, &any_hit<Arch, CylinderMath>,
+                        &any_hit<Arch, ConeMath>, &any_hit<Arch, TorusMath>, &any_hit<Arch, PlaneMath>}};
+}
+
+}  // namespace streamrt::STREAMRT_ISA_NAMESPACE

@@ -1,0 +1,58 @@
+#pragma once
+// The SIMD intersection kernels, one per canonical shape and closest/any-hit, compiled for
+// several x86-64 levels (kernels/isa_*.cpp) and picked once per render from what the CPU
+// has. The pipeline calls them through this table, so only these files carry ISA flags.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scene/scene.h"
+#include "stream/ray_stream.h"
+
+namespace streamrt {
+
+/// One object as the kernels see it: Mi's top three rows (world -> canonical), broadcast
+/// into every lane, the shape parameter (torus minor radius) and the scene object index.
+struct ObjectXf {
+    float m[12];  ///< row-major 3x4
+    float param;
+    std::int32_t id;
+};
+
+/// Closest hit: for each ray, shrinks t_max to the nearest hit among objs and writes that
+/// object's id into object[]. Rays that hit nothing keep t_max and object untouched.
+using ClosestHitFn = void (*)(RayView rays, std::int32_t* object, const ObjectXf* objs, std::size_t n_objs);
+/// Any hit (shadow rays): sets t_max to 0 for every ray blocked by one of objs; packets whose
+/// rays are all blocked already are skipped.
+using AnyHitFn = void (*)(RayView rays, const ObjectXf* objs, std::size_t n_objs);
+
+enum class Isa : std::uint8_t { Sse2, Sse42, Avx2, Avx512 };
+inline constexpr int kIsaCount = 4;
+
+struct KernelTable {
+    Isa isa;
+    const char* name;
+    int float_lanes;
+    ClosestHitFn closest[kShapeKindCount];
+    AnyHitFn any[kShapeKindCount];
+};
+
+/// The best level this CPU runs.
+Isa best_isa();
+bool isa_supported(Isa isa);
+const char* isa_name(Isa isa);
+/// Parses "sse2", "sse4.2", "avx2", "avx512"; false if unknown.
+bool parse_isa(const std::string& s, Isa& out);
+/// The kernels built for that level (the caller has checked isa_supported).
+const KernelTable& kernel_table(Isa isa);
+
+namespace isa_kernels {
+// Defined in kernels/isa_<level>.cpp.
+const KernelTable& sse2();
+const KernelTable& sse42();
+const KernelTable& avx2();
+const KernelTable& avx512();
+}  // namespace isa_kernels
+
+}  // namespace streamrt

@@ -1,0 +1,85 @@
+#include "stream/profile.h"
+
+#include <cstdio>
+
+namespace streamrt {
+
+const char* stage_name(Stage s) {
+    switch (s) {
+        case Stage::Generate: return "generate";
+        case Stage::Intersect: return "intersect";
+        case Stage::Shade: return "shade+spawn";
+        case Stage::Occlusion: return "occlusion";
+        case Stage::Accumulate: return "accumulate";
+    }
+    return "?";
+}
+
+std::string StreamProfile::text() const {
+    std::string out;
+    char line[256];
+    std::snprintf(line, sizeof line, "stream profile: isa %s (%d float lanes), %d thread(s), wall %.4f s\n",
+                  isa.c_str(), lanes, threads, wall_seconds);
+    out += line;
+    out += "pipeline built:";
+    for (const auto& b : built) out += " " + b;
+    out += "\n";
+    double total_ns = 0;
+    for (const auto& s : stages) total_ns += double(s.nanoseconds);
+    std::snprintf(line, sizeof line, "%-12s %12s %12s %10s %7s %10s %8s\n", "stage", "rays in", "rays out", "time s",
+                  "share", "Mrays/s", "lanes");
+    out += line;
+    for (int i = 0; i < kStageCount; ++i) {
+        const StageFigures& s = stages[std::size_t(i)];
+        if (s.rays_in == 0 && s.nanoseconds == 0) continue;
+        const double sec = double(s.nanoseconds) * 1e-9;
+        const double mrays = sec > 0 ? double(s.rays_in) / sec / 1e6 : 0;
+        char lanes_txt[16] = "-";
+        if (s.lanes_total) std::snprintf(lanes_txt, sizeof lanes_txt, "%.1f%%", 100.0 * double(s.lanes_used) / double(s.lanes_total));
+        std::snprintf(line, sizeof line, "%-12s %12llu %12llu %10.4f %6.1f%% %10.2f %8s\n", stage_name(Stage(i)),
+                      (unsigned long long)s.rays_in, (unsigned long long)s.rays_out, sec,
+                      total_ns > 0 ? 100.0 * double(s.nanoseconds) / total_ns : 0.0, mrays, lanes_txt);
+        out += line;
+    }
+    std::snprintf(line, sizeof line,
+                  "rays: primary %llu, shadow %llu, reflected %llu, refracted %llu, total %llu (%.2f Mrays/s wall)\n",
+                  (unsigned long long)counts.primary, (unsigned long long)counts.shadow,
+                  (unsigned long long)counts.reflected, (unsigned long long)counts.refracted,
+                  (unsigned long long)counts.total(), wall_seconds > 0 ? double(counts.total()) / wall_seconds / 1e6 : 0.0);
+    out += line;
+    out += "(stage times are summed over threads)\n";
+    return out;
+}
+
+std::string StreamProfile::json() const {
+    std::string out = "{\n";
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "  \"isa\": \"%s\",\n  \"lanes\": %d,\n  \"threads\": %d,\n  \"wall_seconds\": %.6f,\n",
+                  isa.c_str(), lanes, threads, wall_seconds);
+    out += buf;
+    out += "  \"built\": [";
+    for (std::size_t i = 0; i < built.size(); ++i) out += (i ? ", \"" : "\"") + built[i] + "\"";
+    out += "],\n  \"stages\": [\n";
+    bool first = true;
+    for (int i = 0; i < kStageCount; ++i) {
+        const StageFigures& s = stages[std::size_t(i)];
+        if (s.rays_in == 0 && s.nanoseconds == 0) continue;
+        const double sec = double(s.nanoseconds) * 1e-9;
+        std::snprintf(buf, sizeof buf,
+                      "%s    {\"stage\": \"%s\", \"rays_in\": %llu, \"rays_out\": %llu, \"seconds\": %.6f, "
+                      "\"mrays_per_s\": %.3f, \"lane_utilisation\": %.4f}",
+                      first ? "" : ",\n", stage_name(Stage(i)), (unsigned long long)s.rays_in,
+                      (unsigned long long)s.rays_out, sec, sec > 0 ? double(s.rays_in) / sec / 1e6 : 0.0,
+                      s.lanes_total ? double(s.lanes_used) / double(s.lanes_total) : 1.0);
+        out += buf;
+        first = false;
+    }
+    std::snprintf(buf, sizeof buf,
+                  "\n  ],\n  \"rays\": {\"primary\": %llu, \"shadow\": %llu, \"reflected\": %llu, \"refracted\": %llu}\n}\n",
+                  (unsigned long long)counts.primary, (unsigned long long)counts.shadow,
+                  (unsigned long long)counts.reflected, (unsigned long long)counts.refracted);
+    out += buf;
+    return out;
+}
+
+}  // namespace streamrt

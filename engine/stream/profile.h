@@ -1,0 +1,64 @@
+#pragma once
+// Per-stage throughput figures of the stream engine (streamrt --profile).
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "render/render_stats.h"
+
+namespace streamrt {
+
+enum class Stage : int { Generate, Intersect, Shade, Occlusion, Accumulate };
+inline constexpr int kStageCount = 5;
+const char* stage_name(Stage s);
+
+struct StageFigures {
+    std::uint64_t rays_in = 0, rays_out = 0;
+    std::uint64_t nanoseconds = 0;      ///< summed over threads (CPU time in the stage)
+    std::uint64_t lanes_used = 0, lanes_total = 0;  ///< kernel stages: active lanes / lanes run
+    StageFigures& operator+=(const StageFigures& o) {
+        rays_in += o.rays_in;
+        rays_out += o.rays_out;
+        nanoseconds += o.nanoseconds;
+        lanes_used += o.lanes_used;
+        lanes_total += o.lanes_total;
+        return *this;
+    }
+};
+
+struct StreamProfile {
+    std::array<StageFigures, kStageCount> stages{};
+    RayCounts counts;
+    double wall_seconds = 0;
+    int threads = 1;
+    std::string isa;
+    int lanes = 0;
+    std::vector<std::string> built;  ///< the stages and kernels this scene's pipeline has
+    StreamProfile& operator+=(const StreamProfile& o) {
+        for (int i = 0; i < kStageCount; ++i) stages[std::size_t(i)] += o.stages[std::size_t(i)];
+        return *this;
+    }
+    std::string text() const;
+    std::string json() const;
+};
+
+/// Times a scope into a StageFigures when profiling; costs one branch when not.
+class StageTimer {
+  public:
+    StageTimer(StageFigures* f) : f_(f) {
+        if (f_) start_ = std::chrono::steady_clock::now();
+    }
+    ~StageTimer() {
+        if (f_)
+            f_->nanoseconds += std::uint64_t(
+                std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_).count());
+    }
+
+  private:
+    StageFigures* f_;
+    std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace streamrt

@@ -1,0 +1,102 @@
+#pragma once
+// Structure-of-arrays ray packets. Arrays are padded to a multiple of kMaxLanes (16 floats,
+// AVX-512) and 64-byte aligned in every build, so a full-width load of the last packet stays
+// inside the arrays; padding lanes are inert (t_max < 0 can never accept a hit) and
+// the kernels never write them back into results that matter.
+#include <cstddef>
+#include <cstdint>
+
+#include "simd/lanes.h"
+
+namespace streamrt {
+
+using simd::AlignedVec;
+
+enum class RayKind : std::uint8_t { Primary, Reflected, Refracted };
+
+/// Rays of one generation of one tile chunk.
+struct RayStream {
+    std::size_t count = 0;
+    AlignedVec<float> ox, oy, oz, dx, dy, dz;
+    AlignedVec<float> t_max;  ///< hits accepted for t in (0, t_max)
+    AlignedVec<float> wr, wg, wb;  ///< throughput weight: what the ray's colour is worth in its pixel
+    AlignedVec<std::int32_t> pixel;  ///< tile-local pixel the result accumulates into
+    AlignedVec<std::uint8_t> kind;   ///< RayKind, for the profile
+
+    /// Makes room for n rays (padded) and sets count = 0; keeps capacity.
+    void reserve(std::size_t n) {
+        const std::size_t cap = simd::round_up_lanes(n);
+        if (ox.size() < cap) {
+            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t_max, &wr, &wg, &wb}) a->resize(cap);
+            pixel.resize(cap);
+            kind.resize(cap);
+        }
+        count = 0;
+    }
+    std::size_t capacity() const { return ox.size(); }
+    /// Makes the lanes between count and the next multiple of kMaxLanes inert.
+    void pad_tail() {
+        const std::size_t end = simd::round_up_lanes(count);
+        for (std::size_t i = count; i < end; ++i) {
+            ox[i] = oy[i] = oz[i] = 0.f;
+            dx[i] = dy[i] = 0.f;
+            dz[i] = 1.f;
+            t_max[i] = -1.f;
+        }
+    }
+};
+
+/// Closest hit per ray: t (t_max where nothing was hit) and the scene object index (-1).
+struct HitStream {
+    AlignedVec<float> t;
+    AlignedVec<std::int32_t> object;
+    void reserve(std::size_t n) {
+        const std::size_t cap = simd::round_up_lanes(n);
+        if (t.size() < cap) {
+            t.resize(cap);
+            object.resize(cap);
+        }
+    }
+};
+
+/// Shadow rays: a segment towards a light and the colour it brings if nothing blocks it.
+struct ShadowStream {
+    std::size_t count = 0;
+    AlignedVec<float> ox, oy, oz, dx, dy, dz, t_max;
+    AlignedVec<float> cr, cg, cb;  ///< contribution (already weighted) if unoccluded
+    AlignedVec<std::int32_t> pixel;
+    void reserve(std::size_t n) {
+        const std::size_t cap = simd::round_up_lanes(n);
+        if (ox.size() < cap) {
+            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t_max, &cr, &cg, &cb}) a->resize(cap);
+            pixel.resize(cap);
+        }
+        count = 0;
+    }
+    std::size_t capacity() const { return ox.size(); }
+    void pad_tail() {
+        const std::size_t end = simd::round_up_lanes(count);
+        for (std::size_t i = count; i < end; ++i) {
+            ox[i] = oy[i] = oz[i] = 0.f;
+            dx[i] = dy[i] = 0.f;
+            dz[i] = 1.f;
+            t_max[i] = -1.f;
+        }
+    }
+};
+
+/// Rays as the kernels see them: pointers into a RayStream or a ShadowStream.
+struct RayView {
+    std::size_t count;
+    const float *ox, *oy, *oz, *dx, *dy, *dz;
+    float* t_max;  ///< closest-hit kernels shrink it to the best t; any-hit kernels set 0 on occlusion
+};
+
+inline RayView view_of(RayStream& r) {
+    return {r.count, r.ox.data(), r.oy.data(), r.oz.data(), r.dx.data(), r.dy.data(), r.dz.data(), r.t_max.data()};
+}
+inline RayView view_of(ShadowStream& r) {
+    return {r.count, r.ox.data(), r.oy.data(), r.oz.data(), r.dx.data(), r.dy.data(), r.dz.data(), r.t_max.data()};
+}
+
+}  // namespace streamrt

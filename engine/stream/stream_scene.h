@@ -1,0 +1,48 @@
+#pragma once
+// The scene as the stream engine reads it: single precision, flat tables, objects grouped
+// by shape kind so that each kernel runs over one kind's objects only.
+#include <cstdint>
+#include <vector>
+
+#include "kernels/kernel_table.h"
+#include "render/camera_rays.h"
+#include "render/shading.h"
+#include "scene/scene.h"
+
+namespace streamrt {
+
+/// What shading needs of one object, beside the kernels' ObjectXf.
+struct ShadeObject {
+    ShapeKind kind;
+    float param;
+    float mi[12];  ///< world -> canonical, row-major 3x4 (to rebuild the canonical hit point)
+    float md[12];  ///< canonical -> world
+    float mn[9];   ///< normals, row-major 3x3
+};
+
+/// The features a scene uses; the pipeline is specialised on them at compile time, so a
+/// scene without lights or mirrors runs no code for them.
+struct StreamFeatures {
+    bool lighting = false;  ///< degree >= 1
+    bool shadows = false;   ///< degree >= 5 and at least one light
+    bool reflect = false;   ///< degree >= 3, depth >= 1 and some material has refl > 0
+    bool refract = false;   ///< degree >= 4, depth >= 1 and some material has trans > 0
+    bool jitter = false;    ///< spp > 1
+};
+
+struct StreamScene {
+    RenderSettings settings;
+    StreamFeatures features;
+    CameraRays<float> camera;
+    std::vector<ShadeObject> objects;
+    std::vector<MaterialT<float>> materials;  ///< per object
+    std::vector<LightT<float>> lights;
+    /// Per shape kind (indexed by ShapeKind), the objects of that kind; empty kinds get no
+    /// kernel call at all.
+    std::vector<ObjectXf> groups[kShapeKindCount];
+    ColorT<float> background;
+
+    explicit StreamScene(const Scene& scene);
+};
+
+}  // namespace streamrt
