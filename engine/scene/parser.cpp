@@ -193,7 +193,8 @@ class Statement {
     }
     int integer(const Arg& a, int lo, int hi) const {
         const auto v = to_number(a.value);
-        if (!v || *v != std::floor(*v))
+        if (!v) fail(a.value_col, "expected a number for " + quote(a.key) + ", got " + quote(a.value));
+        if (*v != std::floor(*v))
             fail(a.value_col, "expected an integer for " + quote(a.key) + ", got " + quote(a.value));
         if (!(*v >= lo && *v <= hi))
             fail(a.value_col, quote(a.key) + " must be in [" + std::to_string(lo) + ", " +

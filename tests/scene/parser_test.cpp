@@ -153,7 +153,8 @@ TEST_CASE("parser: explicit camera") {
     CHECK(near(apply(d.camera.md, {1, -1, 0}), {2, 1, 3}));
     // The homothety comes first whatever the order the keys are written in.
     const Scene e = parse("camera translate=0,0,5 df=3 scale=2");
-    CHECK(near(apply(e.camera.md, {0, 0, 1}), {0, 0, 11}));
+    CHECK(near(apply(parse("camera df=3 scale=2 translate=0,0,5").camera.md, {0, 0, 1}), {0, 0, 11}));
+    CHECK(near(apply(e.camera.md, {0, 0, 1}), {0, 0, 16}));  // H, then T, then S
     // A later camera statement replaces the earlier one entirely.
     const Scene r = parse("camera eye=1,2,3 look=0,0,0\ncamera df=4\n");
     CHECK_FALSE(r.camera.look_at);
@@ -332,7 +333,7 @@ TEST_CASE("parser: errors carry the exact line and column") {
         expect_error("sphere color=1,1", 1, 14, "expected 3 comma-separated numbers");
         expect_error("sphere color=1,1,1,1", 1, 14, "got '1,1,1,1'");
         expect_error("sphere color=1,,1", 1, 14, "comma-separated");
-        expect_error("sphere color=1, 1,1", 1, 14, "comma-separated");
+        expect_error("sphere color=1, 1,1", 1, 17, "missing '='");  // no spaces inside a value
         expect_error("sphere color=1,x,1", 1, 14, "got '1,x,1'");
         expect_error("sphere diff=nan", 1, 13, "expected a number");
         expect_error("sphere diff=inf", 1, 13, "expected a number");
@@ -361,7 +362,7 @@ TEST_CASE("parser: errors carry the exact line and column") {
         expect_error("image degree=-1", 1, 14, "[0, 5]");
         expect_error("ambient 1.5", 1, 9, "[0, 1]");
         expect_error("ambient -0.1", 1, 9, "[0, 1]");
-        expect_error("material m ior=0", 1, 12, "'ior' must be > 0");
+        expect_error("material m ior=0", 1, 16, "'ior' must be > 0");
         expect_error("sphere ior=-1.5", 1, 12, "'ior' must be > 0");
         expect_error("plane cell=0", 1, 12, "'cell' must be > 0");
         expect_error("light spot pos=0,5,0 dir=0,-1,0 angle=0", 1, 39, "'angle' must be in (0, 180)");
