@@ -590,3 +590,25 @@ TEST_CASE("parser: every scene under scenes/ loads") {
     }
     CHECK(count >= 10);
 }
+
+TEST_CASE("parser: the example in docs/scene-format.md parses") {
+    std::ifstream in(fs::path(STREAMRT_SOURCE_DIR) / "docs" / "scene-format.md");
+    REQUIRE(in);
+    std::string line, text;
+    bool in_section = false, in_block = false, done = false;
+    while (!done && std::getline(in, line)) {
+        if (line.rfind("## A complete example", 0) == 0) in_section = true;
+        else if (in_section && line.rfind("```", 0) == 0) {
+            if (in_block) done = true;
+            in_block = true;
+        } else if (in_block) {
+            text += line + "\n";
+        }
+    }
+    REQUIRE(done);
+    const Scene s = parse_scene(text, "example.cfg");
+    CHECK(s.objects.size() == 4);
+    CHECK(s.lights.size() == 2);
+    CHECK(s.camera.look_at);
+    CHECK(s.settings.output == "example.png");
+}
