@@ -11,9 +11,12 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/error.h"
+#include "image/image_compare.h"
 #include "image/image_io.h"
+#include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
 #include "render/render.h"
 #include "scene/parser.h"
@@ -28,6 +31,7 @@ using namespace streamrt;
 namespace fs = std::filesystem;
 
 std::atomic<bool> g_cancel{false};
+struct Interrupted {};
 extern "C" void on_sigint(int) { g_cancel.store(true); }
 
 struct Options {
@@ -35,7 +39,11 @@ struct Options {
     int jobs = 0;
     std::string output;
     std::optional<int> spp, width, height, degree, depth;
-    std::string engine = "recursive";
+    std::string engine = "stream";
+    std::string isa;
+    bool profile = false;
+    std::string profile_json;
+    bool compare = false;
     std::string sampler;
     bool quiet = false;
     bool check_only = false;
@@ -111,14 +119,26 @@ int run(int argc, char** argv) {
     app.add_option("--height", opt.height, "Image height in pixels")->check(CLI::Range(1, 32768));
     app.add_option("--degree", opt.degree, "Shading degree 0..5 (handout)")->check(CLI::Range(0, 5));
     app.add_option("--depth", opt.depth, "Maximum bounces")->check(CLI::Range(0, 256));
-    app.add_option("--engine", opt.engine, "Renderer: recursive")->check(CLI::IsMember({"recursive"}));
+    app.add_option("--engine", opt.engine, "Renderer: stream (SIMD ray streams) or recursive (the handout's baseline)")
+        ->check(CLI::IsMember({"stream", "recursive"}));
+    app.add_option("--isa", opt.isa, "Force the stream kernels' level: sse2, sse4.2, avx2 or avx512 (default: best the CPU has)")
+        ->check(CLI::IsMember({"sse2", "sse4.2", "avx2", "avx512"}));
+    app.add_flag("--profile", opt.profile, "Print per-stage throughput of the stream engine");
+    app.add_option("--profile-json", opt.profile_json, "Write the profile as JSON to FILE (also: --profile=json FILE)");
+    app.add_flag("--compare", opt.compare, "Render with both engines and report times, speedup and image difference");
     app.add_option("--sampler", opt.sampler, "Pixel sampling: stratified, grid or random")
         ->check(CLI::IsMember({"stratified", "grid", "random"}));
     app.add_flag("-q,--quiet", opt.quiet, "No progress bar and no summary line");
     app.add_flag("--check", opt.check_only, "Validate the scene and the output path, render nothing");
     app.set_version_flag("--version", std::string("streamrt ") + STREAMRT_VERSION);
+    // "--profile=json FILE" is the documented spelling; CLI11 sees it as --profile-json FILE.
+    std::vector<std::string> args;
+    for (int i = argc - 1; i >= 1; --i) args.emplace_back(argv[i]);  // CLI11 wants them reversed
+    for (std::size_t i = 0; i < args.size(); ++i)
+        if (args[i] == "--profile=json") args[i] = "--profile-json";
+        else if (args[i] == "--profile=text") args[i] = "--profile";
     try {
-        app.parse(argc, argv);
+        app.parse(args);
     } catch (const CLI::ParseError& e) {
         return app.exit(e) == 0 ? 0 : 2;
     }
@@ -145,18 +165,56 @@ int run(int argc, char** argv) {
     std::signal(SIGINT, on_sigint);
     std::signal(SIGTERM, on_sigint);
     Parallelism par(opt.jobs);
-    const EngineKind engine = EngineKind::Recursive;
-    RenderProgress progress;
-    progress.cancel = &g_cancel;
-    progress.tiles_total = ((s.width + 15) / 16) * ((s.height + 15) / 16);
-    ProgressDisplay display(progress, !opt.quiet && ::isatty(2));
-    const RenderResult r = render_scene(scene, engine, par, &progress);
-    display.stop();
-    if (g_cancel.load()) {
-        std::fprintf(stderr, "streamrt: interrupted, no image written\n");
-        return 130;
+    const EngineKind engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
+    EngineOptions eo;
+    if (!opt.isa.empty()) {
+        parse_isa(opt.isa, eo.isa);
+        if (!isa_supported(eo.isa)) throw UsageError("--isa " + opt.isa + ": this CPU does not support it");
     }
+    StreamProfile profile;
+    const bool profiling = opt.profile || !opt.profile_json.empty();
+    if (profiling) eo.profile = &profile;
+    if (profiling && engine != EngineKind::Stream) throw UsageError("--profile needs the stream engine");
+
+    const auto render_once = [&](EngineKind which, bool show_progress) {
+        RenderProgress progress;
+        progress.cancel = &g_cancel;
+        progress.tiles_total = ((s.width + 15) / 16) * ((s.height + 15) / 16);
+        ProgressDisplay display(progress, show_progress && !opt.quiet && ::isatty(2));
+        RenderResult r = render_scene(scene, which, par, &progress, eo);
+        display.stop();
+        if (g_cancel.load()) throw Interrupted{};
+        return r;
+    };
+
+    if (opt.compare) {
+        eo.profile = nullptr;
+        const RenderResult base = render_once(EngineKind::Recursive, true);
+        const RenderResult str = render_once(EngineKind::Stream, true);
+        const ImageDifference d = compare_images(str.image, base.image);
+        std::printf("%s: %dx%d, spp %d, degree %d, -j%d, isa %s\n", opt.scene_path.c_str(), s.width, s.height, s.spp,
+                    s.degree, par.jobs(), isa_name(eo.isa));
+        std::printf("recursive: %.3f s, %llu rays (%.2f Mrays/s)\n", base.seconds,
+                    (unsigned long long)base.counts.total(), base.counts.total() / std::max(base.seconds, 1e-9) / 1e6);
+        std::printf("stream:    %.3f s, %llu rays (%.2f Mrays/s)\n", str.seconds,
+                    (unsigned long long)str.counts.total(), str.counts.total() / std::max(str.seconds, 1e-9) / 1e6);
+        std::printf("speedup:   %.2fx\n", base.seconds / std::max(str.seconds, 1e-9));
+        std::printf("difference (stream vs recursive, calibrated): max %.5f, rmse %.6f, psnr %.2f dB, "
+                    "pixels off by > 1/255: %.4f%%\n",
+                    d.max_abs, d.rmse, d.psnr, 100.0 * d.share_over);
+        return 0;
+    }
+
+    const RenderResult r = render_once(engine, true);
     write_image(s.output, r.image, s.calibration);
+    if (opt.profile) std::printf("%s", profile.text().c_str());
+    if (!opt.profile_json.empty()) {
+        std::FILE* f = std::fopen(opt.profile_json.c_str(), "w");
+        if (!f) throw RenderError(opt.profile_json + ": cannot write the profile");
+        const std::string j = profile.json();
+        std::fwrite(j.data(), 1, j.size(), f);
+        std::fclose(f);
+    }
     if (!opt.quiet) {
         const double mrays = r.counts.total() / std::max(r.seconds, 1e-9) / 1e6;
         std::printf("%s: %dx%d, spp %d, degree %d, %s engine, -j%d: %.3f s, %llu rays (%.2f Mrays/s) -> %s\n",
@@ -171,6 +229,9 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
     try {
         return run(argc, argv);
+    } catch (const Interrupted&) {
+        std::fprintf(stderr, "streamrt: interrupted, no image written\n");
+        return 130;
     } catch (const SceneError& e) {
         std::fprintf(stderr, "streamrt: %s\n", e.what());
         return 2;

@@ -87,7 +87,8 @@ std::string encode(const Framebuffer& fb, ImageFormat format) {
 void write_image(const std::string& path, const Framebuffer& fb, Calibration how) {
     const auto format = image_format_for(path);
     if (!format) throw RenderError(path + ": unknown image format (expected .ppm, .png or .pfm)");
-    const std::string data = encode(calibrate(fb, how), *format);
+    // PFM keeps the linear values for error measurement; the 8-bit formats are calibrated.
+    const std::string data = encode(*format == ImageFormat::Pfm ? fb : calibrate(fb, how), *format);
     // Temporary name in the same folder, so the rename is atomic.
     const fs::path target(path);
     const fs::path tmp = target.parent_path() /

@@ -3,6 +3,8 @@
 #include <string>
 
 #include "image/framebuffer.h"
+#include "kernels/kernel_table.h"
+#include "stream/profile.h"
 #include "parallel/parallelism.h"
 #include "render/render_stats.h"
 #include "scene/scene.h"
@@ -18,7 +20,12 @@ struct RenderResult {
     double seconds = 0;
 };
 
+struct EngineOptions {
+    Isa isa = best_isa();               ///< stream engine: kernel level
+    StreamProfile* profile = nullptr;   ///< stream engine: per-stage figures, when wanted
+};
+
 RenderResult render_scene(const Scene& scene, EngineKind engine, Parallelism& par,
-                          RenderProgress* progress = nullptr);
+                          RenderProgress* progress = nullptr, const EngineOptions& options = {});
 
 }  // namespace streamrt

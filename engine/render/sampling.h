@@ -23,8 +23,13 @@ struct PixelSample {
     double x, y;  ///< offset inside the pixel, in [0, 1)
 };
 
-/// Grid layout used by the grid and stratified patterns: cols x rows cells >= spp.
-inline int grid_columns(int spp) { return int(std::ceil(std::sqrt(double(spp)))); }
+/// Lattice used by the grid and stratified patterns: cols x rows = spp exactly, as square
+/// as possible (cols is the smallest divisor of spp not below its square root).
+inline int grid_columns(int spp) {
+    int cols = int(std::ceil(std::sqrt(double(spp))));
+    while (spp % cols != 0) ++cols;
+    return cols;
+}
 
 /// Sample `sample` of `spp` in pixel `pixel` (row-major index). spp = 1 always takes the
 /// pixel centre. grid: cell centres; stratified: one jittered point per cell; random:
@@ -35,7 +40,7 @@ inline PixelSample pixel_sample(SamplePattern pattern, int spp, std::uint64_t pi
     const double u = unit_from_bits(h), v = unit_from_bits(mix64(h));
     if (pattern == SamplePattern::Random) return {u, v};
     const int cols = grid_columns(spp);
-    const int rows = (spp + cols - 1) / cols;
+    const int rows = spp / cols;
     const int cx = sample % cols, cy = sample / cols;
     const double jx = pattern == SamplePattern::Grid ? 0.5 : u;
     const double jy = pattern == SamplePattern::Grid ? 0.5 : v;

@@ -1,0 +1,268 @@
+#pragma once
+// The stages of the stream pipeline, specialised at compile time on the features a scene
+// uses. Read run_chunk() top to bottom: it is the whole algorithm for one chunk of a tile.
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+
+#include "kernels/kernel_table.h"
+#include "parallel/parallelism.h"
+#include "render/render_stats.h"
+#include "render/sampling.h"
+#include "shapes/shapes.h"
+#include "stream/profile.h"
+#include "stream/ray_stream.h"
+#include "stream/stream_scene.h"
+
+namespace streamrt {
+
+/// Per-thread buffers, reused from chunk to chunk.
+struct Workspace {
+    RayStream current, next;
+    AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of `current`
+    ShadowStream shadows;
+};
+
+namespace stage_detail {
+
+inline Vec3f apply_point(const float* m, const Vec3f& p) {
+    return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+            m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
+}
+inline Vec3f apply_vector(const float* m, const Vec3f& v) {
+    return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
+            m[8] * v.x + m[9] * v.y + m[10] * v.z};
+}
+inline Vec3f apply_normal(const float* m, const Vec3f& n) {
+    return normalize(Vec3f{m[0] * n.x + m[1] * n.y + m[2] * n.z, m[3] * n.x + m[4] * n.y + m[5] * n.z,
+                           m[6] * n.x + m[7] * n.y + m[8] * n.z});
+}
+inline void add(float* accum, std::int32_t pixel, const ColorT<float>& c) {
+    accum[pixel * 3 + 0] += c.x;
+    accum[pixel * 3 + 1] += c.y;
+    accum[pixel * 3 + 2] += c.z;
+}
+inline std::uint64_t lanes_for(std::size_t n, int width) {
+    return (std::uint64_t(n) + std::uint64_t(width) - 1) / std::uint64_t(width) * std::uint64_t(width);
+}
+
+}  // namespace stage_detail
+
+template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
+struct PipelineStages {
+    static constexpr bool kSecondary = kReflect || kRefract;
+
+    /// generate: camera rays for pixels [first, first + n_pixels) of the tile, spp per pixel,
+    /// consecutive, so a pixel's samples share a packet. Weight 1/spp each.
+    static void generate(const StreamScene& sc, const Tile& tile, int first, int n_pixels, RayStream& rays) {
+        const int spp = sc.settings.spp;
+        const float w = 1.f / float(spp);
+        rays.reserve(std::size_t(n_pixels) * std::size_t(spp));
+        std::size_t i = 0;
+        for (int p = first; p < first + n_pixels; ++p) {
+            const int x = tile.x0 + p % tile.width(), y = tile.y0 + p / tile.width();
+            const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x);
+            for (int k = 0; k < spp; ++k, ++i) {
+                float sx = 0.5f, sy = 0.5f;
+                if constexpr (kJitter) {
+                    const PixelSample ps = pixel_sample(sc.settings.pattern, spp, pixel, k);
+                    sx = float(ps.x);
+                    sy = float(ps.y);
+                }
+                const Vec3f d = sc.camera.direction(float(x) + sx, float(y) + sy);
+                rays.ox[i] = sc.camera.origin.x;
+                rays.oy[i] = sc.camera.origin.y;
+                rays.oz[i] = sc.camera.origin.z;
+                rays.dx[i] = d.x;
+                rays.dy[i] = d.y;
+                rays.dz[i] = d.z;
+                rays.t_max[i] = std::numeric_limits<float>::infinity();
+                rays.wr[i] = rays.wg[i] = rays.wb[i] = w;
+                rays.pixel[i] = p;
+                rays.kind[i] = std::uint8_t(RayKind::Primary);
+            }
+        }
+        rays.count = i;
+    }
+
+    /// intersect: closest hit of every ray, one SIMD kernel per shape kind present.
+    static void intersect(const StreamScene& sc, const KernelTable& kt, RayStream& rays,
+                          AlignedVec<std::int32_t>& object, StageFigures* fig) {
+        rays.pad_tail();
+        if (object.size() < rays.capacity()) object.resize(rays.capacity());
+        std::fill_n(object.begin(), rays.count, -1);
+        for (int k = 0; k < kShapeKindCount; ++k) {
+            const auto& group = sc.groups[k];
+            if (group.empty()) continue;
+            kt.closest[k](view_of(rays), object.data(), group.data(), group.size());
+            if (fig) {
+                fig->lanes_used += rays.count;
+                fig->lanes_total += stage_detail::lanes_for(rays.count, k == int(ShapeKind::Torus) ? kt.float_lanes / 2 : kt.float_lanes);
+            }
+        }
+    }
+
+    /// shade + spawn: local terms by degree into the tile (or into shadow rays when degree 5
+    /// asks for visibility), reflected and refracted rays appended to `next` (the compaction:
+    /// only surviving rays move on). Misses bring the background.
+    static void shade(const StreamScene& sc, const RayStream& rays, const AlignedVec<std::int32_t>& object, int depth,
+                      RayStream& next, ShadowStream& shadows, float* accum, RayCounts& counts) {
+        using namespace stage_detail;
+        const RenderSettings& s = sc.settings;
+        const bool may_spawn = kSecondary && depth < s.depth;
+        for (std::size_t i = 0; i < rays.count; ++i) {
+            const ColorT<float> w{rays.wr[i], rays.wg[i], rays.wb[i]};
+            const std::int32_t px = rays.pixel[i];
+            const std::int32_t id = object[i];
+            if (id < 0) {
+                add(accum, px, mul(w, sc.background));
+                continue;
+            }
+            const ShadeObject& ob = sc.objects[std::size_t(id)];
+            const MaterialT<float>& m = sc.materials[std::size_t(id)];
+            const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
+            const float t = rays.t_max[i];
+            // Rebuild the canonical hit point (the kernels keep only t and the object) and
+            // bring point and normal back with Md and Mn, as the baseline does.
+            const Vec3f pc = apply_point(ob.mi, o) + apply_vector(ob.mi, d) * t;
+            const Vec3f p = apply_point(ob.md, pc);
+            const ColorT<float> base = surface_color(m, p);
+            if constexpr (!kLighting) {
+                add(accum, px, mul(w, base));
+                continue;
+            } else {
+                const Vec3f nc = visit_shape(ob.kind, [&](auto shape) { return shape.template normal<float>(pc, ob.param); });
+                const Vec3f n_out = apply_normal(ob.mn, nc);
+                const Vec3f n = dot(n_out, d) < 0.f ? n_out : -n_out;
+                add(accum, px, mul(w, ambient_light(s.degree, float(s.ambient), m, base)));
+                Vec3f shadow_origin{};
+                if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n);
+                for (const LightT<float>& l : sc.lights) {
+                    const LightSample<float> ls = sample_light(l, p);
+                    const ColorT<float> c = direct_light(s.degree, m, base, n, d, l, ls);
+                    if (c.x == 0.f && c.y == 0.f && c.z == 0.f) continue;
+                    if constexpr (kShadows) {
+                        const std::size_t j = shadows.count++;
+                        const Vec3f to = l.kind == LightKind::Directional ? ls.to_light : l.pos - shadow_origin;
+                        shadows.ox[j] = shadow_origin.x;
+                        shadows.oy[j] = shadow_origin.y;
+                        shadows.oz[j] = shadow_origin.z;
+                        shadows.dx[j] = to.x;
+                        shadows.dy[j] = to.y;
+                        shadows.dz[j] = to.z;
+                        shadows.t_max[j] = ls.t_max;
+                        const ColorT<float> wc = mul(w, c);
+                        shadows.cr[j] = wc.x;
+                        shadows.cg[j] = wc.y;
+                        shadows.cb[j] = wc.z;
+                        shadows.pixel[j] = px;
+                    } else {
+                        add(accum, px, mul(w, c));
+                    }
+                }
+                if (!may_spawn) continue;
+                if constexpr (kReflect) {
+                    if (m.refl > 0.f) {
+                        const std::size_t j = next.count++;
+                        const Vec3f r = reflect(d, n);
+                        const Vec3f from = offset_ray_origin(p, n);
+                        push(next, j, from, r, w * m.refl, px, RayKind::Reflected);
+                        ++counts.reflected;
+                    }
+                }
+                if constexpr (kRefract) {
+                    if (m.trans > 0.f) {
+                        const std::size_t j = next.count++;
+                        const Vec3f tr = refract(d, n_out, m.ior);
+                        const Vec3f from = offset_ray_origin(p, dot(tr, n_out) > 0.f ? n_out : -n_out);
+                        push(next, j, from, tr, w * m.trans, px, RayKind::Refracted);
+                        ++counts.refracted;
+                    }
+                }
+            }
+        }
+    }
+
+    static void push(RayStream& r, std::size_t j, const Vec3f& o, const Vec3f& d, const ColorT<float>& w,
+                     std::int32_t px, RayKind kind) {
+        r.ox[j] = o.x;
+        r.oy[j] = o.y;
+        r.oz[j] = o.z;
+        r.dx[j] = d.x;
+        r.dy[j] = d.y;
+        r.dz[j] = d.z;
+        r.t_max[j] = std::numeric_limits<float>::infinity();
+        r.wr[j] = w.x;
+        r.wg[j] = w.y;
+        r.wb[j] = w.z;
+        r.pixel[j] = px;
+        r.kind[j] = std::uint8_t(kind);
+    }
+
+    /// occlusion: any-hit kernels per shape kind (early exit per packet), then the light of
+    /// every unblocked shadow ray goes into its pixel.
+    static void occlusion(const StreamScene& sc, const KernelTable& kt, ShadowStream& shadows, float* accum,
+                          StageFigures* fig) {
+        shadows.pad_tail();
+        for (int k = 0; k < kShapeKindCount; ++k) {
+            const auto& group = sc.groups[k];
+            if (group.empty()) continue;
+            kt.any[k](view_of(shadows), group.data(), group.size());
+            if (fig) {
+                fig->lanes_used += shadows.count;
+                fig->lanes_total += stage_detail::lanes_for(shadows.count, k == int(ShapeKind::Torus) ? kt.float_lanes / 2 : kt.float_lanes);
+            }
+        }
+        for (std::size_t i = 0; i < shadows.count; ++i)
+            if (shadows.t_max[i] > 0.f) stage_detail::add(accum, shadows.pixel[i], {shadows.cr[i], shadows.cg[i], shadows.cb[i]});
+    }
+
+    static void run_chunk(const StreamScene& sc, const KernelTable& kt, const Tile& tile, int first, int n_pixels,
+                          Workspace& ws, float* accum, RayCounts& counts, StreamProfile* profile) {
+        const auto fig = [&](Stage s) { return profile ? &profile->stages[int(s)] : nullptr; };
+        const int spp = sc.settings.spp;
+        const std::size_t lights = sc.lights.size();
+        {
+            StageTimer timer(fig(Stage::Generate));
+            generate(sc, tile, first, n_pixels, ws.current);
+            counts.primary += ws.current.count;
+            if (profile) fig(Stage::Generate)->rays_out += ws.current.count, fig(Stage::Generate)->rays_in += std::uint64_t(n_pixels);
+        }
+        (void)spp;
+        for (int depth = 0; ws.current.count > 0; ++depth) {
+            RayStream& rays = ws.current;
+            {
+                StageTimer timer(fig(Stage::Intersect));
+                intersect(sc, kt, rays, ws.object, fig(Stage::Intersect));
+                if (profile) fig(Stage::Intersect)->rays_in += rays.count, fig(Stage::Intersect)->rays_out += rays.count;
+            }
+            {
+                StageTimer timer(fig(Stage::Shade));
+                // Room for every ray spawning both children and a shadow ray per light.
+                ws.next.reserve(kSecondary ? rays.count * 2 : 0);
+                if constexpr (kShadows) ws.shadows.reserve(rays.count * lights);
+                shade(sc, rays, ws.object, depth, ws.next, ws.shadows, accum, counts);
+                if (profile) {
+                    fig(Stage::Shade)->rays_in += rays.count;
+                    fig(Stage::Shade)->rays_out += ws.next.count + (kShadows ? ws.shadows.count : 0);
+                }
+            }
+            if constexpr (kShadows) {
+                StageTimer timer(fig(Stage::Occlusion));
+                counts.shadow += ws.shadows.count;
+                occlusion(sc, kt, ws.shadows, accum, fig(Stage::Occlusion));
+                if (profile) {
+                    fig(Stage::Occlusion)->rays_in += ws.shadows.count;
+                    for (std::size_t i = 0; i < ws.shadows.count; ++i) fig(Stage::Occlusion)->rays_out += ws.shadows.t_max[i] > 0.f;
+                }
+            }
+            if constexpr (kSecondary) {
+                std::swap(ws.current, ws.next);
+            } else {
+                ws.current.count = 0;
+            }
+        }
+    }
+};
+
+}  // namespace streamrt

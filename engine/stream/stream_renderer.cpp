@@ -1,0 +1,110 @@
+#include "stream/stream_renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <mutex>
+
+#include "render/sampling.h"
+#include "shapes/shapes.h"
+#include "stream/stages.h"
+
+namespace streamrt {
+
+StreamRenderer::StreamRenderer(const Scene& scene, Isa isa)
+    : scene_(scene), kernels_(kernel_table(isa)), tile_fn_(nullptr) {
+    tile_fn_ = select_tile_fn();
+}
+
+std::vector<std::string> StreamRenderer::built_stages() const {
+    const StreamFeatures& f = scene_.features;
+    std::vector<std::string> b{f.jitter ? "generate(jittered)" : "generate(centre)"};
+    std::string kernels = "intersect[";
+    bool first = true;
+    for (int k = 0; k < kShapeKindCount; ++k)
+        if (!scene_.groups[k].empty()) {
+            kernels += (first ? "" : ",") + std::string(shape_kind_name(ShapeKind(k)));
+            first = false;
+        }
+    b.push_back(kernels + "]");
+    b.push_back(f.lighting ? "shade(lit)" : "shade(flat)");
+    if (f.reflect) b.push_back("spawn(reflect)");
+    if (f.refract) b.push_back("spawn(refract)");
+    if (f.shadows) b.push_back("occlusion(any-hit)");
+    b.push_back("accumulate");
+    return b;
+}
+
+template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
+void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, float* accum, RayCounts& counts,
+                                 StreamProfile* profile) {
+    using Stages = PipelineStages<kLighting, kShadows, kReflect, kRefract, kJitter>;
+    const StreamScene& sc = self.scene_;
+    const int spp = sc.settings.spp;
+    // Memory in flight is bounded by the chunk, not the image: a tile's pixels are cut into
+    // chunks of whole pixels (all samples of a pixel in the same stream, hence packet).
+    const int tile_pixels = tile.width() * tile.height();
+    const int pixels_per_chunk = std::max(1, int(kMaxChunkRays / std::size_t(spp)));
+    static thread_local Workspace ws;
+    for (int first = 0; first < tile_pixels; first += pixels_per_chunk) {
+        const int n_pixels = std::min(pixels_per_chunk, tile_pixels - first);
+        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile);
+    }
+}
+
+StreamRenderer::TileFn StreamRenderer::select_tile_fn() const {
+    // Every combination is instantiated; the scene picks one. A scene without lights or
+    // mirrors runs a pipeline that has no code for them.
+    const StreamFeatures& f = scene_.features;
+    const int key = (f.lighting ? 1 : 0) | (f.shadows ? 2 : 0) | (f.reflect ? 4 : 0) | (f.refract ? 8 : 0) |
+                    (f.jitter ? 16 : 0);
+#define STREAMRT_TILE_FN(k) \
+    &render_tile<bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8), bool((k) & 16)>
+    static constexpr TileFn table[32] = {
+        STREAMRT_TILE_FN(0),  STREAMRT_TILE_FN(1),  STREAMRT_TILE_FN(2),  STREAMRT_TILE_FN(3),
+        STREAMRT_TILE_FN(4),  STREAMRT_TILE_FN(5),  STREAMRT_TILE_FN(6),  STREAMRT_TILE_FN(7),
+        STREAMRT_TILE_FN(8),  STREAMRT_TILE_FN(9),  STREAMRT_TILE_FN(10), STREAMRT_TILE_FN(11),
+        STREAMRT_TILE_FN(12), STREAMRT_TILE_FN(13), STREAMRT_TILE_FN(14), STREAMRT_TILE_FN(15),
+        STREAMRT_TILE_FN(16), STREAMRT_TILE_FN(17), STREAMRT_TILE_FN(18), STREAMRT_TILE_FN(19),
+        STREAMRT_TILE_FN(20), STREAMRT_TILE_FN(21), STREAMRT_TILE_FN(22), STREAMRT_TILE_FN(23),
+        STREAMRT_TILE_FN(24), STREAMRT_TILE_FN(25), STREAMRT_TILE_FN(26), STREAMRT_TILE_FN(27),
+        STREAMRT_TILE_FN(28), STREAMRT_TILE_FN(29), STREAMRT_TILE_FN(30), STREAMRT_TILE_FN(31)};
+#undef STREAMRT_TILE_FN
+    return table[key];
+}
+
+Framebuffer StreamRenderer::render(Parallelism& par, RenderProgress* progress, StreamProfile* profile) const {
+    const RenderSettings& s = scene_.settings;
+    Framebuffer fb(s.width, s.height);
+    std::mutex profile_mutex;
+    const auto start = std::chrono::steady_clock::now();
+    par.for_each_tile(s.width, s.height, kTileSize, [&](int, Tile tile) {
+        if (progress && progress->cancelled()) return;
+        RayCounts counts;
+        StreamProfile local;
+        // Tile-local accumulation in a fixed order: the result cannot depend on scheduling.
+        float accum[kTileSize * kTileSize * 3] = {};
+        tile_fn_(*this, tile, accum, counts, profile ? &local : nullptr);
+        {
+            StageTimer timer(profile ? &local.stages[int(Stage::Accumulate)] : nullptr);
+            for (int y = tile.y0; y < tile.y1; ++y)
+                std::copy_n(&accum[((y - tile.y0) * tile.width()) * 3], tile.width() * 3, fb.pixel(tile.x0, y));
+        }
+        if (profile) {
+            local.stages[int(Stage::Accumulate)].rays_in += std::uint64_t(tile.width() * tile.height());
+            std::lock_guard<std::mutex> lock(profile_mutex);
+            *profile += local;
+            profile->counts += counts;
+        }
+        if (progress) progress->add(counts);
+    });
+    if (profile) {
+        profile->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        profile->threads = par.jobs();
+        profile->isa = kernels_.name;
+        profile->lanes = kernels_.float_lanes;
+        profile->built = built_stages();
+    }
+    return fb;
+}
+
+}  // namespace streamrt

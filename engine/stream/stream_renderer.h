@@ -1,0 +1,42 @@
+#pragma once
+// The ray-stream engine: rays in structure-of-arrays streams, processed breadth-first in
+// stages per tile (generate, intersect, shade + spawn, occlusion, accumulate), with one SIMD
+// kernel per canonical shape. Same pictures as the recursive baseline, in single precision.
+#include "image/framebuffer.h"
+#include "kernels/kernel_table.h"
+#include "parallel/parallelism.h"
+#include "render/render_stats.h"
+#include "stream/profile.h"
+#include "stream/stream_scene.h"
+
+namespace streamrt {
+
+class StreamRenderer {
+  public:
+    StreamRenderer(const Scene& scene, Isa isa);
+
+    /// Renders the image. With a profile, every stage is timed and counted into it.
+    Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr, StreamProfile* profile = nullptr) const;
+
+    const StreamScene& scene() const { return scene_; }
+    const KernelTable& kernels() const { return kernels_; }
+    /// Names of the stages and kernels this scene's pipeline is built from.
+    std::vector<std::string> built_stages() const;
+
+    /// Pixels per tile side, and the most primary rays in flight per tile chunk.
+    static constexpr int kTileSize = 16;
+    static constexpr std::size_t kMaxChunkRays = 4096;
+
+  private:
+    using TileFn = void (*)(const StreamRenderer&, const Tile&, float* accum, RayCounts&, StreamProfile*);
+    template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
+    static void render_tile(const StreamRenderer& self, const Tile& tile, float* accum, RayCounts& counts,
+                            StreamProfile* profile);
+    TileFn select_tile_fn() const;
+
+    StreamScene scene_;
+    const KernelTable& kernels_;
+    TileFn tile_fn_;
+};
+
+}  // namespace streamrt
