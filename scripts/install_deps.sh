@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs streamrt's build and test dependencies from Debian 12's packages (run as root).
+# Does nothing when everything is already there.
+set -euo pipefail
+packages=(g++ cmake ninja-build pkg-config libxsimd-dev xtl-dev libtbb-dev libglm-dev libstb-dev
+          doctest-dev libcli11-dev libbenchmark-dev libtinyobjloader-dev python3-matplotlib)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "installing: ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
