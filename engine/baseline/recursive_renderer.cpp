@@ -82,8 +82,9 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     ColorT<double> color = ambient_light(s.degree, s.ambient, m, base);
     for (const LightT<double>& l : lights_) {
         const LightSample<double> ls = sample_light(l, hit.point);
-        const ColorT<double> c = direct_light(s.degree, m, base, n, ray.dir, l, ls);
-        if (c.x == 0 && c.y == 0 && c.z == 0) continue;
+        const DirectLight<double> dl = direct_light(s.degree, m, base, n, ray.dir, l, ls);
+        if (!dl.lit) continue;
+        const ColorT<double>& c = dl.color;
         if (s.degree >= 5) {
             const Vec3d from = offset_ray_origin(hit.point, n);
             const Vec3d to = l.kind == LightKind::Directional ? ls.to_light : l.pos - from;

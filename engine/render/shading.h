@@ -1,7 +1,8 @@
 #pragma once
 // The handout's local lighting by degree, reflection, refraction and ray-origin offsets,
-// written once for T = double (recursive baseline) and T = float (stream engine).
-#include <algorithm>
+// written once for V = double (recursive baseline), float and xsimd float batches (the
+// stream engine's shade kernels). Materials and lights are per-object scalars, broadcast
+// into lanes; everything that varies per ray goes through select(), never a branch.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -9,11 +10,26 @@
 
 #include "core/vec3.h"
 #include "scene/scene.h"
+#include "simd/lanes.h"
 
 namespace streamrt {
 
 template <class T>
 using ColorT = Vec3T<T>;
+
+template <class V>
+using MaskOf = decltype(V() < V());
+
+template <class V, class M>
+inline Vec3T<V> select3(const M& m, const Vec3T<V>& a, const Vec3T<V>& b) {
+    using simd::select;
+    return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
+}
+
+template <class V, class T>
+inline Vec3T<V> splat(const Vec3T<T>& a) {
+    return {V(a.x), V(a.y), V(a.z)};
+}
 
 template <class T>
 struct MaterialT {
@@ -46,93 +62,104 @@ struct LightT {
 
 /// Checker cells of side `cell` centred on multiples of cell: y = 0 floors sit mid-cell, so
 /// float noise in a coordinate cannot flip the parity there.
-template <class T>
-inline ColorT<T> surface_color(const MaterialT<T>& m, const Vec3T<T>& p) {
-    if (!m.checker) return m.color;
-    const auto cell = [&](T v) { return static_cast<std::int64_t>(std::floor(v * m.inv_cell + T(0.5))); };
-    const std::int64_t parity = (cell(p.x) + cell(p.y) + cell(p.z)) & 1;
-    return parity ? m.checker_color : m.color;
+template <class V, class T>
+inline ColorT<V> surface_color(const MaterialT<T>& m, const Vec3T<V>& p) {
+    using namespace simd;
+    if (!m.checker) return splat<V>(m.color);
+    using std::floor;
+    const V k(m.inv_cell), half(0.5);
+    const V sum = floor(p.x * k + half) + floor(p.y * k + half) + floor(p.z * k + half);
+    const auto odd = floor(sum * half) != sum * half;
+    return select3(odd, splat<V>(m.checker_color), splat<V>(m.color));
 }
 
 /// Where a light is seen from p: unit direction w towards it, the shadow-ray segment
-/// (p + t (to_light), t in (0, t_max)) and whether p is lit at all (spot cone).
-template <class T>
+/// (p + t to_light, t in (0, t_max)) and whether p is inside the light's reach (spot cone).
+template <class V>
 struct LightSample {
-    Vec3T<T> w;         ///< unit, towards the light
-    Vec3T<T> to_light;  ///< shadow-ray direction: light - p for lights at a point, w otherwise
-    T t_max;            ///< 1 for lights at a point (just short of it), +inf for directional
-    bool reaches;       ///< false outside a spot's cone
+    Vec3T<V> w;         ///< unit, towards the light
+    Vec3T<V> to_light;  ///< shadow-ray direction: light - p for lights at a point, w otherwise
+    V t_max;            ///< 1 for lights at a point, +inf for directional
+    MaskOf<V> reaches;  ///< false outside a spot's cone
 };
 
-template <class T>
-inline LightSample<T> sample_light(const LightT<T>& l, const Vec3T<T>& p) {
-    LightSample<T> s;
+template <class V, class T>
+inline LightSample<V> sample_light(const LightT<T>& l, const Vec3T<V>& p) {
+    LightSample<V> s;
     if (l.kind == LightKind::Directional) {
-        s.w = -l.dir;
+        s.w = splat<V>(-l.dir);
         s.to_light = s.w;
-        s.t_max = std::numeric_limits<T>::infinity();
-        s.reaches = true;
+        s.t_max = V(std::numeric_limits<T>::infinity());
+        s.reaches = V(0) == V(0);
         return s;
     }
-    s.to_light = l.pos - p;
+    s.to_light = splat<V>(l.pos) - p;
     s.w = normalize(s.to_light);
-    s.t_max = T(1);
-    s.reaches = l.kind == LightKind::Point || dot(-s.w, l.dir) >= l.cos_angle;
+    s.t_max = V(1);
+    if (l.kind == LightKind::Point) s.reaches = V(0) == V(0);
+    else s.reaches = dot(-s.w, splat<V>(l.dir)) >= V(l.cos_angle);
     return s;
 }
 
-/// Direct light from one light at degree >= 1 (visibility is the caller's business):
+template <class V>
+struct DirectLight {
+    ColorT<V> color;  ///< zero where `lit` is false
+    MaskOf<V> lit;    ///< the light reaches the side the normal faces
+};
+
+/// Direct light from one light at degree >= 1, before visibility:
 /// degree 1: (N.w) Col with the light taken as white; degree >= 2: light colour x
 /// (diff (N.w) Col + spec (R.V)^shininess).  n faces the viewer; view is the ray direction.
-template <class T>
-inline ColorT<T> direct_light(int degree, const MaterialT<T>& m, const ColorT<T>& base,
-                              const Vec3T<T>& n, const Vec3T<T>& view, const LightT<T>& l,
-                              const LightSample<T>& s) {
-    const T ndotw = dot(n, s.w);
-    if (!s.reaches || !(ndotw > T(0))) return {T(0), T(0), T(0)};
-    if (degree == 1) return base * ndotw;
-    ColorT<T> c = base * (m.diff * ndotw);
+template <class V, class T>
+inline DirectLight<V> direct_light(int degree, const MaterialT<T>& m, const ColorT<V>& base, const Vec3T<V>& n,
+                                   const Vec3T<V>& view, const LightT<T>& l, const LightSample<V>& s) {
+    using namespace simd;
+    const V zero(0);
+    const V ndotw = dot(n, s.w);
+    const auto lit = s.reaches && (ndotw > zero);
+    const V k = select(lit, ndotw, zero);
+    if (degree == 1) return {base * k, lit};
+    ColorT<V> c = base * (V(m.diff) * k);
     if (m.spec > T(0)) {
-        const Vec3T<T> r = n * (T(2) * ndotw) - s.w;  // w mirrored about n
-        const T rv = -dot(r, view);
-        if (rv > T(0)) {
-            const T h = m.spec * std::pow(rv, m.shininess);
-            c = c + ColorT<T>{h, h, h};
-        }
+        using std::pow;
+        const Vec3T<V> r = n * (V(2) * ndotw) - s.w;  // w mirrored about n
+        const V rv = -dot(r, view);
+        const auto shiny = lit && (rv > zero);
+        const V h = select(shiny, V(m.spec) * pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
+        c = c + ColorT<V>{h, h, h};
     }
-    return mul(c, l.color);
+    return {mul(c, splat<V>(l.color)), lit};
 }
 
 /// The part of the colour that needs no light: degree 0 the flat colour, degree 1
 /// alpha Col, degree >= 2 alpha ambi Col.
-template <class T>
-inline ColorT<T> ambient_light(int degree, T alpha, const MaterialT<T>& m, const ColorT<T>& base) {
+template <class V, class T>
+inline ColorT<V> ambient_light(int degree, T alpha, const MaterialT<T>& m, const ColorT<V>& base) {
     if (degree == 0) return base;
-    if (degree == 1) return base * alpha;
-    return base * (alpha * m.ambi);
+    if (degree == 1) return base * V(alpha);
+    return base * V(alpha * m.ambi);
 }
 
-template <class T>
-inline Vec3T<T> reflect(const Vec3T<T>& d, const Vec3T<T>& n) {
-    return d - n * (T(2) * dot(d, n));
+template <class V>
+inline Vec3T<V> reflect(const Vec3T<V>& d, const Vec3T<V>& n) {
+    return d - n * (V(2) * dot(d, n));
 }
 
 /// Snell's law for a unit d at a surface of outward unit normal n and index ior inside.
 /// Entering when d.n < 0. On total internal reflection returns the mirror direction.
-template <class T>
-inline Vec3T<T> refract(const Vec3T<T>& d, const Vec3T<T>& n, T ior, bool* total_internal = nullptr) {
-    T cos_i = -dot(d, n);
-    Vec3T<T> nn = n;
-    T eta = T(1) / ior;
-    if (cos_i < T(0)) {  // leaving
-        cos_i = -cos_i;
-        nn = -n;
-        eta = ior;
-    }
-    const T k = T(1) - eta * eta * (T(1) - cos_i * cos_i);
-    if (total_internal) *total_internal = k < T(0);
-    if (k < T(0)) return reflect(d, nn);
-    return normalize(d * eta + nn * (eta * cos_i - std::sqrt(k)));
+template <class V, class T>
+inline Vec3T<V> refract(const Vec3T<V>& d, const Vec3T<V>& n, T ior, MaskOf<V>* total_internal = nullptr) {
+    using namespace simd;
+    const V cos_signed = -dot(d, n);
+    const auto leaving = cos_signed < V(0);
+    const V cos_i = abs(cos_signed);
+    const Vec3T<V> nn = select3(leaving, -n, n);
+    const V eta = select(leaving, V(ior), V(T(1) / ior));
+    const V k = V(1) - eta * eta * (V(1) - cos_i * cos_i);
+    const auto tir = k < V(0);
+    if (total_internal) *total_internal = tir;
+    const Vec3T<V> t = normalize(d * eta + nn * (eta * cos_i - sqrt(select(tir, V(0), k))));
+    return select3(tir, reflect(d, nn), t);
 }
 
 namespace detail {
@@ -141,7 +168,7 @@ struct OffsetTraits;
 template <>
 struct OffsetTraits<float> {
     using Int = std::int32_t;
-    static constexpr float kIntScale = 256.f;        // ulps pushed along the normal
+    static constexpr float kIntScale = 256.f;  // ulps pushed along the normal
     static constexpr float kFloatScale = 1.f / 65536.f;
 };
 template <>
@@ -158,6 +185,7 @@ inline T add_ulps(T v, typename OffsetTraits<T>::Int ulps) {
     std::memcpy(&v, &bits, sizeof v);
     return v;
 }
+inline constexpr double kOffsetOrigin = 1.0 / 32.0;
 }  // namespace detail
 
 /// Moves a hit point off its surface along n (the side the new ray leaves on) by an amount
@@ -169,10 +197,26 @@ template <class T>
 inline Vec3T<T> offset_ray_origin(const Vec3T<T>& p, const Vec3T<T>& n) {
     using Tr = detail::OffsetTraits<T>;
     using Int = typename Tr::Int;
-    constexpr T kOrigin = T(1) / T(32);
     const auto one = [&](T pc, T nc) {
-        if (std::fabs(pc) < kOrigin) return pc + Tr::kFloatScale * nc;
+        if (std::fabs(pc) < T(detail::kOffsetOrigin)) return pc + Tr::kFloatScale * nc;
         return detail::add_ulps(pc, static_cast<Int>(Tr::kIntScale * nc));
+    };
+    return {one(p.x, n.x), one(p.y, n.y), one(p.z, n.z)};
+}
+
+/// The same for float lanes: the integer view of each lane moves by 256 n ulps.
+template <class A>
+inline Vec3T<xsimd::batch<float, A>> offset_ray_origin(const Vec3T<xsimd::batch<float, A>>& p,
+                                                       const Vec3T<xsimd::batch<float, A>>& n) {
+    using B = xsimd::batch<float, A>;
+    using I = xsimd::batch<std::int32_t, A>;
+    using Tr = detail::OffsetTraits<float>;
+    const auto one = [](const B& pc, const B& nc) {
+        const I of = xsimd::to_int(B(Tr::kIntScale) * nc);  // truncates like the scalar cast
+        const I bits = xsimd::bitwise_cast<I>(pc);
+        const I moved = xsimd::select(xsimd::bool_cast(pc < B(0.f)), bits - of, bits + of);
+        const B far = xsimd::bitwise_cast<B>(moved);
+        return xsimd::select(xsimd::abs(pc) < B(float(detail::kOffsetOrigin)), pc + B(Tr::kFloatScale) * nc, far);
     };
     return {one(p.x, n.x), one(p.y, n.y), one(p.z, n.z)};
 }

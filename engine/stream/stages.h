@@ -139,8 +139,9 @@ struct PipelineStages {
                 if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n);
                 for (const LightT<float>& l : sc.lights) {
                     const LightSample<float> ls = sample_light(l, p);
-                    const ColorT<float> c = direct_light(s.degree, m, base, n, d, l, ls);
-                    if (c.x == 0.f && c.y == 0.f && c.z == 0.f) continue;
+                    const DirectLight<float> dl = direct_light(s.degree, m, base, n, d, l, ls);
+                    if (!dl.lit) continue;
+                    const ColorT<float>& c = dl.color;
                     if constexpr (kShadows) {
                         const std::size_t j = shadows.count++;
                         const Vec3f to = l.kind == LightKind::Directional ? ls.to_light : l.pos - shadow_origin;
