@@ -44,6 +44,7 @@ struct Options {
     bool profile = false;
     std::string profile_json;
     bool compare = false;
+    std::string shade = "simd";
     std::string sampler;
     bool quiet = false;
     bool check_only = false;
@@ -125,6 +126,8 @@ int run(int argc, char** argv) {
         ->check(CLI::IsMember({"sse2", "sse4.2", "avx2", "avx512"}));
     app.add_flag("--profile", opt.profile, "Print per-stage throughput of the stream engine");
     app.add_option("--profile-json", opt.profile_json, "Write the profile as JSON to FILE (also: --profile=json FILE)");
+    app.add_option("--shade", opt.shade, "Stream shade stage: simd (sorted by object, default) or scalar (for measurement)")
+        ->check(CLI::IsMember({"simd", "scalar"}));
     app.add_flag("--compare", opt.compare, "Render with both engines and report times, speedup and image difference");
     app.add_option("--sampler", opt.sampler, "Pixel sampling: stratified, grid or random")
         ->check(CLI::IsMember({"stratified", "grid", "random"}));
@@ -171,6 +174,7 @@ int run(int argc, char** argv) {
         parse_isa(opt.isa, eo.isa);
         if (!isa_supported(eo.isa)) throw UsageError("--isa " + opt.isa + ": this CPU does not support it");
     }
+    eo.scalar_shade = opt.shade == "scalar";
     StreamProfile profile;
     const bool profiling = opt.profile || !opt.profile_json.empty();
     if (profiling) eo.profile = &profile;

@@ -5,6 +5,7 @@
 #include <xsimd/xsimd.hpp>
 
 #include "kernels/kernel_table.h"
+#include "kernels/shade_kernel.h"
 #include "shapes/shapes.h"
 
 namespace streamrt::STREAMRT_ISA_NAMESPACE {
@@ -98,6 +99,7 @@ void any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
     }
 }
 
+#define SHADE_VARIANT(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8)>
 template <class Arch>
 KernelTable make_table(Isa isa, const char* name) {
     return KernelTable{isa,
@@ -106,7 +108,13 @@ KernelTable make_table(Isa isa, const char* name) {
                        {&closest_hit<Arch, SphereMath>, &closest_hit<Arch, CubeMath>, &closest_hit<Arch, CylinderMath>,
                         &closest_hit<Arch, ConeMath>, &closest_hit<Arch, TorusMath>, &closest_hit<Arch, PlaneMath>},
                        {&any_hit<Arch, SphereMath>, &any_hit<Arch, CubeMath>, &any_hit<Arch, CylinderMath>,
-                        &any_hit<Arch, ConeMath>, &any_hit<Arch, TorusMath>, &any_hit<Arch, PlaneMath>}};
+                        &any_hit<Arch, ConeMath>, &any_hit<Arch, TorusMath>, &any_hit<Arch, PlaneMath>},
+                       {SHADE_VARIANT(0), SHADE_VARIANT(1), SHADE_VARIANT(2), SHADE_VARIANT(3), SHADE_VARIANT(4),
+                        SHADE_VARIANT(5), SHADE_VARIANT(6), SHADE_VARIANT(7), SHADE_VARIANT(8), SHADE_VARIANT(9),
+                        SHADE_VARIANT(10), SHADE_VARIANT(11), SHADE_VARIANT(12), SHADE_VARIANT(13), SHADE_VARIANT(14),
+                        SHADE_VARIANT(15)}};
 }
+
+#undef SHADE_VARIANT
 
 }  // namespace streamrt::STREAMRT_ISA_NAMESPACE

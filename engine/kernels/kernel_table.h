@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "kernels/shade_job.h"
 #include "scene/scene.h"
 #include "stream/ray_stream.h"
 
@@ -36,6 +37,7 @@ struct KernelTable {
     int float_lanes;
     ClosestHitFn closest[kShapeKindCount];
     AnyHitFn any[kShapeKindCount];
+    ShadeFn shade[kShadeVariants];
 };
 
 /// The best level this CPU runs.

@@ -19,7 +19,7 @@ RenderResult render_scene(const Scene& scene, EngineKind engine, Parallelism& pa
         RecursiveRenderer renderer(scene);
         r.image = renderer.render(par, &p);
     } else {
-        StreamRenderer renderer(scene, options.isa);
+        StreamRenderer renderer(scene, options.isa, options.scalar_shade);
         r.image = renderer.render(par, &p, options.profile);
     }
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

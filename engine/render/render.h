@@ -23,6 +23,7 @@ struct RenderResult {
 struct EngineOptions {
     Isa isa = best_isa();               ///< stream engine: kernel level
     StreamProfile* profile = nullptr;   ///< stream engine: per-stage figures, when wanted
+    bool scalar_shade = false;          ///< stream engine: scalar shade stage (for measurement)
 };
 
 RenderResult render_scene(const Scene& scene, EngineKind engine, Parallelism& par,

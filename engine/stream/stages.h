@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
@@ -16,12 +17,35 @@
 
 namespace streamrt {
 
+/// Hit rays regrouped by object (a stable counting sort), so that every SIMD packet of the
+/// shade kernel shares one object: its transforms and material are broadcast, not gathered.
+struct SortedHits {
+    std::size_t count = 0;
+    AlignedVec<float> ox, oy, oz, dx, dy, dz, t, wr, wg, wb, lr, lg, lb;
+    AlignedVec<std::int32_t> pixel;
+    std::vector<std::uint32_t> run_start;  ///< per object, then one past the end
+    void reserve(std::size_t n) {
+        // Kernels read a whole packet past the last ray of a run.
+        const std::size_t cap = simd::round_up_lanes(n) + simd::kMaxLanes;
+        if (ox.size() < cap) {
+            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t, &wr, &wg, &wb, &lr, &lg, &lb}) a->resize(cap);
+            pixel.resize(cap);
+        }
+    }
+};
+
 /// Per-thread buffers, reused from chunk to chunk.
 struct Workspace {
     RayStream current, next;
     AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of `current`
     ShadowStream shadows;
+    SortedHits sorted;
+    std::vector<std::uint32_t> slot;
 };
+
+/// Scenes with more objects than this shade without sorting (runs would be too short for
+/// whole packets).
+inline constexpr std::size_t kSortedShadeMaxObjects = 1024;
 
 namespace stage_detail {
 
@@ -184,6 +208,79 @@ struct PipelineStages {
         }
     }
 
+    /// shade + spawn, SIMD: misses bring the background; hits are regrouped by object and
+    /// each run goes through the shade kernel; local colours then go into the tile in the
+    /// sorted order (fixed for a given tile, so the picture does not depend on threads).
+    static void shade_sorted(const StreamScene& sc, const KernelTable& kt, const RayStream& rays,
+                             const AlignedVec<std::int32_t>& object, int depth, Workspace& ws, float* accum,
+                             RayCounts& counts) {
+        using namespace stage_detail;
+        SortedHits& h = ws.sorted;
+        const std::size_t n_obj = sc.objects.size();
+        h.run_start.assign(n_obj + 1, 0);
+        std::size_t hits = 0;
+        for (std::size_t i = 0; i < rays.count; ++i) {
+            const std::int32_t id = object[i];
+            if (id < 0) {
+                add(accum, rays.pixel[i], mul(ColorT<float>{rays.wr[i], rays.wg[i], rays.wb[i]}, sc.background));
+                continue;
+            }
+            ++h.run_start[std::size_t(id) + 1];
+            ++hits;
+        }
+        for (std::size_t k = 1; k <= n_obj; ++k) h.run_start[k] += h.run_start[k - 1];
+        h.reserve(hits);
+        h.count = hits;
+        {
+            std::vector<std::uint32_t>& next_slot = ws.slot;
+            next_slot.assign(h.run_start.begin(), h.run_start.end() - 1);
+            for (std::size_t i = 0; i < rays.count; ++i) {
+                const std::int32_t id = object[i];
+                if (id < 0) continue;
+                const std::size_t j = next_slot[std::size_t(id)]++;
+                h.ox[j] = rays.ox[i];
+                h.oy[j] = rays.oy[i];
+                h.oz[j] = rays.oz[i];
+                h.dx[j] = rays.dx[i];
+                h.dy[j] = rays.dy[i];
+                h.dz[j] = rays.dz[i];
+                h.t[j] = rays.t_max[i];
+                h.wr[j] = rays.wr[i];
+                h.wg[j] = rays.wg[i];
+                h.wb[j] = rays.wb[i];
+                h.pixel[j] = rays.pixel[i];
+            }
+        }
+        const std::size_t next_before = ws.next.count;
+        RayStream& nx = ws.next;
+        ShadowStream& sh = ws.shadows;
+        ShadeJob job{h.ox.data(), h.oy.data(), h.oz.data(), h.dx.data(), h.dy.data(), h.dz.data(), h.t.data(),
+                     h.wr.data(), h.wg.data(), h.wb.data(), h.pixel.data(), 0, 0, nullptr, nullptr,
+                     sc.lights.data(), sc.lights.size(), sc.settings.degree, float(sc.settings.ambient),
+                     kSecondary && depth < sc.settings.depth, h.lr.data(), h.lg.data(), h.lb.data(),
+                     {nx.ox.data(), nx.oy.data(), nx.oz.data(), nx.dx.data(), nx.dy.data(), nx.dz.data(),
+                      nx.t_max.data(), nx.wr.data(), nx.wg.data(), nx.wb.data(), nx.pixel.data(), nx.kind.data(),
+                      &nx.count},
+                     {sh.ox.data(), sh.oy.data(), sh.oz.data(), sh.dx.data(), sh.dy.data(), sh.dz.data(),
+                      sh.t_max.data(), sh.cr.data(), sh.cg.data(), sh.cb.data(), sh.pixel.data(), &sh.count}};
+        const ShadeFn fn = kt.shade[(kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0)];
+        for (std::size_t k = 0; k < n_obj; ++k) {
+            if (h.run_start[k] == h.run_start[k + 1]) continue;
+            job.begin = h.run_start[k];
+            job.end = h.run_start[k + 1];
+            job.object = &sc.objects[k];
+            job.material = &sc.materials[k];
+            fn(job);
+        }
+        for (std::size_t j = 0; j < hits; ++j) add(accum, h.pixel[j], {h.lr[j], h.lg[j], h.lb[j]});
+        if constexpr (kSecondary) {
+            for (std::size_t j = next_before; j < nx.count; ++j) {
+                if (nx.kind[j] == std::uint8_t(RayKind::Reflected)) ++counts.reflected;
+                else ++counts.refracted;
+            }
+        }
+    }
+
     static void push(RayStream& r, std::size_t j, const Vec3f& o, const Vec3f& d, const ColorT<float>& w,
                      std::int32_t px, RayKind kind) {
         r.ox[j] = o.x;
@@ -219,7 +316,8 @@ struct PipelineStages {
     }
 
     static void run_chunk(const StreamScene& sc, const KernelTable& kt, const Tile& tile, int first, int n_pixels,
-                          Workspace& ws, float* accum, RayCounts& counts, StreamProfile* profile) {
+                          Workspace& ws, float* accum, RayCounts& counts, StreamProfile* profile,
+                          bool scalar_shade) {
         const auto fig = [&](Stage s) { return profile ? &profile->stages[int(s)] : nullptr; };
         const int spp = sc.settings.spp;
         const std::size_t lights = sc.lights.size();
@@ -242,7 +340,10 @@ struct PipelineStages {
                 // Room for every ray spawning both children and a shadow ray per light.
                 ws.next.reserve(kSecondary ? rays.count * 2 : 0);
                 if constexpr (kShadows) ws.shadows.reserve(rays.count * lights);
-                shade(sc, rays, ws.object, depth, ws.next, ws.shadows, accum, counts);
+                if (scalar_shade || sc.objects.size() > kSortedShadeMaxObjects)
+                    shade(sc, rays, ws.object, depth, ws.next, ws.shadows, accum, counts);
+                else
+                    shade_sorted(sc, kt, rays, ws.object, depth, ws, accum, counts);
                 if (profile) {
                     fig(Stage::Shade)->rays_in += rays.count;
                     fig(Stage::Shade)->rays_out += ws.next.count + (kShadows ? ws.shadows.count : 0);

@@ -10,8 +10,8 @@
 
 namespace streamrt {
 
-StreamRenderer::StreamRenderer(const Scene& scene, Isa isa)
-    : scene_(scene), kernels_(kernel_table(isa)), tile_fn_(nullptr) {
+StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, bool scalar_shade)
+    : scene_(scene), kernels_(kernel_table(isa)), tile_fn_(nullptr), scalar_shade_(scalar_shade) {
     tile_fn_ = select_tile_fn();
 }
 
@@ -26,7 +26,8 @@ std::vector<std::string> StreamRenderer::built_stages() const {
             first = false;
         }
     b.push_back(kernels + "]");
-    b.push_back(f.lighting ? "shade(lit)" : "shade(flat)");
+    const bool sorted = !scalar_shade_ && scene_.objects.size() <= kSortedShadeMaxObjects;
+    b.push_back(std::string(f.lighting ? "shade(lit" : "shade(flat") + (sorted ? ",simd,sorted)" : ",scalar)"));
     if (f.reflect) b.push_back("spawn(reflect)");
     if (f.refract) b.push_back("spawn(refract)");
     if (f.shadows) b.push_back("occlusion(any-hit)");
@@ -47,7 +48,7 @@ void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, f
     static thread_local Workspace ws;
     for (int first = 0; first < tile_pixels; first += pixels_per_chunk) {
         const int n_pixels = std::min(pixels_per_chunk, tile_pixels - first);
-        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile);
+        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile, self.scalar_shade_);
     }
 }
 

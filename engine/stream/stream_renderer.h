@@ -13,7 +13,9 @@ namespace streamrt {
 
 class StreamRenderer {
   public:
-    StreamRenderer(const Scene& scene, Isa isa);
+    /// scalar_shade: shade one ray at a time instead of the sorted SIMD shade kernel (kept
+    /// for measurement; see docs/performance.md).
+    StreamRenderer(const Scene& scene, Isa isa, bool scalar_shade = false);
 
     /// Renders the image. With a profile, every stage is timed and counted into it.
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr, StreamProfile* profile = nullptr) const;
@@ -37,6 +39,7 @@ class StreamRenderer {
     StreamScene scene_;
     const KernelTable& kernels_;
     TileFn tile_fn_;
+    bool scalar_shade_;
 };
 
 }  // namespace streamrt

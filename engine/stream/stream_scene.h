@@ -11,15 +11,6 @@
 
 namespace streamrt {
 
-/// What shading needs of one object, beside the kernels' ObjectXf.
-struct ShadeObject {
-    ShapeKind kind;
-    float param;
-    float mi[12];  ///< world -> canonical, row-major 3x4 (to rebuild the canonical hit point)
-    float md[12];  ///< canonical -> world
-    float mn[9];   ///< normals, row-major 3x3
-};
-
 /// The features a scene uses; the pipeline is specialised on them at compile time, so a
 /// scene without lights or mirrors runs no code for them.
 struct StreamFeatures {

@@ -1,0 +1,62 @@
+#pragma once
+// What a shade kernel reads and writes: a run of rays (sorted so that they all hit the same
+// object) and the streams it appends to. Raw pointers only, so the per-ISA kernel files touch
+// no container code (see kernels/intersect_kernel.h on why).
+#include <cstddef>
+#include <cstdint>
+
+#include "render/shading.h"
+#include "scene/scene.h"
+
+namespace streamrt {
+
+/// What shading needs of one object, beside the kernels' ObjectXf.
+struct ShadeObject {
+    ShapeKind kind;
+    float param;
+    float mi[12];  ///< world -> canonical, row-major 3x4 (to rebuild the canonical hit point)
+    float md[12];  ///< canonical -> world
+    float mn[9];   ///< normals, row-major 3x3
+};
+
+
+/// Append-only view of a RayStream (reflected and refracted rays).
+struct RayAppend {
+    float *ox, *oy, *oz, *dx, *dy, *dz, *t_max, *wr, *wg, *wb;
+    std::int32_t* pixel;
+    std::uint8_t* kind;
+    std::size_t* count;
+};
+
+/// Append-only view of a ShadowStream.
+struct ShadowAppend {
+    float *ox, *oy, *oz, *dx, *dy, *dz, *t_max, *cr, *cg, *cb;
+    std::int32_t* pixel;
+    std::size_t* count;
+};
+
+struct ShadeJob {
+    // Rays [begin, end) of the sorted arrays; readable up to end + kMaxLanes (padding).
+    const float *ox, *oy, *oz, *dx, *dy, *dz, *t, *wr, *wg, *wb;
+    const std::int32_t* pixel;
+    std::size_t begin, end;
+    // The object they all hit.
+    const ShadeObject* object;
+    const MaterialT<float>* material;
+    const LightT<float>* lights;
+    std::size_t n_lights;
+    int degree;
+    float ambient;
+    bool spawn;  ///< depth allows reflected / refracted children
+    // Outputs: the weighted local colour of each ray (same indexing as the inputs) ...
+    float *lr, *lg, *lb;
+    // ... and the rays it spawns.
+    RayAppend next;
+    ShadowAppend shadows;
+};
+
+/// Shade variants, indexed by lit | shadows << 1 | reflect << 2 | refract << 3.
+inline constexpr int kShadeVariants = 16;
+using ShadeFn = void (*)(const ShadeJob& job);
+
+}  // namespace streamrt

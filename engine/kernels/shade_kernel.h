@@ -1,0 +1,180 @@
+#pragma once
+// The SIMD shade kernel: local terms by degree, shadow rays, reflected and refracted rays
+// for a run of rays that all hit one object. Specialised at compile time on the features
+// the scene uses. Included only by kernels/isa_*.cpp, inside their own namespace.
+#include <xsimd/xsimd.hpp>
+
+#include <cstddef>
+#include <limits>
+
+#include "kernels/shade_job.h"
+#include "render/shading.h"
+#include "shapes/shapes.h"
+
+namespace streamrt::STREAMRT_ISA_NAMESPACE {
+
+template <class B>
+inline Vec3T<B> apply_point(const float* m, const Vec3T<B>& p) {
+    return {xsimd::fma(B(m[0]), p.x, xsimd::fma(B(m[1]), p.y, xsimd::fma(B(m[2]), p.z, B(m[3])))),
+            xsimd::fma(B(m[4]), p.x, xsimd::fma(B(m[5]), p.y, xsimd::fma(B(m[6]), p.z, B(m[7])))),
+            xsimd::fma(B(m[8]), p.x, xsimd::fma(B(m[9]), p.y, xsimd::fma(B(m[10]), p.z, B(m[11]))))};
+}
+template <class B>
+inline Vec3T<B> apply_vector(const float* m, const Vec3T<B>& v) {
+    return {xsimd::fma(B(m[0]), v.x, xsimd::fma(B(m[1]), v.y, B(m[2]) * v.z)),
+            xsimd::fma(B(m[4]), v.x, xsimd::fma(B(m[5]), v.y, B(m[6]) * v.z)),
+            xsimd::fma(B(m[8]), v.x, xsimd::fma(B(m[9]), v.y, B(m[10]) * v.z))};
+}
+template <class B>
+inline Vec3T<B> apply_normal(const float* m, const Vec3T<B>& n) {
+    return normalize(Vec3T<B>{xsimd::fma(B(m[0]), n.x, xsimd::fma(B(m[1]), n.y, B(m[2]) * n.z)),
+                              xsimd::fma(B(m[3]), n.x, xsimd::fma(B(m[4]), n.y, B(m[5]) * n.z)),
+                              xsimd::fma(B(m[6]), n.x, xsimd::fma(B(m[7]), n.y, B(m[8]) * n.z))});
+}
+
+template <class B>
+inline Vec3T<B> canonical_normal(ShapeKind kind, const Vec3T<B>& p, const B& param) {
+    // One branch per packet (every lane hit the same object), never per ray.
+    switch (kind) {
+        case ShapeKind::Sphere: return SphereMath::normal<B>(p, param);
+        case ShapeKind::Cube: return CubeMath::normal<B>(p, param);
+        case ShapeKind::Cylinder: return CylinderMath::normal<B>(p, param);
+        case ShapeKind::Cone: return ConeMath::normal<B>(p, param);
+        case ShapeKind::Torus: return TorusMath::normal<B>(p, param);
+        case ShapeKind::Plane: break;
+    }
+    return PlaneMath::normal<B>(p, param);
+}
+
+template <class B, class M>
+inline void append(const ShadeJob& job, std::size_t i, const M& active, const Vec3T<B>& o, const Vec3T<B>& d,
+                   const ColorT<B>& w, RayKind kind) {
+    constexpr std::size_t W = B::size;
+    alignas(64) float ox[W], oy[W], oz[W], dx[W], dy[W], dz[W], wr[W], wg[W], wb[W];
+    alignas(64) bool go[W];
+    o.x.store_aligned(ox);
+    o.y.store_aligned(oy);
+    o.z.store_aligned(oz);
+    d.x.store_aligned(dx);
+    d.y.store_aligned(dy);
+    d.z.store_aligned(dz);
+    w.x.store_aligned(wr);
+    w.y.store_aligned(wg);
+    w.z.store_aligned(wb);
+    active.store_aligned(go);
+    const RayAppend& r = job.next;
+    std::size_t j = *r.count;
+    for (std::size_t l = 0; l < W; ++l) {
+        if (!go[l]) continue;
+        r.ox[j] = ox[l];
+        r.oy[j] = oy[l];
+        r.oz[j] = oz[l];
+        r.dx[j] = dx[l];
+        r.dy[j] = dy[l];
+        r.dz[j] = dz[l];
+        r.t_max[j] = std::numeric_limits<float>::infinity();
+        r.wr[j] = wr[l];
+        r.wg[j] = wg[l];
+        r.wb[j] = wb[l];
+        r.pixel[j] = job.pixel[i + l];
+        r.kind[j] = std::uint8_t(kind);
+        ++j;
+    }
+    *r.count = j;
+}
+
+template <class Arch, bool kLit, bool kShadows, bool kReflect, bool kRefract>
+void shade_run(const ShadeJob& job) {
+    using B = xsimd::batch<float, Arch>;
+    constexpr std::size_t W = B::size;
+    const ShadeObject& ob = *job.object;
+    const MaterialT<float>& m = *job.material;
+    const bool reflect_here = kReflect && job.spawn && m.refl > 0.f;
+    const bool refract_here = kRefract && job.spawn && m.trans > 0.f;
+    alignas(64) float lane_index[W];
+    for (std::size_t l = 0; l < W; ++l) lane_index[l] = float(l);
+    const B lanes = B::load_aligned(lane_index);
+
+    for (std::size_t i = job.begin; i < job.end; i += W) {
+        // The last packet may be partial: its extra lanes read padding and are never stored
+        // into a stream (their local colour lands in padding too).
+        const auto active = lanes < B(float(job.end - i));
+        const Vec3T<B> o{B::load_unaligned(job.ox + i), B::load_unaligned(job.oy + i), B::load_unaligned(job.oz + i)};
+        const Vec3T<B> d{B::load_unaligned(job.dx + i), B::load_unaligned(job.dy + i), B::load_unaligned(job.dz + i)};
+        const B t = B::load_unaligned(job.t + i);
+        const ColorT<B> w{B::load_unaligned(job.wr + i), B::load_unaligned(job.wg + i), B::load_unaligned(job.wb + i)};
+
+        // Rebuild the canonical hit point, then world point and normal through Md and Mn.
+        const Vec3T<B> pc = apply_point(ob.mi, o) + apply_vector(ob.mi, d) * t;
+        const Vec3T<B> p = apply_point(ob.md, pc);
+        const ColorT<B> base = surface_color(m, p);
+        ColorT<B> local;
+        if constexpr (!kLit) {
+            local = mul(w, base);
+        } else {
+            const Vec3T<B> n_out = apply_normal(ob.mn, canonical_normal(ob.kind, pc, B(ob.param)));
+            const auto facing = dot(n_out, d) < B(0.f);
+            const Vec3T<B> n = select3(facing, n_out, -n_out);
+            local = mul(w, ambient_light(job.degree, job.ambient, m, base));
+            Vec3T<B> shadow_origin{};
+            if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n);
+            for (std::size_t li = 0; li < job.n_lights; ++li) {
+                const LightT<float>& l = job.lights[li];
+                const LightSample<B> ls = sample_light(l, p);
+                const DirectLight<B> dl = direct_light(job.degree, m, base, n, d, l, ls);
+                const auto send = dl.lit && active;
+                if (xsimd::none(send)) continue;
+                if constexpr (kShadows) {
+                    const Vec3T<B> to =
+                        l.kind == LightKind::Directional ? ls.to_light : splat<B>(l.pos) - shadow_origin;
+                    const ColorT<B> c = mul(w, dl.color);
+                    alignas(64) float sox[W], soy[W], soz[W], sdx[W], sdy[W], sdz[W], stm[W], scr[W], scg[W], scb[W];
+                    alignas(64) bool go[W];
+                    shadow_origin.x.store_aligned(sox);
+                    shadow_origin.y.store_aligned(soy);
+                    shadow_origin.z.store_aligned(soz);
+                    to.x.store_aligned(sdx);
+                    to.y.store_aligned(sdy);
+                    to.z.store_aligned(sdz);
+                    ls.t_max.store_aligned(stm);
+                    c.x.store_aligned(scr);
+                    c.y.store_aligned(scg);
+                    c.z.store_aligned(scb);
+                    send.store_aligned(go);
+                    const ShadowAppend& s = job.shadows;
+                    std::size_t j = *s.count;
+                    for (std::size_t l2 = 0; l2 < W; ++l2) {
+                        if (!go[l2]) continue;
+                        s.ox[j] = sox[l2];
+                        s.oy[j] = soy[l2];
+                        s.oz[j] = soz[l2];
+                        s.dx[j] = sdx[l2];
+                        s.dy[j] = sdy[l2];
+                        s.dz[j] = sdz[l2];
+                        s.t_max[j] = stm[l2];
+                        s.cr[j] = scr[l2];
+                        s.cg[j] = scg[l2];
+                        s.cb[j] = scb[l2];
+                        s.pixel[j] = job.pixel[i + l2];
+                        ++j;
+                    }
+                    *s.count = j;
+                } else {
+                    local = local + mul(w, dl.color);
+                }
+            }
+            if (reflect_here) append(job, i, active, offset_ray_origin(p, n), reflect(d, n), w * B(m.refl), RayKind::Reflected);
+            if (refract_here) {
+                const Vec3T<B> tr = refract(d, n_out, m.ior);
+                const auto out_side = dot(tr, n_out) > B(0.f);
+                append(job, i, active, offset_ray_origin(p, select3(out_side, n_out, -n_out)), tr, w * B(m.trans),
+                       RayKind::Refracted);
+            }
+        }
+        local.x.store_unaligned(job.lr + i);
+        local.y.store_unaligned(job.lg + i);
+        local.z.store_unaligned(job.lb + i);
+    }
+}
+
+}  // namespace streamrt::STREAMRT_ISA_NAMESPACE
