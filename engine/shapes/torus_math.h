@@ -3,7 +3,7 @@
 // radius r = `minor` (any r > 0: thin, fat and self-intersecting "spindle" r > 1).
 //
 //   F(p) = (|p|^2 + 1 - r^2)^2 - 4 (x^2 + z^2)
-//        = ((rho - 1)^2 + y^2 - r^2) * ((rho + 1)^2 + y^2 - r^2),   rho = sqrt(x^2 + z^2).
+//        = ((rho - 1)^2 + y^2 - r^2) * ((rho + 1)^2 + y^2 - r^2),   rho = simd::sqrt(x^2 + z^2).
 //
 // Written once for V = double (baseline renderer), V = xsimd::batch<double, A> (stream
 // kernels) and V = float. Branch-free on lanes: every loop has a fixed trip count and the
@@ -52,33 +52,31 @@ inline mask_t<V> finite(const V& a) {
 /// otherwise the bracket is bisected. Returns the evaluated point with the smallest |f|.
 template <class V, class Fn>
 inline V bracket_solve(V a, V b, const mask_t<V>& neg_a, Fn&& fn, int iters) {
-    using simd::abs;
-    using simd::select;
     V x = (a + b) * V(0.5);
-    V step_old = abs(b - a);
+    V step_old = simd::abs(b - a);
     V best = x;
     V best_f = inf_v<V>();
     for (int i = 0; i < iters; ++i) {
         V f, df;
         fn(x, f, df);
-        const V af = abs(f);
+        const V af = simd::abs(f);
         const auto better = af < best_f;
-        best = select(better, x, best);
-        best_f = select(better, af, best_f);
+        best = simd::select(better, x, best);
+        best_f = simd::select(better, af, best_f);
         // Same sign as at a: the root lies right of x.
         const auto right = !((f < V(0)) ^ neg_a);
-        a = select(right, x, a);
-        b = select(right, b, x);
+        a = simd::select(right, x, a);
+        b = simd::select(right, b, x);
         const V step = f / df;
         const V xn = x - step;
-        const auto newton_ok = (xn >= a) & (xn <= b) & (abs(step) * V(2) <= step_old);
-        const V xnew = select(newton_ok, xn, (a + b) * V(0.5));
-        step_old = abs(xnew - x);
+        const auto newton_ok = (xn >= a) & (xn <= b) & (simd::abs(step) * V(2) <= step_old);
+        const V xnew = simd::select(newton_ok, xn, (a + b) * V(0.5));
+        step_old = simd::abs(xnew - x);
         x = xnew;
     }
     V f, df;
     fn(x, f, df);
-    return select(abs(f) < best_f, x, best);
+    return simd::select(simd::abs(f) < best_f, x, best);
 }
 
 template <class V>
@@ -89,12 +87,11 @@ struct Factored {
 /// F and dF/ds at p = p0 + s*D. F in the factored form; dF/ds = 4 q (p.D) - 8 (x Dx + z Dz).
 template <class V>
 inline void torus_f(const Vec3T<V>& p0, const Vec3T<V>& D, const V& r2, const V& s, V& f, V& df) {
-    using simd::sqrt;
     const V x = p0.x + s * D.x;
     const V y = p0.y + s * D.y;
     const V z = p0.z + s * D.z;
     const V rho2 = x * x + z * z;
-    const V rho = sqrt(rho2);
+    const V rho = simd::sqrt(rho2);
     const V yr = y * y - r2;
     const V g1 = (rho - V(1)) * (rho - V(1)) + yr;
     const V g2 = (rho + V(1)) * (rho + V(1)) + yr;
@@ -110,42 +107,42 @@ inline void torus_f(const Vec3T<V>& p0, const Vec3T<V>& D, const V& r2, const V&
 template <class V>
 V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     using namespace torus_detail;
-    using simd::abs;
-    using simd::max;
-    using simd::min;
-    using simd::select;
-    using simd::sqrt;
     using S = simd::scalar_t<V>;
     using M = mask_t<V>;
     const V inf = inf_v<V>();
     const V zero(0), one(1);
 
     // 1. Validate and normalise the direction.
-    const V m = max(abs(d.x), max(abs(d.y), abs(d.z)));
+    const V m = simd::max(simd::abs(d.x), simd::max(simd::abs(d.y), simd::abs(d.z)));
     M valid = finite(o.x) & finite(o.y) & finite(o.z) & finite(m) &
               (m >= V(std::numeric_limits<S>::min())) & finite(minor) &
               (minor > V(std::numeric_limits<S>::min())) & !(t_min != t_min) & !(t_max != t_max);
     // Invalid lanes compute on harmless stand-ins so no NaN travels through the arithmetic.
-    const V ms = select(valid, m, one);
+    const V ms = simd::select(valid, m, one);
     const V inv_m = one / ms;
-    const Vec3T<V> dm{select(valid, d.x * inv_m, one), select(valid, d.y * inv_m, zero),
-                      select(valid, d.z * inv_m, zero)};
-    const V lm = sqrt(dot(dm, dm));  // in [1, sqrt 3]
+    const Vec3T<V> dm{simd::select(valid, d.x * inv_m, one), simd::select(valid, d.y * inv_m, zero),
+                      simd::select(valid, d.z * inv_m, zero)};
+    const V lm = simd::sqrt(dot(dm, dm));  // in [1, sqrt 3]
     const V inv_lm = one / lm;
     const Vec3T<V> D = dm * inv_lm;
     const V len = ms * lm;  // |d|; may overflow to inf
     valid = valid & finite(len);
-    const V r = select(valid, minor, one);
+    const V r = simd::select(valid, minor, one);
     const V r2 = r * r;
-    const V B = one + r;  // bounding sphere radius
+    // Bounding sphere and slab, padded by a relative 2^-20 so that rays whose roots lie
+    // exactly on them (radial rays through the outer equator, grazing the top) start from a
+    // point safely outside the surface.
+    const V pad(1.0 + 1.0 / 1048576.0);
+    const V B = (one + r) * pad;
     const V B2 = B * B;
+    const V r_slab = r * pad;
 
     // 2. Move a far origin to the closest approach to the centre (s = t*len - tc).
-    Vec3T<V> oo{select(valid, o.x, zero), select(valid, o.y, zero), select(valid, o.z, zero)};
+    Vec3T<V> oo{simd::select(valid, o.x, zero), simd::select(valid, o.y, zero), simd::select(valid, o.z, zero)};
     const M far = dot(oo, oo) > V(4) * B2;
-    V tc = select(far, -dot(oo, D), zero);
+    V tc = simd::select(far, -dot(oo, D), zero);
     Vec3T<V> p0 = oo + D * tc;
-    const V tc2 = select(far, -dot(p0, D), zero);  // one refinement pass
+    const V tc2 = simd::select(far, -dot(p0, D), zero);  // one refinement pass
     p0 = p0 + D * tc2;
     tc = tc + tc2;
 
@@ -154,30 +151,30 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     const V c = dot(p0, p0);
     const V disc = b * b - (c - B2);
     valid = valid & (disc >= zero);
-    const V w = sqrt(max(disc, zero));
+    const V w = simd::sqrt(simd::max(disc, zero));
     V lo = -b - w;
     V hi = -b + w;
     {
         const V inv_dy = one / D.y;
-        const V s1 = (-r - p0.y) * inv_dy;
-        const V s2 = (r - p0.y) * inv_dy;
+        const V s1 = (-r_slab - p0.y) * inv_dy;
+        const V s2 = (r_slab - p0.y) * inv_dy;
         const M flat = D.y == zero;
-        const M in_slab = abs(p0.y) <= r;
-        const V sl = select(flat, select(in_slab, -inf, inf), min(s1, s2));
-        const V sh = select(flat, select(in_slab, inf, -inf), max(s1, s2));
-        lo = max(lo, sl);
-        hi = min(hi, sh);
+        const M in_slab = simd::abs(p0.y) <= r_slab;
+        const V sl = simd::select(flat, simd::select(in_slab, -inf, inf), simd::min(s1, s2));
+        const V sh = simd::select(flat, simd::select(in_slab, inf, -inf), simd::max(s1, s2));
+        lo = simd::max(lo, sl);
+        hi = simd::min(hi, sh);
     }
     {
-        const V smin = select(valid, t_min, zero) * len - tc;
-        const V smax = select(valid, t_max, zero) * len - tc;
-        lo = max(lo, smin);
-        hi = min(hi, smax);
+        const V smin = simd::select(valid, t_min, zero) * len - tc;
+        const V smax = simd::select(valid, t_max, zero) * len - tc;
+        lo = simd::max(lo, smin);
+        hi = simd::min(hi, smax);
     }
     valid = valid & (lo <= hi);
     if (!simd::any(valid)) return inf;
-    lo = select(valid, lo, zero);
-    hi = select(valid, hi, zero);
+    lo = simd::select(valid, lo, zero);
+    hi = simd::select(valid, hi, zero);
 
     // 4. Quartic f(s) = s^4 + A3 s^3 + A2 s^2 + A1 s + A0 and its critical points.
     const V e = c + (one - r2);
@@ -192,10 +189,10 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
         f1 = ((V(4) * s + C2) * s + C1) * s + A1;
         f2 = (V(12) * s + V(2) * C2) * s + C1;
     };
-    // Roots of f''(s) = 12 s^2 + 6 A3 s + 2 A2: s = -b +- sqrt(b^2 - A2/6).
-    const V hq = sqrt(max(b * b - A2 * V(1.0 / 6.0), zero));
-    const V q1 = min(max(-b - hq, lo), hi);
-    const V q2 = min(max(-b + hq, lo), hi);
+    // Roots of f''(s) = 12 s^2 + 6 A3 s + 2 A2: s = -b +- simd::sqrt(b^2 - A2/6).
+    const V hq = simd::sqrt(simd::max(b * b - A2 * V(1.0 / 6.0), zero));
+    const V q1 = simd::min(simd::max(-b - hq, lo), hi);
+    const V q2 = simd::min(simd::max(-b + hq, lo), hi);
     auto critical = [&](const V& u, const V& v) {
         V fu, fv, dummy;
         fprime(u, fu, dummy);
@@ -203,7 +200,7 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
         const M nu = fu < zero;
         const M change = nu ^ (fv < zero);
         const V k = bracket_solve(u, v, nu, fprime, kCriticalIters);
-        return select(change, k, v);
+        return simd::select(change, k, v);
     };
     const V k1 = critical(lo, q1);
     const V k2 = critical(q1, q2);
@@ -223,8 +220,8 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     M found = neg[0] & !neg[0];  // all false
     for (int i = 3; i >= 0; --i) {
         const M change = neg[i] ^ neg[i + 1];
-        a = select(change, pts[i], a);
-        bb = select(change, pts[i + 1], bb);
+        a = simd::select(change, pts[i], a);
+        bb = simd::select(change, pts[i + 1], bb);
         neg_a = (change & neg[i]) | (!change & neg_a);
         found = found | change;
     }
@@ -233,7 +230,7 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     const V s_hit = bracket_solve(a, bb, neg_a, ffun, kRootIters);
     const V t = (s_hit + tc) / len;
     const M hit = valid & (t > t_min) & (t < t_max);
-    return select(hit, t, inf);
+    return simd::select(hit, t, inf);
 }
 
 /// Outward normal (not necessarily unit length) at a point p on (or very near) the torus
@@ -242,21 +239,18 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
 /// ring, and the normal points away from that circle.
 template <class V>
 Vec3T<V> torus_normal(const Vec3T<V>& p, V minor) {
-    using simd::abs;
-    using simd::select;
-    using simd::sqrt;
     const V zero(0), one(1);
     const V rho2 = p.x * p.x + p.z * p.z;
-    const V rho = sqrt(rho2);
+    const V rho = simd::sqrt(rho2);
     const auto has_rho = rho > zero;
-    const V inv_rho = one / select(has_rho, rho, one);
-    const V ux = select(has_rho, p.x * inv_rho, zero);
-    const V uz = select(has_rho, p.z * inv_rho, zero);
+    const V inv_rho = one / simd::select(has_rho, rho, one);
+    const V ux = simd::select(has_rho, p.x * inv_rho, zero);
+    const V uz = simd::select(has_rho, p.z * inv_rho, zero);
     const V yr = p.y * p.y - minor * minor;
     const V g1 = (rho - one) * (rho - one) + yr;
     const V g2 = (rho + one) * (rho + one) + yr;
     // Near circle (ring point on p's side) unless p lies on the opposite tube's surface.
-    const V sgn = select(abs(g2) < abs(g1), V(-1), one);
+    const V sgn = simd::select(simd::abs(g2) < simd::abs(g1), V(-1), one);
     return {p.x - sgn * ux, p.y, p.z - sgn * uz};
 }
 
