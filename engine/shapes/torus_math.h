@@ -34,8 +34,8 @@ template <class V>
 using mask_t = decltype(V() < V());
 
 /// Iteration counts of the safeguarded Newton/bisection solves (fixed so lanes stay in step).
-inline constexpr int kCriticalIters = 28;
-inline constexpr int kRootIters = 36;
+inline constexpr int kCriticalIters = 20;
+inline constexpr int kRootIters = 28;
 
 template <class V>
 inline V inf_v() { return V(std::numeric_limits<simd::scalar_t<V>>::infinity()); }
@@ -180,7 +180,6 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     const V e = c + (one - r2);
     const V a2 = D.x * D.x + D.z * D.z;
     const V a1 = p0.x * D.x + p0.z * D.z;
-    const V a0 = p0.x * p0.x + p0.z * p0.z;
     const V A3 = V(4) * b;
     const V A2 = V(4) * b * b + V(2) * e - V(4) * a2;
     const V A1 = V(4) * b * e - V(8) * a1;
@@ -222,7 +221,7 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
         const M change = neg[i] ^ neg[i + 1];
         a = simd::select(change, pts[i], a);
         bb = simd::select(change, pts[i + 1], bb);
-        neg_a = (change & neg[i]) | (!change & neg_a);
+        neg_a = (change & neg[i]) | ((!change) & neg_a);
         found = found | change;
     }
     valid = valid & found;
