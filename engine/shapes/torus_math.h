@@ -3,7 +3,7 @@
 // radius r = `minor` (any r > 0: thin, fat and self-intersecting "spindle" r > 1).
 //
 //   F(p) = (|p|^2 + 1 - r^2)^2 - 4 (x^2 + z^2)
-//        = ((rho - 1)^2 + y^2 - r^2) * ((rho + 1)^2 + y^2 - r^2),   rho = simd::sqrt(x^2 + z^2).
+//        = ((rho - 1)^2 + y^2 - r^2) * ((rho + 1)^2 + y^2 - r^2),   rho = sqrt(x^2 + z^2).
 //
 // Written once for V = double (baseline renderer), V = xsimd::batch<double, A> (stream
 // kernels) and V = float. Branch-free on lanes: every loop has a fixed trip count and the
