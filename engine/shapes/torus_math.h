@@ -1,8 +1,256 @@
 #pragma once
-// Placeholder, replaced by the robust solver.
+// Canonical torus: ring of major radius R = 1 around the y axis in the xz plane, tube of
+// radius r = `minor` (any r > 0: thin, fat and self-intersecting "spindle" r > 1).
+//
+//   F(p) = (|p|^2 + 1 - r^2)^2 - 4 (x^2 + z^2)
+//        = ((rho - 1)^2 + y^2 - r^2) * ((rho + 1)^2 + y^2 - r^2),   rho = sqrt(x^2 + z^2).
+//
+// Written once for V = double (baseline renderer), V = xsimd::batch<double, A> (stream
+// kernels) and V = float. Branch-free on lanes: every loop has a fixed trip count and the
+// only data-dependent branch is the "no lane can hit" early out. See docs/torus.md.
+//
+// Method (per lane):
+//   1. reject NaN/inf/zero/denormal input; normalise d (scaled by its largest component so
+//      tiny and huge directions work) and remember |d| to rescale t at the end;
+//   2. if the origin is far (|o| > 2(1+r)) move it to the ray's closest approach to the
+//      centre, so the quartic is built from coordinates of size <= 1 + r;
+//   3. clip the ray to the bounding sphere |p| <= 1 + r, the slab |y| <= r and (t_min, t_max);
+//   4. split the clipped interval into <= 4 pieces on which the quartic is monotone: the
+//      roots of f'' (closed-form quadratic) bracket the <= 3 roots of f' (cubic), each found
+//      by a safeguarded Newton/bisection;
+//   5. take the first piece whose end points have opposite signs of F (evaluated in the
+//      factored, cancellation-free form) and solve it with safeguarded Newton/bisection on the
+//      factored F, which doubles as the final Newton polish.
+#include <limits>
+
 #include "core/vec3.h"
-#include "shapes/quadratic.h"
+#include "simd/lanes.h"
+
 namespace streamrt {
-template <class V> V torus_hit_t(const Vec3T<V>&, const Vec3T<V>&, V, V, V) { return infinity_v<V>(); }
-template <class V> Vec3T<V> torus_normal(const Vec3T<V>& p, V) { return p; }
+
+namespace torus_detail {
+
+template <class V>
+using mask_t = decltype(V() < V());
+
+/// Iteration counts of the safeguarded Newton/bisection solves (fixed so lanes stay in step).
+inline constexpr int kCriticalIters = 20;
+inline constexpr int kRootIters = 28;
+
+template <class V>
+inline V inf_v() { return V(std::numeric_limits<simd::scalar_t<V>>::infinity()); }
+
+/// |a| is finite (false for NaN and +-inf).
+template <class V>
+inline mask_t<V> finite(const V& a) {
+    return simd::abs(a) <= V(std::numeric_limits<simd::scalar_t<V>>::max());
+}
+
+/// Safeguarded Newton/bisection on [a, b] where fn(a) has sign `neg_a` (true: negative) and
+/// fn(b) the other sign. fn(x, f, df) evaluates the function and its derivative. Newton steps
+/// are taken when they stay in the (shrinking) bracket and at least halve the previous step,
+/// otherwise the bracket is bisected. Returns the evaluated point with the smallest |f|.
+template <class V, class Fn>
+inline V bracket_solve(V a, V b, const mask_t<V>& neg_a, Fn&& fn, int iters) {
+    V x = (a + b) * V(0.5);
+    V step_old = simd::abs(b - a);
+    V best = x;
+    V best_f = inf_v<V>();
+    for (int i = 0; i < iters; ++i) {
+        V f, df;
+        fn(x, f, df);
+        const V af = simd::abs(f);
+        const auto better = af < best_f;
+        best = simd::select(better, x, best);
+        best_f = simd::select(better, af, best_f);
+        // Same sign as at a: the root lies right of x.
+        const auto right = !((f < V(0)) ^ neg_a);
+        a = simd::select(right, x, a);
+        b = simd::select(right, b, x);
+        const V step = f / df;
+        const V xn = x - step;
+        const auto newton_ok = (xn >= a) & (xn <= b) & (simd::abs(step) * V(2) <= step_old);
+        const V xnew = simd::select(newton_ok, xn, (a + b) * V(0.5));
+        step_old = simd::abs(xnew - x);
+        x = xnew;
+    }
+    V f, df;
+    fn(x, f, df);
+    return simd::select(simd::abs(f) < best_f, x, best);
+}
+
+template <class V>
+struct Factored {
+    V f, df;
+};
+
+/// F and dF/ds at p = p0 + s*D. F in the factored form; dF/ds = 4 q (p.D) - 8 (x Dx + z Dz).
+template <class V>
+inline void torus_f(const Vec3T<V>& p0, const Vec3T<V>& D, const V& r2, const V& s, V& f, V& df) {
+    const V x = p0.x + s * D.x;
+    const V y = p0.y + s * D.y;
+    const V z = p0.z + s * D.z;
+    const V rho2 = x * x + z * z;
+    const V rho = simd::sqrt(rho2);
+    const V yr = y * y - r2;
+    const V g1 = (rho - V(1)) * (rho - V(1)) + yr;
+    const V g2 = (rho + V(1)) * (rho + V(1)) + yr;
+    f = g1 * g2;
+    const V q = rho2 + yr + V(1);
+    df = V(4) * q * (x * D.x + y * D.y + z * D.z) - V(8) * (x * D.x + z * D.z);
+}
+
+}  // namespace torus_detail
+
+/// Nearest t in (t_min, t_max) with o + t*d on the torus (d need NOT be unit length), or
+/// +infinity for a miss. NaN/inf inputs give a miss (+inf), never NaN.
+template <class V>
+V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
+    using namespace torus_detail;
+    using S = simd::scalar_t<V>;
+    using M = mask_t<V>;
+    const V inf = inf_v<V>();
+    const V zero(0), one(1);
+
+    // 1. Validate and normalise the direction.
+    const V m = simd::max(simd::abs(d.x), simd::max(simd::abs(d.y), simd::abs(d.z)));
+    M valid = finite(o.x) & finite(o.y) & finite(o.z) & finite(m) &
+              (m >= V(std::numeric_limits<S>::min())) & finite(minor) &
+              (minor > V(std::numeric_limits<S>::min())) & !(t_min != t_min) & !(t_max != t_max);
+    // Invalid lanes compute on harmless stand-ins so no NaN travels through the arithmetic.
+    const V ms = simd::select(valid, m, one);
+    const V inv_m = one / ms;
+    const Vec3T<V> dm{simd::select(valid, d.x * inv_m, one), simd::select(valid, d.y * inv_m, zero),
+                      simd::select(valid, d.z * inv_m, zero)};
+    const V lm = simd::sqrt(dot(dm, dm));  // in [1, sqrt 3]
+    const V inv_lm = one / lm;
+    const Vec3T<V> D = dm * inv_lm;
+    const V len = ms * lm;  // |d|; may overflow to inf
+    valid = valid & finite(len);
+    const V r = simd::select(valid, minor, one);
+    const V r2 = r * r;
+    // Bounding sphere and slab, padded by a relative 2^-20 so that rays whose roots lie
+    // exactly on them (radial rays through the outer equator, grazing the top) start from a
+    // point safely outside the surface.
+    const V pad(1.0 + 1.0 / 1048576.0);
+    const V B = (one + r) * pad;
+    const V B2 = B * B;
+    const V r_slab = r * pad;
+
+    // 2. Move a far origin to the closest approach to the centre (s = t*len - tc).
+    Vec3T<V> oo{simd::select(valid, o.x, zero), simd::select(valid, o.y, zero), simd::select(valid, o.z, zero)};
+    const M far = dot(oo, oo) > V(4) * B2;
+    V tc = simd::select(far, -dot(oo, D), zero);
+    Vec3T<V> p0 = oo + D * tc;
+    const V tc2 = simd::select(far, -dot(p0, D), zero);  // one refinement pass
+    p0 = p0 + D * tc2;
+    tc = tc + tc2;
+
+    // 3. Clip to the bounding sphere, the slab |y| <= r and (t_min, t_max).
+    const V b = dot(p0, D);
+    const V c = dot(p0, p0);
+    const V disc = b * b - (c - B2);
+    valid = valid & (disc >= zero);
+    const V w = simd::sqrt(simd::max(disc, zero));
+    V lo = -b - w;
+    V hi = -b + w;
+    {
+        const V inv_dy = one / D.y;
+        const V s1 = (-r_slab - p0.y) * inv_dy;
+        const V s2 = (r_slab - p0.y) * inv_dy;
+        const M flat = D.y == zero;
+        const M in_slab = simd::abs(p0.y) <= r_slab;
+        const V sl = simd::select(flat, simd::select(in_slab, -inf, inf), simd::min(s1, s2));
+        const V sh = simd::select(flat, simd::select(in_slab, inf, -inf), simd::max(s1, s2));
+        lo = simd::max(lo, sl);
+        hi = simd::min(hi, sh);
+    }
+    {
+        const V smin = simd::select(valid, t_min, zero) * len - tc;
+        const V smax = simd::select(valid, t_max, zero) * len - tc;
+        lo = simd::max(lo, smin);
+        hi = simd::min(hi, smax);
+    }
+    valid = valid & (lo <= hi);
+    if (!simd::any(valid)) return inf;
+    lo = simd::select(valid, lo, zero);
+    hi = simd::select(valid, hi, zero);
+
+    // 4. Quartic f(s) = s^4 + A3 s^3 + A2 s^2 + A1 s + A0 and its critical points.
+    const V e = c + (one - r2);
+    const V a2 = D.x * D.x + D.z * D.z;
+    const V a1 = p0.x * D.x + p0.z * D.z;
+    const V A3 = V(4) * b;
+    const V A2 = V(4) * b * b + V(2) * e - V(4) * a2;
+    const V A1 = V(4) * b * e - V(8) * a1;
+    const V C2 = V(3) * A3, C1 = V(2) * A2;  // f'(s) = 4 s^3 + C2 s^2 + C1 s + A1
+    auto fprime = [&](const V& s, V& f1, V& f2) {
+        f1 = ((V(4) * s + C2) * s + C1) * s + A1;
+        f2 = (V(12) * s + V(2) * C2) * s + C1;
+    };
+    // Roots of f''(s) = 12 s^2 + 6 A3 s + 2 A2: s = -b +- simd::sqrt(b^2 - A2/6).
+    const V hq = simd::sqrt(simd::max(b * b - A2 * V(1.0 / 6.0), zero));
+    const V q1 = simd::min(simd::max(-b - hq, lo), hi);
+    const V q2 = simd::min(simd::max(-b + hq, lo), hi);
+    auto critical = [&](const V& u, const V& v) {
+        V fu, fv, dummy;
+        fprime(u, fu, dummy);
+        fprime(v, fv, dummy);
+        const M nu = fu < zero;
+        const M change = nu ^ (fv < zero);
+        const V k = bracket_solve(u, v, nu, fprime, kCriticalIters);
+        return simd::select(change, k, v);
+    };
+    const V k1 = critical(lo, q1);
+    const V k2 = critical(q1, q2);
+    const V k3 = critical(q2, hi);
+
+    // 5. First monotone piece with a sign change of F, then solve it.
+    auto ffun = [&](const V& s, V& f, V& df) { torus_f(p0, D, r2, s, f, df); };
+    const V pts[5] = {lo, k1, k2, k3, hi};
+    M neg[5];
+    for (int i = 0; i < 5; ++i) {
+        V f, df;
+        ffun(pts[i], f, df);
+        neg[i] = f < zero;
+    }
+    V a = zero, bb = zero;
+    M neg_a = neg[0];
+    M found = neg[0] & !neg[0];  // all false
+    for (int i = 3; i >= 0; --i) {
+        const M change = neg[i] ^ neg[i + 1];
+        a = simd::select(change, pts[i], a);
+        bb = simd::select(change, pts[i + 1], bb);
+        neg_a = (change & neg[i]) | ((!change) & neg_a);
+        found = found | change;
+    }
+    valid = valid & found;
+    if (!simd::any(valid)) return inf;
+    const V s_hit = bracket_solve(a, bb, neg_a, ffun, kRootIters);
+    const V t = (s_hit + tc) / len;
+    const M hit = valid & (t > t_min) & (t < t_max);
+    return simd::select(hit, t, inf);
+}
+
+/// Outward normal (not necessarily unit length) at a point p on (or very near) the torus
+/// surface: p minus the nearest point of the tube's centre circle. For the spindle torus
+/// (r > 1) the inner "lemon" surface belongs to the tube centred on the opposite side of the
+/// ring, and the normal points away from that circle.
+template <class V>
+Vec3T<V> torus_normal(const Vec3T<V>& p, V minor) {
+    const V zero(0), one(1);
+    const V rho2 = p.x * p.x + p.z * p.z;
+    const V rho = simd::sqrt(rho2);
+    const auto has_rho = rho > zero;
+    const V inv_rho = one / simd::select(has_rho, rho, one);
+    const V ux = simd::select(has_rho, p.x * inv_rho, zero);
+    const V uz = simd::select(has_rho, p.z * inv_rho, zero);
+    const V yr = p.y * p.y - minor * minor;
+    const V g1 = (rho - one) * (rho - one) + yr;
+    const V g2 = (rho + one) * (rho + one) + yr;
+    // Near circle (ring point on p's side) unless p lies on the opposite tube's surface.
+    const V sgn = simd::select(simd::abs(g2) < simd::abs(g1), V(-1), one);
+    return {p.x - sgn * ux, p.y, p.z - sgn * uz};
+}
+
 }  // namespace streamrt
