@@ -23,8 +23,33 @@ inline double max(double a, double b) { return a > b ? a : b; }
 inline float sign_of(float a) { return std::copysign(1.f, a); }
 inline double sign_of(double a) { return std::copysign(1.0, a); }
 
-// Batch overloads of select/any/all/abs/min/max are xsimd's own, found by argument-dependent
-// lookup; declaring our own would make the calls ambiguous.
+template <class B>
+inline constexpr bool is_batch = xsimd::is_batch<B>::value;
+template <class M>
+inline constexpr bool is_batch_bool = xsimd::is_batch_bool<M>::value;
+
+// Batch forms for qualified calls (simd::select(...)). They are deliberately generic: for an
+// unqualified call, xsimd's own, more specialised overloads (found by argument-dependent
+// lookup) win the partial ordering, so the two never make a call ambiguous.
+template <class M, class B>
+    requires is_batch<B>
+inline B select(const M& m, const B& a, const B& b) { return xsimd::select(m, a, b); }
+template <class M>
+    requires is_batch_bool<M>
+inline bool any(const M& m) { return xsimd::any(m); }
+template <class M>
+    requires is_batch_bool<M>
+inline bool all(const M& m) { return xsimd::all(m); }
+template <class B>
+    requires is_batch<B>
+inline B abs(const B& a) { return xsimd::abs(a); }
+template <class B>
+    requires is_batch<B>
+inline B min(const B& a, const B& b) { return xsimd::min(a, b); }
+template <class B>
+    requires is_batch<B>
+inline B max(const B& a, const B& b) { return xsimd::max(a, b); }
+
 template <class T, class A>
 inline xsimd::batch<T, A> sign_of(const xsimd::batch<T, A>& a) {
     return xsimd::copysign(xsimd::batch<T, A>(T(1)), a);
