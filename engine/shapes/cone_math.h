@@ -12,15 +12,21 @@ struct ConeMath {
     static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
         using namespace simd;
         const V k2(0.25);
-        const V w = V(1) - o.y;  // height below the apex
+        // b^2 - a c cancels badly when the origin is far away (b^2 ~ |o|^2 |d|^2 while the
+        // discriminant is O(|d|^2)): float then kept 3 digits at 11 units and primary hits
+        // landed past the surface (shadow acne). Solving from the ray's closest approach to
+        // the canonical origin keeps every term O(1); t = t_shift + s.
+        const V t_shift = -dot(o, d) / dot(d, d);
+        const Vec3T<V> os = o + d * t_shift;
+        const V w = V(1) - os.y;  // height below the apex
         const V a = d.x * d.x + d.z * d.z - k2 * d.y * d.y;
-        const V b = o.x * d.x + o.z * d.z + k2 * w * d.y;
-        const V c = o.x * o.x + o.z * o.z - k2 * w * w;
+        const V b = os.x * d.x + os.z * d.z + k2 * w * d.y;
+        const V c = os.x * os.x + os.z * os.z - k2 * w * w;
         const auto r = solve_quadratic(a, b, c, b * b - a * c);
         V best = t_max;
-        for (const V& t : {r.t0, r.t1}) {
-            const V y = o.y + d.y * t;
-            best = keep_closest(best, t, r.valid && y >= V(-1) && y <= V(1), t_min);
+        for (const V& s : {r.t0, r.t1}) {
+            const V y = os.y + d.y * s;
+            best = keep_closest(best, t_shift + s, r.valid && y >= V(-1) && y <= V(1), t_min);
         }
         const V t = (V(-1) - o.y) / d.y;
         const V x = o.x + d.x * t, z = o.z + d.z * t;
