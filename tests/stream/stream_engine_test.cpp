@@ -165,7 +165,8 @@ TEST_CASE("stream engine: bit-identical for -j1 and -j3 and across runs; so is t
     for (const auto& ls : loaded_scenes()) {
         CAPTURE(ls.name);
         for (EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
-            CAPTURE(engine_name(engine));
+            const std::string engine_str = engine_name(engine);
+            CAPTURE(engine_str);
             const Framebuffer j1 = render_with(ls.scene, engine, 1);
             const Framebuffer j3 = render_with(ls.scene, engine, 3);
             const Framebuffer j3_again = render_with(ls.scene, engine, 3);
@@ -181,7 +182,8 @@ TEST_CASE("stream engine: every supported ISA level gives the default picture") 
         const Framebuffer def = render_with(ls.scene, EngineKind::Stream, 2);
         for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
             if (!isa_supported(isa)) continue;
-            CAPTURE(isa_name(isa));
+            const std::string isa_str = isa_name(isa);
+            CAPTURE(isa_str);
             const Framebuffer img = render_with(ls.scene, EngineKind::Stream, 2, isa);
             const ImageDifference d = compare_images(img, def);
             CAPTURE(d.psnr);
