@@ -151,7 +151,8 @@ TEST_CASE("pipeline: the profile counts width*height*spp primary rays and lane u
             CHECK(prof.built == StreamRenderer(sc, best_isa()).built_stages());
             for (Stage s : {Stage::Intersect, Stage::Occlusion}) {
                 const StageFigures& f = prof.stages[int(s)];
-                CAPTURE(stage_name(s));
+                const std::string stage_str = stage_name(s);
+                CAPTURE(stage_str);
                 CHECK(f.lanes_used <= f.lanes_total);
                 if (f.lanes_total > 0) {
                     const double use = double(f.lanes_used) / double(f.lanes_total);
