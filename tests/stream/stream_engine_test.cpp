@@ -1,0 +1,197 @@
+// End to end: every example scene rendered by the stream engine and by the recursive
+// baseline at reduced size, compared; determinism across thread counts, runs and ISA levels.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "image/image_compare.h"
+#include "kernels/kernel_table.h"
+#include "parallel/parallelism.h"
+#include "render/render.h"
+#include "scene/parser.h"
+
+using namespace streamrt;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Known failures at this bound (investigated, not loosened; see the commit message):
+//  * scenes/shapes.cfg: shadow acne on the cone. ConeMath computes disc = b^2 - a c
+//    directly; for a camera ~10 units away b^2 ~ 521 and disc ~ 0.02, so float keeps ~3
+//    digits, the primary hit lands ~1e-4 past the surface, beyond the 256-ulp shadow offset
+//    (~6e-5), and the shadow ray starts inside the cone. Cause in engine/shapes/cone_math.h.
+//  * scenes/degrees/degree0.cfg: PSNR 44 dB from a handful of samples at the checker floor's
+//    horizon (t ~ 1e3): float's hit point picks the neighbouring cell (aliasing in both).
+//  * scenes/whitted.cfg: 0.16% of pixels over 1/255, appearing at degree 4 (refraction).
+constexpr int kWidth = 160, kHeight = 120, kSpp = 2;
+constexpr double kMinPsnr = 50.0;         // dB
+constexpr double kMaxShareOver = 0.001;   // share of pixels off by more than 1/255
+
+std::vector<fs::path> scene_files() {
+    std::vector<fs::path> v;
+    for (const auto& e : fs::recursive_directory_iterator(fs::path(STREAMRT_SOURCE_DIR) / "scenes"))
+        if (e.is_regular_file() && e.path().extension() == ".cfg") v.push_back(e.path());
+    std::sort(v.begin(), v.end());
+    return v;
+}
+
+/// Files some other scene includes (fragments such as scenes/degrees/common.cfg).
+std::set<fs::path> included_files(const std::vector<fs::path>& files) {
+    std::set<fs::path> inc;
+    for (const fs::path& f : files) {
+        std::ifstream in(f);
+        std::string line;
+        while (std::getline(in, line)) {
+            std::istringstream words(line);
+            std::string w, arg;
+            if (words >> w && w == "include" && words >> arg)
+                inc.insert(fs::weakly_canonical(f.parent_path() / arg));
+        }
+    }
+    return inc;
+}
+
+struct LoadedScene {
+    std::string name;
+    Scene scene;
+};
+
+/// Every scene under scenes/, at reduced size. Only include fragments may fail to load.
+const std::vector<LoadedScene>& loaded_scenes() {
+    static const std::vector<LoadedScene> scenes = [] {
+        std::vector<LoadedScene> v;
+        const auto files = scene_files();
+        const auto fragments = included_files(files);
+        for (const fs::path& f : files) {
+            const std::string name = fs::relative(f, fs::path(STREAMRT_SOURCE_DIR)).string();
+            try {
+                Scene s = load_scene(f.string());
+                s.settings.width = kWidth;
+                s.settings.height = kHeight;
+                s.settings.spp = kSpp;
+                v.push_back({name, std::move(s)});
+            } catch (const SceneError& e) {
+                if (fragments.count(fs::weakly_canonical(f))) {
+                    MESSAGE("skipping include fragment " << name << ": " << e.what());
+                } else {
+                    FAIL_CHECK("scene " << name << " does not load: " << e.what());
+                }
+            }
+        }
+        return v;
+    }();
+    return scenes;
+}
+
+Framebuffer render_with(const Scene& s, EngineKind engine, int jobs, Isa isa = best_isa()) {
+    Parallelism par(jobs);
+    EngineOptions opt;
+    opt.isa = isa;
+    return render_scene(s, engine, par, nullptr, opt).image;
+}
+
+bool bit_identical(const Framebuffer& a, const Framebuffer& b) {
+    if (a.width != b.width || a.height != b.height) return false;
+    for (int y = 0; y < a.height; ++y)
+        if (std::memcmp(a.pixel(0, y), b.pixel(0, y), sizeof(float) * 3 * std::size_t(a.width)) != 0) return false;
+    return true;
+}
+
+/// The worst pixels of `a` against `b`, for the failure message.
+std::string worst_pixels(const Framebuffer& a, const Framebuffer& b, int n = 8) {
+    struct P {
+        double err;
+        int x, y;
+    };
+    std::vector<P> all;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) {
+            double e = 0;
+            for (int c = 0; c < 3; ++c)
+                e = std::max(e, std::abs(std::clamp(double(a.pixel(x, y)[c]), 0.0, 1.0) - std::clamp(double(b.pixel(x, y)[c]), 0.0, 1.0)));
+            all.push_back({e, x, y});
+        }
+    std::partial_sort(all.begin(), all.begin() + std::min<std::ptrdiff_t>(n, std::ptrdiff_t(all.size())), all.end(),
+                      [](const P& p, const P& q) { return p.err > q.err; });
+    std::ostringstream s;
+    s.precision(5);
+    for (int i = 0; i < n && i < int(all.size()); ++i) {
+        const P& p = all[std::size_t(i)];
+        const float* pa = a.pixel(p.x, p.y);
+        const float* pb = b.pixel(p.x, p.y);
+        s << "\n  (" << p.x << "," << p.y << ") err " << p.err << " stream " << pa[0] << "," << pa[1] << "," << pa[2]
+          << " recursive " << pb[0] << "," << pb[1] << "," << pb[2];
+    }
+    return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("stream engine: every scene under scenes/ loads (or is an include fragment)") {
+    const auto files = scene_files();
+    CHECK(files.size() >= 5);
+    CHECK(loaded_scenes().size() >= files.size() - included_files(files).size());
+    for (const auto& s : loaded_scenes()) MESSAGE("scene " << s.name << ": " << s.scene.objects.size() << " objects");
+}
+
+TEST_CASE("stream engine: matches the recursive baseline on every scene") {
+    for (const auto& ls : loaded_scenes()) {
+        CAPTURE(ls.name);
+        const Framebuffer stream = render_with(ls.scene, EngineKind::Stream, 2);
+        const Framebuffer recursive = render_with(ls.scene, EngineKind::Recursive, 2);
+        REQUIRE(stream.width == kWidth);
+        REQUIRE(stream.height == kHeight);
+        const ImageDifference d = compare_images(stream, recursive);
+        MESSAGE(ls.name << ": PSNR " << d.psnr << " dB, max " << d.max_abs << ", pixels over 1/255 " << d.share_over * 100
+                        << "%");
+        CAPTURE(d.psnr);
+        CAPTURE(d.share_over);
+        CAPTURE(d.max_abs);
+        if (d.psnr < kMinPsnr || d.share_over > kMaxShareOver) MESSAGE("worst pixels of " << ls.name << worst_pixels(stream, recursive));
+        CHECK(d.psnr >= kMinPsnr);
+        CHECK(d.share_over <= kMaxShareOver);
+    }
+}
+
+TEST_CASE("stream engine: bit-identical for -j1 and -j3 and across runs; so is the recursive engine") {
+    for (const auto& ls : loaded_scenes()) {
+        CAPTURE(ls.name);
+        for (EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
+            const std::string engine_str = engine_name(engine);
+            CAPTURE(engine_str);
+            const Framebuffer j1 = render_with(ls.scene, engine, 1);
+            const Framebuffer j3 = render_with(ls.scene, engine, 3);
+            const Framebuffer j3_again = render_with(ls.scene, engine, 3);
+            CHECK(bit_identical(j1, j3));
+            CHECK(bit_identical(j3, j3_again));
+        }
+    }
+}
+
+TEST_CASE("stream engine: every supported ISA level gives the default picture") {
+    for (const auto& ls : loaded_scenes()) {
+        CAPTURE(ls.name);
+        const Framebuffer def = render_with(ls.scene, EngineKind::Stream, 2);
+        for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
+            if (!isa_supported(isa)) continue;
+            const std::string isa_str = isa_name(isa);
+            CAPTURE(isa_str);
+            const Framebuffer img = render_with(ls.scene, EngineKind::Stream, 2, isa);
+            const ImageDifference d = compare_images(img, def);
+            CAPTURE(d.psnr);
+            CAPTURE(d.share_over);
+            if (d.psnr < kMinPsnr || d.share_over > kMaxShareOver) MESSAGE("worst pixels" << worst_pixels(img, def));
+            CHECK(d.psnr >= kMinPsnr);
+            CHECK(d.share_over <= kMaxShareOver);
+            if (isa == best_isa()) CHECK(bit_identical(img, def));
+        }
+    }
+}
