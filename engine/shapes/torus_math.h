@@ -64,8 +64,8 @@ inline V bracket_solve(V a, V b, const mask_t<V>& neg_a, Fn&& fn, int iters) {
         best = simd::select(better, x, best);
         best_f = simd::select(better, af, best_f);
         // Same sign as at a: the root lies right of x.
-        // Masks are compared with != rather than ^: xsimd 8.1 implements ^ on AVX-512 masks as OR.
-        const auto right = !((f < V(0)) != neg_a);
+        // mask_xor, not ^ or != on masks (xsimd 8.1 gets both wrong on some levels; lanes.h).
+        const auto right = !simd::mask_xor(f < V(0), neg_a);
         a = simd::select(right, x, a);
         b = simd::select(right, b, x);
         const V step = f / df;
@@ -198,7 +198,7 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
         fprime(u, fu, dummy);
         fprime(v, fv, dummy);
         const M nu = fu < zero;
-        const M change = nu != (fv < zero);  // != not ^ (see bracket_solve)
+        const M change = simd::mask_xor(nu, fv < zero);
         const V k = bracket_solve(u, v, nu, fprime, kCriticalIters);
         return simd::select(change, k, v);
     };
@@ -219,7 +219,7 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     M neg_a = neg[0];
     M found = neg[0] & !neg[0];  // all false
     for (int i = 3; i >= 0; --i) {
-        const M change = neg[i] != neg[i + 1];  // != not ^ (see bracket_solve)
+        const M change = simd::mask_xor(neg[i], neg[i + 1]);
         a = simd::select(change, pts[i], a);
         bb = simd::select(change, pts[i + 1], bb);
         neg_a = (change & neg[i]) | ((!change) & neg_a);

@@ -40,6 +40,14 @@ inline bool any(const M& m) { return xsimd::any(m); }
 template <class M>
     requires is_batch_bool<M>
 inline bool all(const M& m) { return xsimd::all(m); }
+/// Lane-wise exclusive or of two masks. Written with and/or/not because xsimd 8.1 gets the
+/// direct forms wrong: on AVX-512, mask ^ mask is an OR; on SSE2, mask != mask compares the
+/// all-ones lanes as doubles (NaN), so it is always true.
+inline bool mask_xor(bool a, bool b) { return a != b; }
+template <class M>
+    requires is_batch_bool<M>
+inline M mask_xor(const M& a, const M& b) { return (a && !b) || (!a && b); }
+
 template <class B>
     requires is_batch<B>
 inline B abs(const B& a) { return xsimd::abs(a); }
