@@ -32,15 +32,21 @@ struct BinNode {
 /// fixed size always suffice (see bvh.h: 64 wide levels).
 constexpr int kMedianDepth = 40;
 
+/// A primitive as the builder moves it: its box and number, 32 bytes, partitioned in place so
+/// that every pass over a node's primitives reads memory in order.
+struct Ref {
+    Aabb box;
+    std::uint32_t id;
+    float pad;
+    float c(int a) const { return box.lo[a] + box.hi[a]; }  ///< twice the centroid
+};
+
 struct Builder {
-    const std::vector<Aabb>& boxes;
-    std::vector<float> cx, cy, cz;  ///< centroids
-    std::vector<std::uint32_t>& idx;
+    std::vector<Ref>& refs;
     std::vector<BinNode> nodes;
     std::atomic<std::uint32_t> n_nodes{0};
     BuildOptions opt;
 
-    float centroid(std::uint32_t i, int a) const { return a == 0 ? cx[i] : a == 1 ? cy[i] : cz[i]; }
 
     std::uint32_t alloc() { return n_nodes.fetch_add(1, std::memory_order_relaxed); }
 
@@ -50,50 +56,57 @@ struct Builder {
     }
 
     /// Builds node `node` over idx[first, first + count) whose bounds are `box`.
-    void build(std::uint32_t node, std::uint32_t first, std::uint32_t count, const Aabb& box, int depth) {
+    /// cbox: the bounds of the primitives' doubled centroids (Ref::c).
+    void build(std::uint32_t node, std::uint32_t first, std::uint32_t count, const Aabb& box, const Aabb& cbox,
+               int depth) {
         nodes[node].box = box;
         if (count <= 1) return make_leaf(node, first, count);
-        Aabb cbox;
-        for (std::uint32_t k = first; k < first + count; ++k) {
-            const float c[3] = {cx[idx[k]], cy[idx[k]], cz[idx[k]]};
-            cbox.grow(c);
-        }
         std::uint32_t mid = first;
         bool split = false;
         if (depth < kMedianDepth) {
-            // Binned SAH over the three axes.
+            // Binned SAH over the three axes, one pass over the primitives; small nodes use
+            // fewer bins (as many as primitives), so the bottom of the tree stays cheap.
             constexpr int kMaxBins = 64;
-            const int nb = std::clamp(opt.bins, 2, kMaxBins);
+            const int nb = std::clamp(std::min(opt.bins, int(count)), 2, kMaxBins);
             float best_cost = std::numeric_limits<float>::infinity();
             int best_axis = -1, best_bin = 0;
+            Aabb bb[3][kMaxBins];
+            std::uint32_t bc[3][kMaxBins];
+            float scale[3];
             for (int a = 0; a < 3; ++a) {
                 const float ext = cbox.hi[a] - cbox.lo[a];
-                if (!(ext > 0.f)) continue;
-                const float scale = float(nb) / ext * 0.99999f;
-                Aabb bb[kMaxBins];
-                std::uint32_t bc[kMaxBins] = {};
-                for (std::uint32_t k = first; k < first + count; ++k) {
-                    const std::uint32_t i = idx[k];
-                    int b = int((centroid(i, a) - cbox.lo[a]) * scale);
-                    b = std::clamp(b, 0, nb - 1);
-                    bb[b].grow(boxes[i]);
-                    ++bc[b];
+                scale[a] = ext > 0.f ? float(nb) / ext * 0.99999f : 0.f;
+                for (int b = 0; b < nb; ++b) {
+                    bb[a][b] = Aabb{};
+                    bc[a][b] = 0;
                 }
+            }
+            for (std::uint32_t k = first; k < first + count; ++k) {
+                const Aabb& box_i = refs[k].box;
+                const float c[3] = {refs[k].c(0), refs[k].c(1), refs[k].c(2)};
+                for (int a = 0; a < 3; ++a) {
+                    const int b = std::clamp(int((c[a] - cbox.lo[a]) * scale[a]), 0, nb - 1);
+                    bb[a][b].grow(box_i);
+                    ++bc[a][b];
+                }
+            }
+            for (int a = 0; a < 3; ++a) {
+                if (!(scale[a] > 0.f)) continue;
                 float right_area[kMaxBins];
                 std::uint32_t right_count[kMaxBins];
                 Aabb acc;
                 std::uint32_t cnt = 0;
                 for (int b = nb - 1; b > 0; --b) {
-                    acc.grow(bb[b]);
-                    cnt += bc[b];
+                    acc.grow(bb[a][b]);
+                    cnt += bc[a][b];
                     right_area[b] = acc.half_area();
                     right_count[b] = cnt;
                 }
                 acc = Aabb{};
                 cnt = 0;
                 for (int b = 0; b < nb - 1; ++b) {
-                    acc.grow(bb[b]);
-                    cnt += bc[b];
+                    acc.grow(bb[a][b]);
+                    cnt += bc[a][b];
                     if (cnt == 0 || right_count[b + 1] == 0) continue;
                     const float cost = acc.half_area() * float(cnt) + right_area[b + 1] * float(right_count[b + 1]);
                     if (cost < best_cost) {
@@ -109,11 +122,11 @@ struct Builder {
                 if (count <= std::uint32_t(opt.max_leaf) && leaf_cost <= split_cost)
                     return make_leaf(node, first, count);
                 const int a = best_axis;
-                const float scale = float(nb) / (cbox.hi[a] - cbox.lo[a]) * 0.99999f;
-                const auto it = std::partition(idx.begin() + first, idx.begin() + first + count, [&](std::uint32_t i) {
-                    return std::clamp(int((centroid(i, a) - cbox.lo[a]) * scale), 0, nb - 1) <= best_bin;
+                const float sc = scale[a];
+                const auto it = std::partition(refs.begin() + first, refs.begin() + first + count, [&](const Ref& r) {
+                    return std::clamp(int((r.c(a) - cbox.lo[a]) * sc), 0, nb - 1) <= best_bin;
                 });
-                mid = std::uint32_t(it - idx.begin());
+                mid = std::uint32_t(it - refs.begin());
                 split = mid > first && mid < first + count;
             }
         }
@@ -124,22 +137,30 @@ struct Builder {
             for (int k = 1; k < 3; ++k)
                 if (cbox.hi[k] - cbox.lo[k] > cbox.hi[a] - cbox.lo[a]) a = k;
             mid = first + count / 2;
-            std::nth_element(idx.begin() + first, idx.begin() + mid, idx.begin() + first + count,
-                             [&](std::uint32_t x, std::uint32_t y) { return centroid(x, a) < centroid(y, a); });
+            std::nth_element(refs.begin() + first, refs.begin() + mid, refs.begin() + first + count,
+                             [&](const Ref& x, const Ref& y) { return x.c(a) < y.c(a); });
         }
-        Aabb lb, rb;
-        for (std::uint32_t k = first; k < mid; ++k) lb.grow(boxes[idx[k]]);
-        for (std::uint32_t k = mid; k < first + count; ++k) rb.grow(boxes[idx[k]]);
+        Aabb lb, rb, lc, rc;
+        for (std::uint32_t k = first; k < mid; ++k) {
+            lb.grow(refs[k].box);
+            const float c[3] = {refs[k].c(0), refs[k].c(1), refs[k].c(2)};
+            lc.grow(c);
+        }
+        for (std::uint32_t k = mid; k < first + count; ++k) {
+            rb.grow(refs[k].box);
+            const float c[3] = {refs[k].c(0), refs[k].c(1), refs[k].c(2)};
+            rc.grow(c);
+        }
         const std::uint32_t l = alloc(), r = alloc();
         nodes[node].left = std::int32_t(l);
         nodes[node].right = std::int32_t(r);
         const std::uint32_t nl = mid - first, nr = first + count - mid;
         if (count >= opt.parallel_grain) {
-            parallel_invoke([&] { build(l, first, nl, lb, depth + 1); },
-                            [&] { build(r, mid, nr, rb, depth + 1); });
+            parallel_invoke([&] { build(l, first, nl, lb, lc, depth + 1); },
+                            [&] { build(r, mid, nr, rb, rc, depth + 1); });
         } else {
-            build(l, first, nl, lb, depth + 1);
-            build(r, mid, nr, rb, depth + 1);
+            build(l, first, nl, lb, lc, depth + 1);
+            build(r, mid, nr, rb, rc, depth + 1);
         }
     }
 };
@@ -217,33 +238,30 @@ struct Collapser {
 Bvh Bvh::build(const std::vector<Aabb>& boxes, const BuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     Bvh bvh;
-    std::vector<std::uint32_t> idx;
-    idx.reserve(boxes.size());
+    std::vector<Ref> refs;
+    refs.reserve(boxes.size());
     for (std::size_t i = 0; i < boxes.size(); ++i)
-        if (!boxes[i].empty()) idx.push_back(std::uint32_t(i));
-    if (idx.empty()) return bvh;
-    const std::size_t n = idx.size();
+        if (!boxes[i].empty()) refs.push_back({boxes[i], std::uint32_t(i), 0.f});
+    if (refs.empty()) return bvh;
+    const std::size_t n = refs.size();
 
-    Builder b{boxes, {}, {}, {}, idx, {}, {}, options};
-    b.cx.resize(boxes.size());
-    b.cy.resize(boxes.size());
-    b.cz.resize(boxes.size());
-    parallel_for_index(boxes.size(), 16384, [&](std::size_t i) {
-        b.cx[i] = boxes[i].centre(0);
-        b.cy[i] = boxes[i].centre(1);
-        b.cz[i] = boxes[i].centre(2);
-    });
-    Aabb all;
-    for (std::uint32_t i : idx) all.grow(boxes[i]);
+    Builder b{refs, {}, {}, options};
+    Aabb all, call;
+    for (const Ref& r : refs) {
+        all.grow(r.box);
+        const float c[3] = {r.c(0), r.c(1), r.c(2)};
+        call.grow(c);
+    }
     b.nodes.resize(2 * n);
     const std::uint32_t root = b.alloc();
-    b.build(root, 0, std::uint32_t(n), all, 0);
+    b.build(root, 0, std::uint32_t(n), all, call, 0);
     b.nodes.resize(b.n_nodes.load());
 
     Collapser c{b.nodes, bvh.nodes};
     bvh.nodes.reserve(b.nodes.size() / 4 + 1);
     c.emit(0);
-    bvh.prim_index = std::move(idx);
+    bvh.prim_index.resize(n);
+    parallel_for_index(n, 65536, [&](std::size_t k) { bvh.prim_index[k] = refs[k].id; });
     bvh.bounds = all;
     bvh.stats.binary_nodes = b.nodes.size();
     bvh.stats.wide_nodes = bvh.nodes.size();
