@@ -66,7 +66,7 @@ static_assert(sizeof(WideNode) == 256);
 struct BuildOptions {
     int max_leaf = 4;        ///< largest leaf the SAH may choose
     int bins = 16;           ///< bins per axis
-    float traversal_cost = 1.f;  ///< node visit, relative to one primitive test
+    float traversal_cost = 3.f;  ///< node visit, relative to one primitive test (measured: 3 beats 1)
     std::size_t parallel_grain = 4096;  ///< subtrees at least this big are built as parallel tasks
 };
 
