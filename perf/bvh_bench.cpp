@@ -5,7 +5,6 @@
 //                                     N random spheres on a plane (default 1e2 .. 1e6)
 //   bvh_bench traversal [N]           packet vs single-ray traversal per ray kind (one core)
 //   bvh_bench threshold [-j J]        flat loops vs hierarchy for small N, both engines
-//   bvh_bench mesh FILE.obj [-j J]    render a mesh 1280x720, 1 spp, primary rays only
 #include <algorithm>
 #include <chrono>
 #include <cmath>

@@ -5,8 +5,8 @@
 // one SIMD operation tests a ray against all of them (kernels/accel_kernel.h), or one child
 // against a packet of rays.
 //
-// The hierarchy knows only boxes and primitive indices: the scene's objects (accel/scene_bvh.h)
-// and a mesh's triangles (accel/mesh.h) are both primitives of one.
+// The hierarchy knows only boxes and primitive indices (the scene's objects, accel/scene_bvh.h;
+// a mesh's triangles could be primitives of another).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
