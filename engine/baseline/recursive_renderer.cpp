@@ -14,12 +14,27 @@ inline Vec3d apply_vector(const glm::dmat4& m, const Vec3d& v) { return to_vec(t
 }  // namespace
 
 RecursiveRenderer::RecursiveRenderer(const Scene& scene)
-    : scene_(scene), camera_(CameraRays<double>::from(scene)) {
+    : scene_(scene), bvh_(accel::SceneBvh::build_for(scene)), camera_(CameraRays<double>::from(scene)) {
     for (const Object& o : scene.objects) {
         objects_.push_back({o.kind, o.minor, o.xf.mi, o.xf.md, o.xf.mn});
         materials_.push_back(MaterialT<double>::from(o.material));
     }
     for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(l));
+}
+
+bool RecursiveRenderer::test_object(std::size_t i, const RayD& ray, double t_min, double& t_max, Vec3d& o,
+                                    Vec3d& d) const {
+    const PreparedObject& ob = objects_[i];
+    const Vec3d oc = apply_point(ob.mi, ray.origin);
+    const Vec3d dc = apply_vector(ob.mi, ray.dir);
+    const double t = visit_shape(ob.kind, [&](auto shape) {
+        return shape.template hit_t<double>(oc, dc, ob.param, t_min, t_max);
+    });
+    if (!(t < t_max)) return false;
+    t_max = t;
+    o = oc;
+    d = dc;
+    return true;
 }
 
 bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max, HitD& hit) const {
@@ -29,19 +44,19 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
     int best = -1;
     double best_t = t_max;
     Vec3d best_o{}, best_d{};
-    for (std::size_t i = 0; i < objects_.size(); ++i) {
-        const PreparedObject& ob = objects_[i];
-        const Vec3d o = apply_point(ob.mi, ray.origin);
-        const Vec3d d = apply_vector(ob.mi, ray.dir);
-        const double t = visit_shape(ob.kind, [&](auto shape) {
-            return shape.template hit_t<double>(o, d, ob.param, t_min, best_t);
-        });
-        if (t < best_t) {
-            best_t = t;
-            best = int(i);
-            best_o = o;
-            best_d = d;
-        }
+    if (bvh_) {
+        for (std::uint32_t i : bvh_->unbounded)
+            if (test_object(i, ray, t_min, best_t, best_o, best_d)) best = int(i);
+        const accel::Bvh& h = bvh_->bvh;
+        accel::traverse_closest<double>(h, ray.origin, ray.dir, best_t,
+                                        [&](std::uint32_t first, std::uint32_t count, double& tm) {
+                                            for (std::uint32_t k = first; k < first + count; ++k)
+                                                if (test_object(h.prim_index[k], ray, t_min, tm, best_o, best_d))
+                                                    best = int(h.prim_index[k]);
+                                        });
+    } else {
+        for (std::size_t i = 0; i < objects_.size(); ++i)
+            if (test_object(i, ray, t_min, best_t, best_o, best_d)) best = int(i);
     }
     if (best < 0) return false;
     const PreparedObject& ob = objects_[std::size_t(best)];
@@ -55,13 +70,25 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
 }
 
 bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
-    for (const PreparedObject& ob : objects_) {
-        const Vec3d o = apply_point(ob.mi, ray.origin);
-        const Vec3d d = apply_vector(ob.mi, ray.dir);
-        const double t = visit_shape(ob.kind, [&](auto shape) {
-            return shape.template hit_t<double>(o, d, ob.param, 0.0, t_max);
-        });
-        if (t < t_max) return true;
+    Vec3d o, d;
+    if (bvh_) {
+        for (std::uint32_t i : bvh_->unbounded) {
+            double tm = t_max;
+            if (test_object(i, ray, 0.0, tm, o, d)) return true;
+        }
+        const accel::Bvh& h = bvh_->bvh;
+        return accel::traverse_any<double>(h, ray.origin, ray.dir, t_max,
+                                           [&](std::uint32_t first, std::uint32_t count, double tm) {
+                                               for (std::uint32_t k = first; k < first + count; ++k) {
+                                                   double t = tm;
+                                                   if (test_object(h.prim_index[k], ray, 0.0, t, o, d)) return true;
+                                               }
+                                               return false;
+                                           });
+    }
+    for (std::size_t i = 0; i < objects_.size(); ++i) {
+        double tm = t_max;
+        if (test_object(i, ray, 0.0, tm, o, d)) return true;
     }
     return false;
 }

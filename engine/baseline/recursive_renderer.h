@@ -2,7 +2,10 @@
 // The handout's algorithm as written: scalar, double precision, one ray at a time, closest
 // hit over every object, colour gathered recursively by degree. Kept as a first-class
 // renderer: it is the reference the stream engine is measured against.
+#include <memory>
 #include <vector>
+
+#include "accel/scene_bvh.h"
 
 #include "core/vec3.h"
 #include "image/framebuffer.h"
@@ -36,7 +39,7 @@ class RecursiveRenderer {
     /// Colour brought back by one ray (the handout's recursive procedure).
     ColorT<double> trace(const RayD& ray, int depth, RayCounts& counts) const;
 
-    /// Closest hit over all objects, t in (t_min, t_max); false for a miss.
+    /// Closest hit over all objects (through the scene's hierarchy when it has one), t in (t_min, t_max); false for a miss.
     bool closest_hit(const RayD& ray, double t_min, double t_max, HitD& hit) const;
 
     /// True if anything lies on the ray for t in (0, t_max) (shadow rays).
@@ -52,7 +55,10 @@ class RecursiveRenderer {
         glm::dmat4 mi, md;
         glm::dmat3 mn;
     };
+    /// Tests object i in its canonical space; shrinks t_max and records it on a closer hit.
+    bool test_object(std::size_t i, const RayD& ray, double t_min, double& t_max, Vec3d& o, Vec3d& d) const;
     const Scene& scene_;
+    std::unique_ptr<accel::SceneBvh> bvh_;  ///< null: the handout's loop over all objects
     CameraRays<double> camera_;
     std::vector<PreparedObject> objects_;
     std::vector<MaterialT<double>> materials_;

@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "accel/scene_bvh.h"
 #include "core/error.h"
 #include "image/image_compare.h"
 #include "image/image_io.h"
@@ -40,6 +41,7 @@ struct Options {
     std::string output;
     std::optional<int> spp, width, height, degree, depth;
     std::string engine = "stream";
+    std::string accel = "auto";
     std::string isa;
     bool profile = false;
     std::string profile_json;
@@ -124,6 +126,10 @@ int run(int argc, char** argv) {
         ->check(CLI::IsMember({"stream", "recursive"}));
     app.add_option("--isa", opt.isa, "Force the stream kernels' level: sse2, sse4.2, avx2 or avx512 (default: best the CPU has)")
         ->check(CLI::IsMember({"sse2", "sse4.2", "avx2", "avx512"}));
+    app.add_option("--accel", opt.accel,
+                   "Object hierarchy: auto (the BVH above a measured object count), bvh (always) or flat (the "
+                   "handout's loop over all objects)")
+        ->check(CLI::IsMember({"auto", "bvh", "flat"}));
     app.add_flag("--profile", opt.profile, "Print per-stage throughput of the stream engine");
     app.add_option("--profile-json", opt.profile_json, "Write the profile as JSON to FILE (also: --profile=json FILE)");
     app.add_option("--shade", opt.shade, "Stream shade stage: simd (sorted by object, default) or scalar (for measurement)")
@@ -165,6 +171,9 @@ int run(int argc, char** argv) {
         return 0;
     }
 
+    accel::accel_config().mode = opt.accel == "bvh"    ? accel::AccelMode::Bvh
+                                 : opt.accel == "flat" ? accel::AccelMode::Flat
+                                                       : accel::AccelMode::Auto;
     std::signal(SIGINT, on_sigint);
     std::signal(SIGTERM, on_sigint);
     Parallelism par(opt.jobs);

@@ -4,8 +4,13 @@
 # -std=c++20, so with -mfma the AVX2/AVX-512 kernels silently evaluated a different float
 # expression from the SSE kernels and the scalar shape math (different answers on
 # ill-conditioned rays, e.g. near a cone's apex). FMAs are written explicitly (xsimd::fma).
-set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/isa_sse42.cpp PROPERTIES COMPILE_OPTIONS "-msse4.2;-ffp-contract=off")
-set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/isa_avx2.cpp PROPERTIES COMPILE_OPTIONS "-mavx2;-mfma;-ffp-contract=off")
 # GCC 12 gives false -Wuninitialized/-Wmaybe-uninitialized warnings with AVX-512 (bug 105593).
-set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/isa_avx512.cpp PROPERTIES COMPILE_OPTIONS
+set(STREAMRT_SSE42_FLAGS "-msse4.2;-ffp-contract=off")
+set(STREAMRT_AVX2_FLAGS "-mavx2;-mfma;-ffp-contract=off")
+set(STREAMRT_AVX512_FLAGS
   "-mavx512f;-mavx512cd;-mavx512dq;-mavx512bw;-mavx512vl;-mfma;-ffp-contract=off;-Wno-uninitialized;-Wno-maybe-uninitialized")
+foreach(suffix "" "_accel")
+  set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/isa_sse42${suffix}.cpp PROPERTIES COMPILE_OPTIONS "${STREAMRT_SSE42_FLAGS}")
+  set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/isa_avx2${suffix}.cpp PROPERTIES COMPILE_OPTIONS "${STREAMRT_AVX2_FLAGS}")
+  set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/isa_avx512${suffix}.cpp PROPERTIES COMPILE_OPTIONS "${STREAMRT_AVX512_FLAGS}")
+endforeach()

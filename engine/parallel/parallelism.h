@@ -5,10 +5,12 @@
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/parallel_invoke.h>
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstddef>
+#include <utility>
 
 namespace streamrt {
 
@@ -65,5 +67,21 @@ class Parallelism {
     oneapi::tbb::global_control limit_;
     oneapi::tbb::task_arena arena_;
 };
+
+/// Runs a() and b() possibly in parallel, in the caller's arena (so inside a Parallelism's
+/// work, or after one was made, -j is honoured). For recursive builds (engine/accel).
+template <class A, class B>
+inline void parallel_invoke(A&& a, B&& b) {
+    oneapi::tbb::parallel_invoke(std::forward<A>(a), std::forward<B>(b));
+}
+
+/// body(i) for i in [0, n), chunks of `grain`, in the caller's arena (see parallel_invoke).
+template <class Body>
+inline void parallel_for_index(std::size_t n, std::size_t grain, Body&& body) {
+    oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, grain),
+                              [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                                  for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+                              });
+}
 
 }  // namespace streamrt

@@ -115,6 +115,11 @@ struct PipelineStages {
         rays.pad_tail();
         if (object.size() < rays.capacity()) object.resize(rays.capacity());
         std::fill_n(object.begin(), rays.count, -1);
+        if (sc.accel) {  // the object hierarchy (stream/stream_accel.h)
+            sc.accel->closest(kt, view_of(rays), object.data(), rays.count > 0 && rays.kind[0] == std::uint8_t(RayKind::Primary));
+            if (fig) fig->lanes_used += rays.count, fig->lanes_total += rays.count;
+            return;
+        }
         for (int k = 0; k < kShapeKindCount; ++k) {
             const auto& group = sc.groups[k];
             if (group.empty()) continue;
@@ -302,7 +307,11 @@ struct PipelineStages {
     static void occlusion(const StreamScene& sc, const KernelTable& kt, ShadowStream& shadows, float* accum,
                           StageFigures* fig) {
         shadows.pad_tail();
-        for (int k = 0; k < kShapeKindCount; ++k) {
+        if (sc.accel) {  // the object hierarchy (stream/stream_accel.h)
+            sc.accel->any(kt, view_of(shadows));
+            if (fig) fig->lanes_used += shadows.count, fig->lanes_total += shadows.count;
+        }
+        for (int k = 0; !sc.accel && k < kShapeKindCount; ++k) {
             const auto& group = sc.groups[k];
             if (group.empty()) continue;
             kt.any[k](view_of(shadows), group.data(), group.size());

@@ -39,6 +39,7 @@ StreamScene::StreamScene(const Scene& scene)
     features.reflect = s.degree >= 3 && s.depth >= 1 && any_refl;
     features.refract = s.degree >= 4 && s.depth >= 1 && any_trans;
     features.jitter = s.spp > 1;
+    accel = StreamAccel::build_for(scene);
 }
 
 }  // namespace streamrt

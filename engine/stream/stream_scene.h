@@ -2,12 +2,14 @@
 // The scene as the stream engine reads it: single precision, flat tables, objects grouped
 // by shape kind so that each kernel runs over one kind's objects only.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "kernels/kernel_table.h"
 #include "render/camera_rays.h"
 #include "render/shading.h"
 #include "scene/scene.h"
+#include "stream/stream_accel.h"
 
 namespace streamrt {
 
@@ -32,6 +34,9 @@ struct StreamScene {
     /// kernel call at all.
     std::vector<ObjectXf> groups[kShapeKindCount];
     ColorT<float> background;
+    /// The object hierarchy, when the scene is traced with one (stream/stream_accel.h); the
+    /// intersect and occlusion stages then use it instead of `groups`.
+    std::shared_ptr<const StreamAccel> accel;
 
     explicit StreamScene(const Scene& scene);
 };

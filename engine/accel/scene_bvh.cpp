@@ -1,0 +1,78 @@
+#include "accel/scene_bvh.h"
+
+#include <cmath>
+
+#include "parallel/parallelism.h"
+
+namespace streamrt::accel {
+
+AccelConfig& accel_config() {
+    static AccelConfig config;
+    return config;
+}
+
+bool object_world_bounds(const Object& o, double lo[3], double hi[3]) {
+    const glm::dmat4& m = o.xf.md;
+    switch (o.kind) {
+        case ShapeKind::Plane: return false;
+        case ShapeKind::Sphere:
+            // Exact box of an affine image of the unit sphere: centre +- the row norms of M.
+            for (int a = 0; a < 3; ++a) {
+                const double r = std::sqrt(m[0][a] * m[0][a] + m[1][a] * m[1][a] + m[2][a] * m[2][a]);
+                lo[a] = m[3][a] - r;
+                hi[a] = m[3][a] + r;
+            }
+            return true;
+        default: break;
+    }
+    // The canonical box through Md: centre +- |M| half-extent (the box of the 8 corners).
+    double c[3] = {0, 0, 0}, e[3] = {1, 1, 1};
+    if (o.kind == ShapeKind::Torus) e[0] = e[2] = 1 + o.minor, e[1] = o.minor;
+    for (int a = 0; a < 3; ++a) {
+        double mid = m[3][a], ext = 0;
+        for (int k = 0; k < 3; ++k) {
+            mid += m[k][a] * c[k];
+            ext += std::abs(m[k][a]) * e[k];
+        }
+        lo[a] = mid - ext;
+        hi[a] = mid + ext;
+    }
+    return true;
+}
+
+std::unique_ptr<SceneBvh> SceneBvh::build(const Scene& scene, const BuildOptions& options) {
+    auto s = std::make_unique<SceneBvh>();
+    const std::size_t n = scene.objects.size();
+    std::vector<Aabb> boxes(n);
+    std::vector<char> ok(n);
+    parallel_for_index(n, 4096, [&](std::size_t i) {
+        double lo[3], hi[3];
+        ok[i] = object_world_bounds(scene.objects[i], lo, hi);
+        if (ok[i]) boxes[i] = conservative_box(lo, hi);
+    });
+    std::vector<Aabb> prim_boxes;
+    prim_boxes.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (ok[i]) {
+            s->bounded.push_back(std::uint32_t(i));
+            prim_boxes.push_back(boxes[i]);
+        } else {
+            s->unbounded.push_back(std::uint32_t(i));
+        }
+    }
+    s->bvh = Bvh::build(prim_boxes, options);
+    for (std::uint32_t& k : s->bvh.prim_index) k = s->bounded[k];  // leaf order -> object index
+    return s;
+}
+
+std::unique_ptr<SceneBvh> SceneBvh::build_for(const Scene& scene, const AccelConfig& config) {
+    if (config.mode == AccelMode::Flat) return nullptr;
+    if (config.mode == AccelMode::Auto) {
+        std::size_t bounded = 0;
+        for (const Object& o : scene.objects) bounded += o.kind != ShapeKind::Plane;
+        if (bounded < config.min_objects) return nullptr;
+    }
+    return build(scene, config.build);
+}
+
+}  // namespace streamrt::accel

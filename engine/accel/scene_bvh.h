@@ -1,0 +1,55 @@
+#pragma once
+// The hierarchy over a scene's objects, shared by both engines: world-space bounds of each
+// object (its canonical bounds through Md), the infinite planes kept outside, and the policy
+// that decides when a scene is traced with the hierarchy and how the stream engine walks it.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "accel/bvh.h"
+#include "scene/scene.h"
+
+namespace streamrt::accel {
+
+/// World-space bounds of an object in double; false for an unbounded one (the plane).
+bool object_world_bounds(const Object& o, double lo[3], double hi[3]);
+
+/// How the stream engine walks the hierarchy for one class of rays.
+enum class Traversal : std::uint8_t {
+    Packet,  ///< a packet of SIMD-width rays per walk, children tested one at a time against all lanes
+    Single,  ///< one ray per walk, the 8 child boxes of a node tested in one SIMD operation
+};
+
+enum class AccelMode : std::uint8_t {
+    Auto,  ///< the hierarchy when the scene has at least `min_objects` bounded objects
+    Bvh,   ///< always the hierarchy
+    Flat,  ///< the handout's loop over every object (per shape kind in the stream engine)
+};
+
+/// Process-wide settings (the command line's --accel, perf/ and the tests set them).
+struct AccelConfig {
+    AccelMode mode = AccelMode::Auto;
+    /// Measured (docs/performance.md, "## BVH"): below this many bounded objects the flat
+    /// loops are as fast or faster.
+    std::size_t min_objects = 8;
+    Traversal primary = Traversal::Packet;
+    Traversal secondary = Traversal::Packet;  ///< reflected and refracted rays (packets measured faster, docs/performance.md)
+    Traversal shadow = Traversal::Packet;
+    BuildOptions build;
+};
+AccelConfig& accel_config();
+
+/// The hierarchy over the bounded objects of a scene plus the list of the others.
+struct SceneBvh {
+    Bvh bvh;                               ///< prim_index holds object indices
+    std::vector<std::uint32_t> bounded;    ///< objects in the hierarchy
+    std::vector<std::uint32_t> unbounded;  ///< objects tested separately (planes)
+
+    /// nullptr when the configuration says this scene is traced flat.
+    static std::unique_ptr<SceneBvh> build_for(const Scene& scene, const AccelConfig& config = accel_config());
+    /// The hierarchy regardless of the mode.
+    static std::unique_ptr<SceneBvh> build(const Scene& scene, const BuildOptions& options = {});
+};
+
+}  // namespace streamrt::accel

@@ -1,0 +1,337 @@
+#pragma once
+// The hierarchy traversal kernels, templated on the xsimd arch. Included only by the
+// kernels/isa_<level>_accel.cpp files, each inside its own namespace (see intersect_kernel.h).
+//
+// Two ways to walk the 8-wide tree (accel/bvh.h):
+// - packet: SIMD-width rays walk it together; each child box is tested against all lanes at
+//   once and visited if any active lane hits it; leaves run the shape math on the packet.
+// - single: one ray walks it; the 8 child boxes of a node are tested in one SIMD operation
+//   (NodeArch: 8 lanes, or 4 lanes twice on SSE); leaves run the shape math on the ray
+//   broadcast into a batch (so no scalar shape code is instantiated with this level's flags).
+// Which wins for which ray kind is measured in docs/performance.md ("## BVH").
+#include <xsimd/xsimd.hpp>
+
+#include <algorithm>
+#include <limits>
+
+#include "kernels/accel_kernel_table.h"
+#include "kernels/intersect_kernel.h"
+
+namespace streamrt::STREAMRT_ISA_NAMESPACE {
+
+namespace accel_detail {
+
+constexpr int kStack = accel::kNodeWidth * 64;
+constexpr float kInfF = std::numeric_limits<float>::infinity();
+
+struct StackEntry {
+    std::int32_t child;
+    std::uint32_t count;
+    float t;  ///< smallest entry distance of any lane into the box
+};
+
+/// Slab test of a packet (or a broadcast ray) against boxes given per lane. NaN slab
+/// distances are ignored (a grazing ray counts as hitting). Returns the entry distance (>= 0)
+/// and whether [t_near, t_far] with t_far <= t_max is non-empty.
+template <class B>
+inline auto slab_test(const B& lox, const B& loy, const B& loz, const B& hix, const B& hiy, const B& hiz,
+                      const Vec3T<B>& o, const Vec3T<B>& inv, const B& t_max, B& t_near) {
+    using T = typename B::value_type;
+    B tn(T(0)), tf = t_max;
+    const auto slab = [&](const B& lo, const B& hi, const B& oc, const B& ic) {
+        const B a = (lo - oc) * ic, b = (hi - oc) * ic;
+        const B mn = xsimd::select(a < b, a, b), mx = xsimd::select(a < b, b, a);
+        tn = xsimd::select(mn > tn, mn, tn);
+        tf = xsimd::select(mx < tf, mx, tf);
+    };
+    slab(lox, hix, o.x, inv.x);
+    slab(loy, hiy, o.y, inv.y);
+    slab(loz, hiz, o.z, inv.z);
+    t_near = tn;
+    return tn <= tf;
+}
+
+template <class B>
+inline float horizontal_max(const B& v) {
+    alignas(64) float a[B::size];
+    v.store_aligned(a);
+    float m = a[0];
+    for (std::size_t l = 1; l < B::size; ++l) m = std::max(m, a[l]);
+    return m;
+}
+
+/// Pushes the hit children of a node farthest first (so the nearest is popped first).
+inline void push_sorted(StackEntry* stack, int& sp, StackEntry* hits, int nh) {
+    for (int a = 1; a < nh; ++a) {
+        const StackEntry e = hits[a];
+        int k = a;
+        while (k > 0 && hits[k - 1].t < e.t) {
+            hits[k] = hits[k - 1];
+            --k;
+        }
+        hits[k] = e;
+    }
+    for (int k = 0; k < nh; ++k) stack[sp++] = hits[k];
+}
+
+/// Runs f(ShapeMath{}) for a stored kind.
+template <class F>
+inline void with_shape(std::uint32_t kind, F&& f) {
+    switch (ShapeKind(kind)) {
+        case ShapeKind::Sphere: f(SphereMath{}); break;
+        case ShapeKind::Cube: f(CubeMath{}); break;
+        case ShapeKind::Cylinder: f(CylinderMath{}); break;
+        case ShapeKind::Cone: f(ConeMath{}); break;
+        case ShapeKind::Torus: f(TorusMath{}); break;
+        case ShapeKind::Plane: f(PlaneMath{}); break;
+    }
+}
+
+/// Nearest hit t in (0, t_max) of the rays at `base` (W lanes, in memory) with one object, in
+/// the shape's precision; float result. Shapes solved in double run in two or more halves.
+template <class Arch, class Shape>
+inline xsimd::batch<float, Arch> object_t(const RayView& rays, std::size_t base, const ObjectXf& ob,
+                                          const xsimd::batch<float, Arch>& t_max) {
+    using BF = xsimd::batch<float, Arch>;
+    using T = typename ComputeType<Shape>::type;
+    if constexpr (std::is_same_v<T, float>) {
+        const RayPacket<BF> r{{BF::load_aligned(rays.ox + base), BF::load_aligned(rays.oy + base),
+                               BF::load_aligned(rays.oz + base)},
+                              {BF::load_aligned(rays.dx + base), BF::load_aligned(rays.dy + base),
+                               BF::load_aligned(rays.dz + base)}};
+        const RayPacket<BF> c = to_canonical<BF, float>(r, ob);
+        return Shape::template hit_t<BF>(c.o, c.d, BF(ob.param), BF(0.f), t_max);
+    } else {
+        using BD = xsimd::batch<double, Arch>;
+        alignas(64) float tm[BF::size], out[BF::size];
+        t_max.store_aligned(tm);
+        for (std::size_t h = 0; h < BF::size; h += BD::size) {
+            const RayPacket<BD> r{{load_lanes<BD>(rays.ox + base + h), load_lanes<BD>(rays.oy + base + h),
+                                   load_lanes<BD>(rays.oz + base + h)},
+                                  {load_lanes<BD>(rays.dx + base + h), load_lanes<BD>(rays.dy + base + h),
+                                   load_lanes<BD>(rays.dz + base + h)}};
+            const RayPacket<BD> c = to_canonical<BD, double>(r, ob);
+            const BD t = Shape::template hit_t<BD>(c.o, c.d, BD(double(ob.param)), BD(0.0), load_lanes<BD>(tm + h));
+            alignas(64) double td[BD::size];
+            t.store_aligned(td);
+            for (std::size_t l = 0; l < BD::size; ++l) out[h + l] = float(td[l]);
+        }
+        return BF::load_aligned(out);
+    }
+}
+
+/// The same for one ray broadcast into every lane (single-ray traversal); returns lane 0.
+template <class Arch, class Shape>
+inline float object_t_single(const Vec3f& o, const Vec3f& d, const ObjectXf& ob, float t_max) {
+    using T = typename ComputeType<Shape>::type;
+    using B = xsimd::batch<T, Arch>;
+    const RayPacket<B> r{{B(T(o.x)), B(T(o.y)), B(T(o.z))}, {B(T(d.x)), B(T(d.y)), B(T(d.z))}};
+    const RayPacket<B> c = to_canonical<B, T>(r, ob);
+    const B t = Shape::template hit_t<B>(c.o, c.d, B(T(ob.param)), B(T(0)), B(T(t_max)));
+    return float(t.get(0));
+}
+
+}  // namespace accel_detail
+
+template <class Arch>
+void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object) {
+    using namespace accel_detail;
+    using B = xsimd::batch<float, Arch>;
+    constexpr std::size_t W = B::size;
+    StackEntry stack[kStack];
+    for (std::size_t i = 0; i < rays.count; i += W) {
+        const Vec3T<B> o{B::load_aligned(rays.ox + i), B::load_aligned(rays.oy + i), B::load_aligned(rays.oz + i)};
+        const Vec3T<B> d{B::load_aligned(rays.dx + i), B::load_aligned(rays.dy + i), B::load_aligned(rays.dz + i)};
+        const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
+        B best = B::load_aligned(rays.t_max + i);
+        const B start = best;
+        B best_id(-1.f);
+        float best_max = horizontal_max(best);
+        if (!(best_max > 0.f)) continue;
+        int sp = 0;
+        stack[sp++] = {0, 0, 0.f};
+        while (sp > 0) {
+            const StackEntry e = stack[--sp];
+            if (e.t > best_max) continue;
+            if (e.count > 0) {
+                for (std::uint32_t k = e.child; k < e.child + e.count; ++k) {
+                    const AccelObject& ob = bvh.prims[k];
+                    with_shape(ob.kind, [&](auto shape) {
+                        const B t = object_t<Arch, decltype(shape)>(rays, i, ob.xf, best);
+                        const auto closer = t < best;
+                        best = xsimd::select(closer, t, best);
+                        best_id = xsimd::select(closer, B(float(ob.xf.id)), best_id);
+                    });
+                }
+                best_max = horizontal_max(best);
+                continue;
+            }
+            const accel::WideNode& n = bvh.nodes[e.child];
+            StackEntry hits[accel::kNodeWidth];
+            int nh = 0;
+            for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
+                B tn;
+                const auto hit = slab_test(B(n.lo_x[j]), B(n.lo_y[j]), B(n.lo_z[j]), B(n.hi_x[j]), B(n.hi_y[j]),
+                                           B(n.hi_z[j]), o, inv, best, tn);
+                if (!xsimd::any(hit)) continue;
+                const float t_min = -horizontal_max(xsimd::select(hit, -tn, B(-kInfF)));
+                hits[nh++] = {n.child[j], n.count[j], t_min};
+            }
+            push_sorted(stack, sp, hits, nh);
+        }
+        if (!xsimd::any(best < start)) continue;
+        alignas(64) float t_out[W], id_out[W];
+        best.store_aligned(t_out);
+        best_id.store_aligned(id_out);
+        for (std::size_t l = 0; l < W && i + l < rays.count; ++l) {
+            if (id_out[l] >= 0.f) {
+                rays.t_max[i + l] = t_out[l];
+                object[i + l] = static_cast<std::int32_t>(id_out[l]);
+            }
+        }
+    }
+}
+
+template <class Arch>
+void bvh_any_packet(const AccelView& bvh, RayView rays) {
+    using namespace accel_detail;
+    using B = xsimd::batch<float, Arch>;
+    constexpr std::size_t W = B::size;
+    StackEntry stack[kStack];
+    for (std::size_t i = 0; i < rays.count; i += W) {
+        B t_max = B::load_aligned(rays.t_max + i);
+        auto open = t_max > B(0.f);
+        if (!xsimd::any(open)) continue;
+        const Vec3T<B> o{B::load_aligned(rays.ox + i), B::load_aligned(rays.oy + i), B::load_aligned(rays.oz + i)};
+        const Vec3T<B> d{B::load_aligned(rays.dx + i), B::load_aligned(rays.dy + i), B::load_aligned(rays.dz + i)};
+        const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
+        int sp = 0;
+        stack[sp++] = {0, 0, 0.f};
+        while (sp > 0) {
+            const StackEntry e = stack[--sp];
+            if (e.count > 0) {
+                for (std::uint32_t k = e.child; k < e.child + e.count && xsimd::any(open); ++k) {
+                    const AccelObject& ob = bvh.prims[k];
+                    with_shape(ob.kind, [&](auto shape) {
+                        const B t = object_t<Arch, decltype(shape)>(rays, i, ob.xf, t_max);
+                        open = open && !(t < t_max);
+                        t_max = xsimd::select(open, t_max, B(0.f));
+                    });
+                }
+                if (!xsimd::any(open)) break;  // early exit: the whole packet is blocked
+                continue;
+            }
+            const accel::WideNode& n = bvh.nodes[e.child];
+            for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
+                B tn;
+                const auto hit = slab_test(B(n.lo_x[j]), B(n.lo_y[j]), B(n.lo_z[j]), B(n.hi_x[j]), B(n.hi_y[j]),
+                                           B(n.hi_z[j]), o, inv, t_max, tn) && open;
+                if (xsimd::any(hit)) stack[sp++] = {n.child[j], n.count[j], 0.f};
+            }
+        }
+        alignas(64) float out[W];
+        t_max.store_aligned(out);
+        for (std::size_t l = 0; l < W && i + l < rays.count; ++l)
+            if (out[l] <= 0.f) rays.t_max[i + l] = 0.f;
+    }
+}
+
+/// One ray against the 8 children of a node: hit children (entry distance) into hits[].
+template <class NodeArch>
+inline int node_hits_single(const accel::WideNode& n, const Vec3f& o, const Vec3f& inv, float t_max,
+                            accel_detail::StackEntry* hits) {
+    using namespace accel_detail;
+    using NB = xsimd::batch<float, NodeArch>;
+    constexpr std::size_t NW = NB::size;
+    const Vec3T<NB> ob{NB(o.x), NB(o.y), NB(o.z)}, ib{NB(inv.x), NB(inv.y), NB(inv.z)};
+    alignas(64) float tn_out[accel::kNodeWidth];
+    for (std::size_t j = 0; j < std::size_t(accel::kNodeWidth); j += NW) {
+        NB tn;
+        const auto hit = slab_test(NB::load_aligned(n.lo_x + j), NB::load_aligned(n.lo_y + j),
+                                   NB::load_aligned(n.lo_z + j), NB::load_aligned(n.hi_x + j),
+                                   NB::load_aligned(n.hi_y + j), NB::load_aligned(n.hi_z + j), ob, ib, NB(t_max), tn);
+        xsimd::select(hit, tn, NB(kInfF)).store_aligned(tn_out + j);
+    }
+    int nh = 0;
+    for (int j = 0; j < accel::kNodeWidth; ++j)
+        if (tn_out[j] < kInfF && n.child[j] >= 0) hits[nh++] = {n.child[j], n.count[j], tn_out[j]};
+    return nh;
+}
+
+template <class Arch, class NodeArch>
+void bvh_closest_single(const AccelView& bvh, RayView rays, std::int32_t* object) {
+    using namespace accel_detail;
+    StackEntry stack[kStack];
+    for (std::size_t i = 0; i < rays.count; ++i) {
+        float best = rays.t_max[i];
+        if (!(best > 0.f)) continue;
+        const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
+        const Vec3f inv{1.f / d.x, 1.f / d.y, 1.f / d.z};
+        std::int32_t best_id = -1;
+        int sp = 0;
+        stack[sp++] = {0, 0, 0.f};
+        while (sp > 0) {
+            const StackEntry e = stack[--sp];
+            if (e.t > best) continue;
+            if (e.count > 0) {
+                for (std::uint32_t k = e.child; k < e.child + e.count; ++k) {
+                    const AccelObject& ob = bvh.prims[k];
+                    with_shape(ob.kind, [&](auto shape) {
+                        const float t = object_t_single<Arch, decltype(shape)>(o, d, ob.xf, best);
+                        if (t < best) {
+                            best = t;
+                            best_id = ob.xf.id;
+                        }
+                    });
+                }
+                continue;
+            }
+            StackEntry hits[accel::kNodeWidth];
+            const int nh = node_hits_single<NodeArch>(bvh.nodes[e.child], o, inv, best, hits);
+            push_sorted(stack, sp, hits, nh);
+        }
+        if (best_id >= 0) {
+            rays.t_max[i] = best;
+            object[i] = best_id;
+        }
+    }
+}
+
+template <class Arch, class NodeArch>
+void bvh_any_single(const AccelView& bvh, RayView rays) {
+    using namespace accel_detail;
+    StackEntry stack[kStack];
+    for (std::size_t i = 0; i < rays.count; ++i) {
+        const float t_max = rays.t_max[i];
+        if (!(t_max > 0.f)) continue;
+        const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
+        const Vec3f inv{1.f / d.x, 1.f / d.y, 1.f / d.z};
+        bool blocked = false;
+        int sp = 0;
+        stack[sp++] = {0, 0, 0.f};
+        while (sp > 0 && !blocked) {
+            const StackEntry e = stack[--sp];
+            if (e.count > 0) {
+                for (std::uint32_t k = e.child; k < e.child + e.count && !blocked; ++k) {
+                    const AccelObject& ob = bvh.prims[k];
+                    with_shape(ob.kind, [&](auto shape) {
+                        blocked = object_t_single<Arch, decltype(shape)>(o, d, ob.xf, t_max) < t_max;
+                    });
+                }
+                continue;
+            }
+            StackEntry hits[accel::kNodeWidth];
+            const int nh = node_hits_single<NodeArch>(bvh.nodes[e.child], o, inv, t_max, hits);
+            for (int k = 0; k < nh; ++k) stack[sp++] = hits[k];
+        }
+        if (blocked) rays.t_max[i] = 0.f;
+    }
+}
+
+template <class Arch, class NodeArch>
+AccelKernelTable make_accel_table() {
+    return AccelKernelTable{&bvh_closest_packet<Arch>, &bvh_any_packet<Arch>, &bvh_closest_single<Arch, NodeArch>,
+                            &bvh_any_single<Arch, NodeArch>};
+}
+
+}  // namespace streamrt::STREAMRT_ISA_NAMESPACE

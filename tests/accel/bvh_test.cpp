@@ -1,0 +1,216 @@
+// The object hierarchy against brute force: closest hit and any hit, scalar (baseline) and
+// every SIMD traversal kernel the CPU runs, on random scenes of 1..1000 objects.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "accel/scene_bvh.h"
+#include "kernels/accel_kernel_table.h"
+#include "shapes/shapes.h"
+#include "stream/stream_accel.h"
+
+using namespace streamrt;
+
+namespace {
+
+Scene random_scene(std::size_t n, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Scene s;
+    const double side = 3.0 * std::cbrt(double(n));
+    for (std::size_t i = 0; i < n; ++i) {
+        Object o;
+        const int k = int(rng() % 5);  // sphere, cube, cylinder, cone, torus
+        o.kind = ShapeKind(k);
+        o.minor = 0.3;
+        const glm::dmat4 md = translate_matrix({side * u(rng), side * u(rng), side * u(rng)}) *
+                              rotate_y_matrix(180 * u(rng)) * rotate_x_matrix(180 * u(rng)) *
+                              scale_matrix({0.3 + std::abs(u(rng)), 0.3 + std::abs(u(rng)), 0.3 + std::abs(u(rng))});
+        o.xf = Transform::from_direct(md);
+        s.objects.push_back(o);
+    }
+    if (seed % 2) {  // a plane, which stays outside the hierarchy
+        Object p;
+        p.kind = ShapeKind::Plane;
+        p.xf = Transform::from_direct(translate_matrix({0, -side, 0}));
+        s.objects.push_back(p);
+    }
+    return s;
+}
+
+double brute_t(const Scene& s, const Vec3d& o, const Vec3d& d, double t_max, int* id) {
+    double best = t_max;
+    *id = -1;
+    for (std::size_t i = 0; i < s.objects.size(); ++i) {
+        const Object& ob = s.objects[i];
+        const Vec3d oc = to_vec(transform_point(ob.xf.mi, to_glm(o)));
+        const Vec3d dc = to_vec(transform_vector(ob.xf.mi, to_glm(d)));
+        const double t =
+            visit_shape(ob.kind, [&](auto shape) { return shape.template hit_t<double>(oc, dc, ob.minor, 0.0, best); });
+        if (t < best) {
+            best = t;
+            *id = int(i);
+        }
+    }
+    return best;
+}
+
+double bvh_t(const Scene& s, const accel::SceneBvh& b, const Vec3d& o, const Vec3d& d, double t_max, int* id) {
+    double best = t_max;
+    *id = -1;
+    const auto test = [&](std::uint32_t i, double& tm) {
+        const Object& ob = s.objects[i];
+        const Vec3d oc = to_vec(transform_point(ob.xf.mi, to_glm(o)));
+        const Vec3d dc = to_vec(transform_vector(ob.xf.mi, to_glm(d)));
+        const double t =
+            visit_shape(ob.kind, [&](auto shape) { return shape.template hit_t<double>(oc, dc, ob.minor, 0.0, tm); });
+        if (t < tm) {
+            tm = t;
+            *id = int(i);
+            return true;
+        }
+        return false;
+    };
+    for (std::uint32_t i : b.unbounded) test(i, best);
+    accel::traverse_closest<double>(b.bvh, o, d, best, [&](std::uint32_t first, std::uint32_t count, double& tm) {
+        for (std::uint32_t k = first; k < first + count; ++k) test(b.bvh.prim_index[k], tm);
+    });
+    return best;
+}
+
+struct Rays {
+    std::vector<Vec3d> o, d;
+};
+Rays random_rays(std::size_t n, double side, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Rays r;
+    for (std::size_t i = 0; i < n; ++i) {
+        Vec3d o{1.5 * side * u(rng), 1.5 * side * u(rng), 1.5 * side * u(rng)};
+        Vec3d d{u(rng), u(rng), u(rng)};
+        if (i % 7 == 0) d = Vec3d{0, 0, 1};  // axis-aligned: infinite inverse components
+        r.o.push_back(o);
+        r.d.push_back(normalize(d));
+    }
+    return r;
+}
+
+}  // namespace
+
+TEST_CASE("BVH: scalar closest and any hit equal brute force (1..1000 objects)") {
+    for (std::size_t n : {1, 2, 3, 5, 8, 17, 64, 200, 1000}) {
+        const Scene s = random_scene(n, std::uint32_t(n));
+        const auto b = accel::SceneBvh::build(s);
+        const double side = 3.0 * std::cbrt(double(n));
+        const Rays r = random_rays(2000, side, 7 + std::uint32_t(n));
+        for (std::size_t i = 0; i < r.o.size(); ++i) {
+            int id_a, id_b;
+            const double ta = brute_t(s, r.o[i], r.d[i], std::numeric_limits<double>::infinity(), &id_a);
+            const double tb = bvh_t(s, *b, r.o[i], r.d[i], std::numeric_limits<double>::infinity(), &id_b);
+            CHECK(ta == tb);
+            CHECK(id_a == id_b);
+            // any hit on a segment, a little shorter or longer than the closest hit
+            for (double tm : {0.5 * side, std::isinf(ta) ? 10.0 : ta * 0.999, std::isinf(ta) ? 20.0 : ta * 1.001}) {
+                int dummy;
+                const bool brute = brute_t(s, r.o[i], r.d[i], tm, &dummy) < tm;
+                Scene only_unbounded;
+                for (std::uint32_t u : b->unbounded) only_unbounded.objects.push_back(s.objects[u]);
+                bool any = brute_t(only_unbounded, r.o[i], r.d[i], tm, &dummy) < tm;
+                if (!any)
+                    any = accel::traverse_any<double>(b->bvh, r.o[i], r.d[i], tm,
+                                                      [&](std::uint32_t first, std::uint32_t count, double t) {
+                                                          Scene leaf;
+                                                          for (std::uint32_t k = first; k < first + count; ++k)
+                                                              leaf.objects.push_back(s.objects[b->bvh.prim_index[k]]);
+                                                          return brute_t(leaf, r.o[i], r.d[i], t, &dummy) < t;
+                                                      });
+                CHECK(brute == any);
+            }
+        }
+    }
+}
+
+TEST_CASE("BVH: SIMD packet and single-ray kernels agree with the flat kernels, every ISA") {
+    for (std::size_t n : {1, 4, 9, 100, 1000}) {
+        const Scene s = random_scene(n, 100 + std::uint32_t(n));
+        const double side = 3.0 * std::cbrt(double(n));
+        const Rays r = random_rays(1000, side, 3 + std::uint32_t(n));
+        StreamAccel sa(s, accel::SceneBvh::build(s));
+        for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
+            if (!isa_supported(isa)) continue;
+            const KernelTable& kt = kernel_table(isa);
+            // Flat reference: every object in its kind's kernel.
+            std::vector<ObjectXf> groups[kShapeKindCount];
+            for (std::size_t i = 0; i < s.objects.size(); ++i) {
+                const Object& o = s.objects[i];
+                ObjectXf xf{};
+                for (int a = 0; a < 3; ++a)
+                    for (int c = 0; c < 4; ++c) xf.m[a * 4 + c] = float(o.xf.mi[c][a]);
+                xf.param = float(o.minor);
+                xf.id = std::int32_t(i);
+                groups[int(o.kind)].push_back(xf);
+            }
+            const auto make = [&](RayStream& rs, float t_max) {
+                rs.reserve(r.o.size());
+                for (std::size_t i = 0; i < r.o.size(); ++i) {
+                    rs.ox[i] = float(r.o[i].x), rs.oy[i] = float(r.o[i].y), rs.oz[i] = float(r.o[i].z);
+                    rs.dx[i] = float(r.d[i].x), rs.dy[i] = float(r.d[i].y), rs.dz[i] = float(r.d[i].z);
+                    rs.t_max[i] = t_max;
+                }
+                rs.count = r.o.size();
+                rs.pad_tail();
+            };
+            RayStream flat;
+            make(flat, std::numeric_limits<float>::infinity());
+            AlignedVec<std::int32_t> flat_id(flat.capacity(), -1);
+            for (int k = 0; k < kShapeKindCount; ++k)
+                if (!groups[k].empty()) kt.closest[k](view_of(flat), flat_id.data(), groups[k].data(), groups[k].size());
+            for (accel::Traversal tr : {accel::Traversal::Packet, accel::Traversal::Single}) {
+                accel::accel_config().primary = tr;
+                StreamAccel sa2(s, accel::SceneBvh::build(s));
+                RayStream rs;
+                make(rs, std::numeric_limits<float>::infinity());
+                AlignedVec<std::int32_t> id(rs.capacity(), -1);
+                sa2.closest(kt, view_of(rs), id.data(), true);
+                for (std::size_t i = 0; i < rs.count; ++i) {
+                    CHECK(id[i] == flat_id[i]);
+                    CHECK(rs.t_max[i] == flat.t_max[i]);
+                }
+                // any hit: segments just short of / beyond the closest hit
+                for (float f : {0.999f, 1.001f}) {
+                    accel::accel_config().shadow = tr;
+                    StreamAccel sa3(s, accel::SceneBvh::build(s));
+                    RayStream sh;
+                    make(sh, 0.f);
+                    for (std::size_t i = 0; i < sh.count; ++i)
+                        sh.t_max[i] = std::isinf(flat.t_max[i]) ? 1e3f : flat.t_max[i] * f;
+                    sa3.any(kt, view_of(sh));
+                    for (std::size_t i = 0; i < sh.count; ++i) {
+                        const bool blocked = sh.t_max[i] == 0.f;
+                        if (f > 1.f) CHECK(blocked == (flat_id[i] >= 0));
+                        else if (flat_id[i] < 0) CHECK(!blocked);
+                    }
+                }
+            }
+            accel::accel_config() = accel::AccelConfig{};
+        }
+    }
+}
+
+TEST_CASE("BVH: build of an empty set, a single box and many equal boxes") {
+    CHECK(accel::Bvh::build({}).empty());
+    accel::Aabb b;
+    b.lo[0] = b.lo[1] = b.lo[2] = 0;
+    b.hi[0] = b.hi[1] = b.hi[2] = 1;
+    const accel::Bvh one = accel::Bvh::build({b});
+    REQUIRE(one.nodes.size() == 1);
+    CHECK(one.nodes[0].count[0] == 1);
+    const accel::Bvh many = accel::Bvh::build(std::vector<accel::Aabb>(1000, b));
+    std::size_t total = 0;
+    for (const auto& n : many.nodes)
+        for (int j = 0; j < accel::kNodeWidth; ++j) total += n.count[j];
+    CHECK(total == 1000);
+    CHECK(many.prim_index.size() == 1000);
+}
