@@ -99,12 +99,14 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     if (!closest_hit(ray, 0.0, kInf, hit)) return {s.background.x, s.background.y, s.background.z};
 
     const MaterialT<double>& m = materials_[std::size_t(hit.object)];
-    const ColorT<double> base = surface_color(m, hit.point);
+    const Vec3d n_out = hit.normal;
+    const double cone = ray.cone + camera_.spread * hit.t;
+    const ColorT<double> base =
+        surface_color(m, hit.point, n_out, footprint_width(ray.cone, camera_.spread, hit.t, dot(ray.dir, n_out)));
     if (s.degree == 0) return base;
 
     // Light on the side the ray arrives from (a camera inside a room or a sphere sees the
     // inner faces lit).
-    const Vec3d n_out = hit.normal;
     const Vec3d n = dot(n_out, ray.dir) < 0 ? n_out : -n_out;
     ColorT<double> color = ambient_light(s.degree, s.ambient, m, base);
     for (const LightT<double>& l : lights_) {
@@ -125,13 +127,13 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     if (s.degree >= 3 && m.refl > 0) {
         const Vec3d r = reflect(ray.dir, n);
         ++counts.reflected;
-        color = color + trace({offset_ray_origin(hit.point, n), r}, depth + 1, counts) * m.refl;
+        color = color + trace({offset_ray_origin(hit.point, n), r, cone}, depth + 1, counts) * m.refl;
     }
     if (s.degree >= 4 && m.trans > 0) {
         const Vec3d t = refract(ray.dir, n_out, m.ior);
         const Vec3d side = dot(t, n_out) > 0 ? n_out : -n_out;
         ++counts.refracted;
-        color = color + trace({offset_ray_origin(hit.point, side), t}, depth + 1, counts) * m.trans;
+        color = color + trace({offset_ray_origin(hit.point, side), t, cone}, depth + 1, counts) * m.trans;
     }
     return color;
 }
@@ -143,7 +145,7 @@ ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) 
     ColorT<double> sum{0, 0, 0};
     for (int k = 0; k < s.spp; ++k) {
         const PixelSample ps = pixel_sample(s.pattern, s.spp, pixel, k);
-        const RayD ray{cam.origin, cam.direction(x + ps.x, y + ps.y)};
+        const RayD ray{cam.origin, cam.direction(x + ps.x, y + ps.y), 0.0};
         ++counts.primary;
         sum = sum + trace(ray, 0, counts);
     }

@@ -19,6 +19,7 @@ namespace streamrt {
 
 struct RayD {
     Vec3d origin, dir;  ///< world space; dir is unit for camera, reflected and refracted rays
+    double cone = 0;    ///< footprint width at the origin (ray cone), for texture filtering
 };
 
 /// The ray's "memory" of its closest hit (handout): object, distance, point and normal.

@@ -22,7 +22,7 @@ struct ShadeObject {
 
 /// Append-only view of a RayStream (reflected and refracted rays).
 struct RayAppend {
-    float *ox, *oy, *oz, *dx, *dy, *dz, *t_max, *wr, *wg, *wb;
+    float *ox, *oy, *oz, *dx, *dy, *dz, *t_max, *wr, *wg, *wb, *cone;
     std::int32_t* pixel;
     std::uint8_t* kind;
     std::size_t* count;
@@ -37,7 +37,7 @@ struct ShadowAppend {
 
 struct ShadeJob {
     // Rays [begin, end) of the sorted arrays; readable up to end + kMaxLanes (padding).
-    const float *ox, *oy, *oz, *dx, *dy, *dz, *t, *wr, *wg, *wb;
+    const float *ox, *oy, *oz, *dx, *dy, *dz, *t, *wr, *wg, *wb, *cone;
     const std::int32_t* pixel;
     std::size_t begin, end;
     // The object they all hit.
@@ -47,7 +47,8 @@ struct ShadeJob {
     std::size_t n_lights;
     int degree;
     float ambient;
-    bool spawn;  ///< depth allows reflected / refracted children
+    bool spawn;    ///< depth allows reflected / refracted children
+    float spread;  ///< ray-cone spread angle (texture filtering)
     // Outputs: the weighted local colour of each ray (same indexing as the inputs) ...
     float *lr, *lg, *lb;
     // ... and the rays it spawns.

@@ -48,9 +48,10 @@ inline Vec3T<B> canonical_normal(ShapeKind kind, const Vec3T<B>& p, const B& par
 
 template <class B, class M>
 inline void append(const ShadeJob& job, std::size_t i, const M& active, const Vec3T<B>& o, const Vec3T<B>& d,
-                   const ColorT<B>& w, RayKind kind) {
+                   const ColorT<B>& w, const B& cone, RayKind kind) {
     constexpr std::size_t W = B::size;
-    alignas(64) float ox[W], oy[W], oz[W], dx[W], dy[W], dz[W], wr[W], wg[W], wb[W];
+    alignas(64) float ox[W], oy[W], oz[W], dx[W], dy[W], dz[W], wr[W], wg[W], wb[W], cn[W];
+    cone.store_aligned(cn);
     alignas(64) bool go[W];
     o.x.store_aligned(ox);
     o.y.store_aligned(oy);
@@ -76,6 +77,7 @@ inline void append(const ShadeJob& job, std::size_t i, const M& active, const Ve
         r.wr[j] = wr[l];
         r.wg[j] = wg[l];
         r.wb[j] = wb[l];
+        r.cone[j] = cn[l];
         r.pixel[j] = job.pixel[i + l];
         r.kind[j] = std::uint8_t(kind);
         ++j;
@@ -107,12 +109,17 @@ void shade_run(const ShadeJob& job) {
         // Rebuild the canonical hit point, then world point and normal through Md and Mn.
         const Vec3T<B> pc = apply_point(ob.mi, o) + apply_vector(ob.mi, d) * t;
         const Vec3T<B> p = apply_point(ob.md, pc);
-        const ColorT<B> base = surface_color(m, p);
+        const B cone_in = B::load_unaligned(job.cone + i);
+        const B cone = cone_in + B(job.spread) * t;
+        ColorT<B> base;
+        Vec3T<B> n_out;
+        if (kLit || m.checker) n_out = apply_normal(ob.mn, canonical_normal(ob.kind, pc, B(ob.param)));
+        if (m.checker) base = surface_color(m, p, n_out, footprint_width(cone_in, B(job.spread), t, dot(d, n_out)));
+        else base = splat<B>(m.color);
         ColorT<B> local;
         if constexpr (!kLit) {
             local = mul(w, base);
         } else {
-            const Vec3T<B> n_out = apply_normal(ob.mn, canonical_normal(ob.kind, pc, B(ob.param)));
             const auto facing = dot(n_out, d) < B(0.f);
             const Vec3T<B> n = select3(facing, n_out, -n_out);
             local = mul(w, ambient_light(job.degree, job.ambient, m, base));
@@ -163,12 +170,12 @@ void shade_run(const ShadeJob& job) {
                     local = local + mul(w, dl.color);
                 }
             }
-            if (reflect_here) append(job, i, active, offset_ray_origin(p, n), reflect(d, n), w * B(m.refl), RayKind::Reflected);
+            if (reflect_here) append(job, i, active, offset_ray_origin(p, n), reflect(d, n), w * B(m.refl), cone, RayKind::Reflected);
             if (refract_here) {
                 const Vec3T<B> tr = refract(d, n_out, m.ior);
                 const auto out_side = dot(tr, n_out) > B(0.f);
                 append(job, i, active, offset_ray_origin(p, select3(out_side, n_out, -n_out)), tr, w * B(m.trans),
-                       RayKind::Refracted);
+                       cone, RayKind::Refracted);
             }
         }
         local.x.store_unaligned(job.lr + i);

@@ -3,6 +3,9 @@
 // both placed in the world by Md. The ray through screen point P is [Md E, Md (P - E)).
 #include <glm/glm.hpp>
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/vec3.h"
 #include "scene/scene.h"
 
@@ -13,14 +16,20 @@ struct CameraRays {
     Vec3T<T> origin;         ///< Md E
     Vec3T<T> du, dv, dback;  ///< Md's linear part applied to x, y and -z
     T inv_width, inv_height;
+    T spread;  ///< angle between neighbouring samples at the image centre (ray-cone spread)
 
     static CameraRays from(const Scene& scene) {
         const RenderSettings& s = scene.settings;
         const glm::dmat4 md = scene.camera.world_from_canonical(s.width, s.height);
         const glm::dvec3 e = transform_point(md, {0.0, 0.0, 1.0});
         const auto v = [](const glm::dvec3& a) { return Vec3T<T>{T(a.x), T(a.y), T(a.z)}; };
+        // A pixel spans 2 / width of the canonical screen (|Md x| per unit) at distance
+        // |Md z| from the eye; samples are spread over it sqrt(spp) to a side.
+        const double pixel = std::min(2.0 * glm::length(glm::dvec3(md[0])) / s.width,
+                                      2.0 * glm::length(glm::dvec3(md[1])) / s.height) /
+                             glm::length(glm::dvec3(md[2]));
         return {v(e), v(glm::dvec3(md[0])), v(glm::dvec3(md[1])), v(-glm::dvec3(md[2])),
-                T(1.0 / s.width), T(1.0 / s.height)};
+                T(1.0 / s.width), T(1.0 / s.height), T(pixel / std::sqrt(double(s.spp)))};
     }
 
     /// Unit direction through image position (px, py), in pixels from the top-left corner.

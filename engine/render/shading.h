@@ -60,17 +60,60 @@ struct LightT {
     }
 };
 
-/// Checker cells of side `cell` centred on multiples of cell: y = 0 floors sit mid-cell, so
-/// float noise in a coordinate cannot flip the parity there.
+namespace detail {
+/// G(x) = integral from 0 to x of [floor(u) is odd] du; G(x + 2) = G(x) + 1.
+template <class V>
+inline V odd_cells_integral(const V& x) {
+    using namespace simd;
+    using std::floor;
+    const V pairs = floor(x * V(0.5));
+    return pairs + max(x - V(2) * pairs - V(1), V(0));
+}
+/// Share of [c - half, c + half] covered by odd cells. The pattern has period 2, so c is first
+/// brought into [0, 2): the difference of G then stays accurate far from the origin. Boxes
+/// narrower than 1e-4 cell fall back to a point sample (and avoid 0 / 0).
+template <class V>
+inline V odd_share(const V& c, const V& half) {
+    using namespace simd;
+    using std::floor;
+    const V r = c - V(2) * floor(c * V(0.5));
+    const V point = select(r >= V(1), V(1), V(0));
+    const auto wide = half > V(1e-4);
+    const V h = select(wide, half, V(1));
+    const V box = (odd_cells_integral(r + h) - odd_cells_integral(r - h)) / (V(2) * h);
+    return select(wide, box, point);
+}
+}  // namespace detail
+
+/// Checker cells of side `cell` centred on multiples of cell (so y = 0 floors sit mid-cell,
+/// where float noise cannot flip the parity), box-filtered over the ray's footprint: a disc of
+/// diameter `footprint` (world units) in the surface's tangent plane, n its unit normal. The
+/// parity of three axes combines as p = a + b - 2ab (the chance that an odd number of them is
+/// odd), the closed form of a box filter applied to the 3-D checker. Far away, where a pixel
+/// covers many cells, this converges to the average colour instead of aliasing, and the
+/// float and double engines agree there.
 template <class V, class T>
-inline ColorT<V> surface_color(const MaterialT<T>& m, const Vec3T<V>& p) {
+inline ColorT<V> surface_color(const MaterialT<T>& m, const Vec3T<V>& p, const Vec3T<V>& n, const V& footprint) {
     using namespace simd;
     if (!m.checker) return splat<V>(m.color);
-    using std::floor;
-    const V k(m.inv_cell), half(0.5);
-    const V sum = floor(p.x * k + half) + floor(p.y * k + half) + floor(p.z * k + half);
-    const auto odd = floor(sum * half) != sum * half;
-    return select3(odd, splat<V>(m.checker_color), splat<V>(m.color));
+    const V k(m.inv_cell), half_cell(0.5);
+    const V h = half_cell * footprint * k;
+    const auto extent = [&](const V& nc) { return h * sqrt(max(V(1) - nc * nc, V(0))); };
+    const V fx = detail::odd_share(p.x * k + half_cell, extent(n.x));
+    const V fy = detail::odd_share(p.y * k + half_cell, extent(n.y));
+    const V fz = detail::odd_share(p.z * k + half_cell, extent(n.z));
+    const V fxy = fx + fy - V(2) * fx * fy;
+    const V odd = fxy + fz - V(2) * fxy * fz;
+    return splat<V>(m.color) + (splat<V>(m.checker_color) - splat<V>(m.color)) * odd;
+}
+
+/// Width of a ray's footprint where it meets a surface: the cone it carries (width at its
+/// origin plus `spread` radians per unit of distance; ray cones, Akenine-Moeller et al. 2019,
+/// without the curvature term) stretched by 1 / |cos| of the angle of incidence.
+template <class V>
+inline V footprint_width(const V& cone_at_origin, const V& spread, const V& t, const V& cos_incidence) {
+    using namespace simd;
+    return (cone_at_origin + spread * t) / max(abs(cos_incidence), V(1e-3));
 }
 
 /// Where a light is seen from p: unit direction w towards it, the shadow-ray segment

@@ -20,6 +20,7 @@ struct RayStream {
     AlignedVec<float> ox, oy, oz, dx, dy, dz;
     AlignedVec<float> t_max;  ///< hits accepted for t in (0, t_max)
     AlignedVec<float> wr, wg, wb;  ///< throughput weight: what the ray's colour is worth in its pixel
+    AlignedVec<float> cone;        ///< footprint width at the origin (ray cone, texture filtering)
     AlignedVec<std::int32_t> pixel;  ///< tile-local pixel the result accumulates into
     AlignedVec<std::uint8_t> kind;   ///< RayKind, for the profile
 
@@ -27,7 +28,7 @@ struct RayStream {
     void reserve(std::size_t n) {
         const std::size_t cap = simd::round_up_lanes(n);
         if (ox.size() < cap) {
-            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t_max, &wr, &wg, &wb}) a->resize(cap);
+            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t_max, &wr, &wg, &wb, &cone}) a->resize(cap);
             pixel.resize(cap);
             kind.resize(cap);
         }

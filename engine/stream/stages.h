@@ -21,14 +21,14 @@ namespace streamrt {
 /// shade kernel shares one object: its transforms and material are broadcast, not gathered.
 struct SortedHits {
     std::size_t count = 0;
-    AlignedVec<float> ox, oy, oz, dx, dy, dz, t, wr, wg, wb, lr, lg, lb;
+    AlignedVec<float> ox, oy, oz, dx, dy, dz, t, wr, wg, wb, cone, lr, lg, lb;
     AlignedVec<std::int32_t> pixel;
     std::vector<std::uint32_t> run_start;  ///< per object, then one past the end
     void reserve(std::size_t n) {
         // Kernels read a whole packet past the last ray of a run.
         const std::size_t cap = simd::round_up_lanes(n) + simd::kMaxLanes;
         if (ox.size() < cap) {
-            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t, &wr, &wg, &wb, &lr, &lg, &lb}) a->resize(cap);
+            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t, &wr, &wg, &wb, &cone, &lr, &lg, &lb}) a->resize(cap);
             pixel.resize(cap);
         }
     }
@@ -102,6 +102,7 @@ struct PipelineStages {
                 rays.dz[i] = d.z;
                 rays.t_max[i] = std::numeric_limits<float>::infinity();
                 rays.wr[i] = rays.wg[i] = rays.wb[i] = w;
+                rays.cone[i] = 0.f;  // a pinhole: the cone starts as a point
                 rays.pixel[i] = p;
                 rays.kind[i] = std::uint8_t(RayKind::Primary);
             }
@@ -155,13 +156,15 @@ struct PipelineStages {
             // bring point and normal back with Md and Mn, as the baseline does.
             const Vec3f pc = apply_point(ob.mi, o) + apply_vector(ob.mi, d) * t;
             const Vec3f p = apply_point(ob.md, pc);
-            const ColorT<float> base = surface_color(m, p);
+            const Vec3f nc = visit_shape(ob.kind, [&](auto shape) { return shape.template normal<float>(pc, ob.param); });
+            const Vec3f n_out = apply_normal(ob.mn, nc);
+            const float cone = rays.cone[i] + sc.camera.spread * t;
+            const ColorT<float> base =
+                surface_color(m, p, n_out, footprint_width(rays.cone[i], sc.camera.spread, t, dot(d, n_out)));
             if constexpr (!kLighting) {
                 add(accum, px, mul(w, base));
                 continue;
             } else {
-                const Vec3f nc = visit_shape(ob.kind, [&](auto shape) { return shape.template normal<float>(pc, ob.param); });
-                const Vec3f n_out = apply_normal(ob.mn, nc);
                 const Vec3f n = dot(n_out, d) < 0.f ? n_out : -n_out;
                 add(accum, px, mul(w, ambient_light(s.degree, float(s.ambient), m, base)));
                 Vec3f shadow_origin{};
@@ -196,7 +199,7 @@ struct PipelineStages {
                         const std::size_t j = next.count++;
                         const Vec3f r = reflect(d, n);
                         const Vec3f from = offset_ray_origin(p, n);
-                        push(next, j, from, r, w * m.refl, px, RayKind::Reflected);
+                        push(next, j, from, r, w * m.refl, cone, px, RayKind::Reflected);
                         ++counts.reflected;
                     }
                 }
@@ -205,7 +208,7 @@ struct PipelineStages {
                         const std::size_t j = next.count++;
                         const Vec3f tr = refract(d, n_out, m.ior);
                         const Vec3f from = offset_ray_origin(p, dot(tr, n_out) > 0.f ? n_out : -n_out);
-                        push(next, j, from, tr, w * m.trans, px, RayKind::Refracted);
+                        push(next, j, from, tr, w * m.trans, cone, px, RayKind::Refracted);
                         ++counts.refracted;
                     }
                 }
@@ -253,6 +256,7 @@ struct PipelineStages {
                 h.wr[j] = rays.wr[i];
                 h.wg[j] = rays.wg[i];
                 h.wb[j] = rays.wb[i];
+                h.cone[j] = rays.cone[i];
                 h.pixel[j] = rays.pixel[i];
             }
         }
@@ -260,12 +264,12 @@ struct PipelineStages {
         RayStream& nx = ws.next;
         ShadowStream& sh = ws.shadows;
         ShadeJob job{h.ox.data(), h.oy.data(), h.oz.data(), h.dx.data(), h.dy.data(), h.dz.data(), h.t.data(),
-                     h.wr.data(), h.wg.data(), h.wb.data(), h.pixel.data(), 0, 0, nullptr, nullptr,
+                     h.wr.data(), h.wg.data(), h.wb.data(), h.cone.data(), h.pixel.data(), 0, 0, nullptr, nullptr,
                      sc.lights.data(), sc.lights.size(), sc.settings.degree, float(sc.settings.ambient),
-                     kSecondary && depth < sc.settings.depth, h.lr.data(), h.lg.data(), h.lb.data(),
+                     kSecondary && depth < sc.settings.depth, sc.camera.spread, h.lr.data(), h.lg.data(), h.lb.data(),
                      {nx.ox.data(), nx.oy.data(), nx.oz.data(), nx.dx.data(), nx.dy.data(), nx.dz.data(),
-                      nx.t_max.data(), nx.wr.data(), nx.wg.data(), nx.wb.data(), nx.pixel.data(), nx.kind.data(),
-                      &nx.count},
+                      nx.t_max.data(), nx.wr.data(), nx.wg.data(), nx.wb.data(), nx.cone.data(), nx.pixel.data(),
+                      nx.kind.data(), &nx.count},
                      {sh.ox.data(), sh.oy.data(), sh.oz.data(), sh.dx.data(), sh.dy.data(), sh.dz.data(),
                       sh.t_max.data(), sh.cr.data(), sh.cg.data(), sh.cb.data(), sh.pixel.data(), &sh.count}};
         const ShadeFn fn = kt.shade[(kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0)];
@@ -287,7 +291,8 @@ struct PipelineStages {
     }
 
     static void push(RayStream& r, std::size_t j, const Vec3f& o, const Vec3f& d, const ColorT<float>& w,
-                     std::int32_t px, RayKind kind) {
+                     float cone, std::int32_t px, RayKind kind) {
+        r.cone[j] = cone;
         r.ox[j] = o.x;
         r.oy[j] = o.y;
         r.oz[j] = o.z;
