@@ -161,7 +161,7 @@ TEST_CASE("stream engine: matches the recursive baseline on every scene") {
     }
 }
 
-TEST_CASE("stream engine: bit-identical for -j1 and -j3 and across runs; so is the recursive engine") {
+TEST_CASE("stream engine: bit-identical for -j1 and -j3 and across runs, and so is the recursive engine") {
     for (const auto& ls : loaded_scenes()) {
         CAPTURE(ls.name);
         for (EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
