@@ -78,7 +78,7 @@ TEST_CASE("degree 3: a mirror brings back what the reflected ray sees") {
     check_pixel("sphere color=1,1,1 ambi=0 diff=0 refl=0.5\nlight point pos=0,0,10\n", 2, 0, 0, 0);
 }
 
-TEST_CASE("degree 4: straight through a glass sphere at normal incidence; depth limits it") {
+TEST_CASE("degree 4: straight through a glass sphere at normal incidence, and depth limits it") {
     // Enters at (0,0,1), leaves at (0,0,-1) undeviated, reaches the background: trans^2 * bg.
     check_pixel("sphere color=1,1,1 ambi=0 diff=0 trans=0.5 ior=1.5\nlight point pos=0,10,0\n", 4,
                 0.25 * 0.2, 0.25 * 0.3, 0.25 * 0.4);
