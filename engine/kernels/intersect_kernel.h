@@ -41,8 +41,26 @@ inline RayPacket<B> to_canonical(const RayPacket<B>& r, const ObjectXf& ob) {
     return c;
 }
 
+/// Whether any lane of the packet meets the box within (0, best). Slab test with the
+/// NaN-tolerant min/max of the cube (a zero direction component on a slab face gives 0 * inf).
+template <class B, class T>
+inline bool packet_meets_box(const RayPacket<B>& r, const Vec3T<B>& inv, const ObjectBounds& box, const B& best) {
+    B t_near(T(0)), t_far = best;
+    const B o[3] = {r.o.x, r.o.y, r.o.z}, iv[3] = {inv.x, inv.y, inv.z};
+    for (int a = 0; a < 3; ++a) {
+        const B ta = (B(T(box.lo[a])) - o[a]) * iv[a];
+        const B tb = (B(T(box.hi[a])) - o[a]) * iv[a];
+        const auto ordered = ta < tb;
+        const B lo = xsimd::select(ordered, ta, tb), hi = xsimd::select(ordered, tb, ta);
+        t_near = xsimd::select(lo > t_near, lo, t_near);
+        t_far = xsimd::select(hi < t_far, hi, t_far);
+    }
+    return xsimd::any(t_near <= t_far);
+}
+
 template <class Arch, class Shape>
-void closest_hit(RayView rays, std::int32_t* object, const ObjectXf* objs, std::size_t n_objs) {
+void closest_hit_impl(RayView rays, std::int32_t* object, const ObjectXf* objs, const ObjectBounds* bounds,
+                      std::size_t n_objs) {
     using T = typename ComputeType<Shape>::type;
     using B = xsimd::batch<T, Arch>;
     constexpr std::size_t W = B::size;
@@ -51,10 +69,13 @@ void closest_hit(RayView rays, std::int32_t* object, const ObjectXf* objs, std::
                              {load_lanes<B>(rays.dx + i), load_lanes<B>(rays.dy + i), load_lanes<B>(rays.dz + i)}};
         B best = load_lanes<B>(rays.t_max + i);
         const B start = best;
+        Vec3T<B> inv{};
+        if (bounds) inv = {B(T(1)) / r.d.x, B(T(1)) / r.d.y, B(T(1)) / r.d.z};
         // Ids travel as T lanes (exact below 2^24 objects in float) so that the select shares
         // the distance mask's type at every width.
         B best_id(T(-1));
         for (std::size_t k = 0; k < n_objs; ++k) {
+            if (bounds && !packet_meets_box<B, T>(r, inv, bounds[k], best)) continue;
             const RayPacket<B> c = to_canonical<B, T>(r, objs[k]);
             const B t = Shape::template hit_t<B>(c.o, c.d, B(T(objs[k].param)), B(T(0)), best);
             const auto closer = t < best;
@@ -75,7 +96,7 @@ void closest_hit(RayView rays, std::int32_t* object, const ObjectXf* objs, std::
 }
 
 template <class Arch, class Shape>
-void any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
+void any_hit_impl(RayView rays, const ObjectXf* objs, const ObjectBounds* bounds, std::size_t n_objs) {
     using T = typename ComputeType<Shape>::type;
     using B = xsimd::batch<T, Arch>;
     constexpr std::size_t W = B::size;
@@ -85,7 +106,10 @@ void any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
         if (!xsimd::any(open)) continue;
         const RayPacket<B> r{{load_lanes<B>(rays.ox + i), load_lanes<B>(rays.oy + i), load_lanes<B>(rays.oz + i)},
                              {load_lanes<B>(rays.dx + i), load_lanes<B>(rays.dy + i), load_lanes<B>(rays.dz + i)}};
+        Vec3T<B> inv{};
+        if (bounds) inv = {B(T(1)) / r.d.x, B(T(1)) / r.d.y, B(T(1)) / r.d.z};
         for (std::size_t k = 0; k < n_objs; ++k) {
+            if (bounds && !packet_meets_box<B, T>(r, inv, bounds[k], t_max)) continue;
             const RayPacket<B> c = to_canonical<B, T>(r, objs[k]);
             const B t = Shape::template hit_t<B>(c.o, c.d, B(T(objs[k].param)), B(T(0)), t_max);
             open = open && !(t < t_max);
@@ -99,6 +123,15 @@ void any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
     }
 }
 
+template <class Arch, class Shape>
+void closest_hit(RayView rays, std::int32_t* object, const ObjectXf* objs, std::size_t n_objs) {
+    closest_hit_impl<Arch, Shape>(rays, object, objs, nullptr, n_objs);
+}
+template <class Arch, class Shape>
+void any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
+    any_hit_impl<Arch, Shape>(rays, objs, nullptr, n_objs);
+}
+
 #define SHADE_VARIANT(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8)>
 template <class Arch>
 KernelTable make_table(Isa isa, const char* name) {
@@ -109,6 +142,11 @@ KernelTable make_table(Isa isa, const char* name) {
                         &closest_hit<Arch, ConeMath>, &closest_hit<Arch, TorusMath>, &closest_hit<Arch, PlaneMath>},
                        {&any_hit<Arch, SphereMath>, &any_hit<Arch, CubeMath>, &any_hit<Arch, CylinderMath>,
                         &any_hit<Arch, ConeMath>, &any_hit<Arch, TorusMath>, &any_hit<Arch, PlaneMath>},
+                       {&closest_hit_impl<Arch, SphereMath>, &closest_hit_impl<Arch, CubeMath>,
+                        &closest_hit_impl<Arch, CylinderMath>, &closest_hit_impl<Arch, ConeMath>,
+                        &closest_hit_impl<Arch, TorusMath>, &closest_hit_impl<Arch, PlaneMath>},
+                       {&any_hit_impl<Arch, SphereMath>, &any_hit_impl<Arch, CubeMath>, &any_hit_impl<Arch, CylinderMath>,
+                        &any_hit_impl<Arch, ConeMath>, &any_hit_impl<Arch, TorusMath>, &any_hit_impl<Arch, PlaneMath>},
                        {SHADE_VARIANT(0), SHADE_VARIANT(1), SHADE_VARIANT(2), SHADE_VARIANT(3), SHADE_VARIANT(4),
                         SHADE_VARIANT(5), SHADE_VARIANT(6), SHADE_VARIANT(7), SHADE_VARIANT(8), SHADE_VARIANT(9),
                         SHADE_VARIANT(10), SHADE_VARIANT(11), SHADE_VARIANT(12), SHADE_VARIANT(13), SHADE_VARIANT(14),

@@ -21,12 +21,23 @@ struct ObjectXf {
     std::int32_t id;
 };
 
+/// An object's world-space bounding box, padded outwards; the flat kernels skip an object
+/// for a whole packet when no ray of it meets the box before its current closest hit.
+struct ObjectBounds {
+    float lo[3], hi[3];
+};
+
 /// Closest hit: for each ray, shrinks t_max to the nearest hit among objs and writes that
 /// object's id into object[]. Rays that hit nothing keep t_max and object untouched.
 using ClosestHitFn = void (*)(RayView rays, std::int32_t* object, const ObjectXf* objs, std::size_t n_objs);
 /// Any hit (shadow rays): sets t_max to 0 for every ray blocked by one of objs; packets whose
 /// rays are all blocked already are skipped.
 using AnyHitFn = void (*)(RayView rays, const ObjectXf* objs, std::size_t n_objs);
+
+/// The same with a bounding box per object (bounds[k] for objs[k]), tested per packet.
+using ClosestCulledFn = void (*)(RayView rays, std::int32_t* object, const ObjectXf* objs, const ObjectBounds* bounds,
+                                 std::size_t n_objs);
+using AnyCulledFn = void (*)(RayView rays, const ObjectXf* objs, const ObjectBounds* bounds, std::size_t n_objs);
 
 enum class Isa : std::uint8_t { Sse2, Sse42, Avx2, Avx512 };
 inline constexpr int kIsaCount = 4;
@@ -37,6 +48,8 @@ struct KernelTable {
     int float_lanes;
     ClosestHitFn closest[kShapeKindCount];
     AnyHitFn any[kShapeKindCount];
+    ClosestCulledFn closest_culled[kShapeKindCount];
+    AnyCulledFn any_culled[kShapeKindCount];
     ShadeFn shade[kShadeVariants];
 };
 

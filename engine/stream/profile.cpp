@@ -26,7 +26,7 @@ std::string StreamProfile::text() const {
     out += "\n";
     double total_ns = 0;
     for (const auto& s : stages) total_ns += double(s.nanoseconds);
-    std::snprintf(line, sizeof line, "%-12s %12s %12s %10s %7s %10s %8s\n", "stage", "rays in", "rays out", "time s",
+    std::snprintf(line, sizeof line, "%-12s %12s %12s %10s %7s %10s %8s\n", "stage", "rays in", "rays out", "cpu s",
                   "share", "Mrays/s", "lanes");
     out += line;
     for (int i = 0; i < kStageCount; ++i) {
@@ -47,7 +47,7 @@ std::string StreamProfile::text() const {
                   (unsigned long long)counts.reflected, (unsigned long long)counts.refracted,
                   (unsigned long long)counts.total(), wall_seconds > 0 ? double(counts.total()) / wall_seconds / 1e6 : 0.0);
     out += line;
-    out += "(stage times are summed over threads)\n";
+    out += "(stage times are thread CPU time, summed over threads; Mrays/s = rays in / cpu s)\n";
     return out;
 }
 
@@ -66,7 +66,7 @@ std::string StreamProfile::json() const {
         if (s.rays_in == 0 && s.nanoseconds == 0) continue;
         const double sec = double(s.nanoseconds) * 1e-9;
         std::snprintf(buf, sizeof buf,
-                      "%s    {\"stage\": \"%s\", \"rays_in\": %llu, \"rays_out\": %llu, \"seconds\": %.6f, "
+                      "%s    {\"stage\": \"%s\", \"rays_in\": %llu, \"rays_out\": %llu, \"cpu_seconds\": %.6f, "
                       "\"mrays_per_s\": %.3f, \"lane_utilisation\": %.4f}",
                       first ? "" : ",\n", stage_name(Stage(i)), (unsigned long long)s.rays_in,
                       (unsigned long long)s.rays_out, sec, sec > 0 ? double(s.rays_in) / sec / 1e6 : 0.0,

@@ -124,7 +124,10 @@ struct PipelineStages {
         for (int k = 0; k < kShapeKindCount; ++k) {
             const auto& group = sc.groups[k];
             if (group.empty()) continue;
-            kt.closest[k](view_of(rays), object.data(), group.data(), group.size());
+            if (sc.group_bounded[k])
+                kt.closest_culled[k](view_of(rays), object.data(), group.data(), sc.group_bounds[k].data(), group.size());
+            else
+                kt.closest[k](view_of(rays), object.data(), group.data(), group.size());
             if (fig) {
                 fig->lanes_used += rays.count;
                 fig->lanes_total += stage_detail::lanes_for(rays.count, k == int(ShapeKind::Torus) ? kt.float_lanes / 2 : kt.float_lanes);
@@ -319,7 +322,10 @@ struct PipelineStages {
         for (int k = 0; !sc.accel && k < kShapeKindCount; ++k) {
             const auto& group = sc.groups[k];
             if (group.empty()) continue;
-            kt.any[k](view_of(shadows), group.data(), group.size());
+            if (sc.group_bounded[k])
+                kt.any_culled[k](view_of(shadows), group.data(), sc.group_bounds[k].data(), group.size());
+            else
+                kt.any[k](view_of(shadows), group.data(), group.size());
             if (fig) {
                 fig->lanes_used += shadows.count;
                 fig->lanes_total += stage_detail::lanes_for(shadows.count, k == int(ShapeKind::Torus) ? kt.float_lanes / 2 : kt.float_lanes);

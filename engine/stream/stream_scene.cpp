@@ -1,5 +1,10 @@
 #include "stream/stream_scene.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include "accel/scene_bvh.h"
+
 namespace streamrt {
 
 namespace {
@@ -30,6 +35,20 @@ StreamScene::StreamScene(const Scene& scene)
         xf.param = so.param;
         xf.id = std::int32_t(i);
         groups[int(o.kind)].push_back(xf);
+        double lo[3], hi[3];
+        ObjectBounds box{};
+        if (accel::object_world_bounds(o, lo, hi)) {
+            for (int a = 0; a < 3; ++a) {
+                // Padded outwards by a relative margin and a few float ulps of the coordinates,
+                // so that the float slab test never culls a packet the shape would hit.
+                const double pad = 1e-5 * (hi[a] - lo[a]) + 8.0 * 1.2e-7 * std::max(std::fabs(lo[a]), std::fabs(hi[a]));
+                box.lo[a] = std::nextafter(float(lo[a] - pad), -INFINITY);
+                box.hi[a] = std::nextafter(float(hi[a] + pad), INFINITY);
+            }
+        } else {
+            group_bounded[int(o.kind)] = false;
+        }
+        group_bounds[int(o.kind)].push_back(box);
         any_refl |= o.material.refl > 0;
         any_trans |= o.material.trans > 0;
     }

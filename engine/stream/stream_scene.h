@@ -33,6 +33,10 @@ struct StreamScene {
     /// Per shape kind (indexed by ShapeKind), the objects of that kind; empty kinds get no
     /// kernel call at all.
     std::vector<ObjectXf> groups[kShapeKindCount];
+    /// World bounds per object of each group, for the per-packet culling of the flat kernels;
+    /// a kind with an unbounded member (the plane) is tested without culling.
+    std::vector<ObjectBounds> group_bounds[kShapeKindCount];
+    bool group_bounded[kShapeKindCount] = {true, true, true, true, true, true};
     ColorT<float> background;
     /// The object hierarchy, when the scene is traced with one (stream/stream_accel.h); the
     /// intersect and occlusion stages then use it instead of `groups`.
