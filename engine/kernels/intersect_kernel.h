@@ -4,6 +4,7 @@
 // with one level's flags can be picked by the linker for another's callers.
 #include <xsimd/xsimd.hpp>
 
+#include "kernels/generate_kernel.h"
 #include "kernels/kernel_table.h"
 #include "kernels/shade_kernel.h"
 #include "shapes/shapes.h"
@@ -150,7 +151,8 @@ KernelTable make_table(Isa isa, const char* name) {
                        {SHADE_VARIANT(0), SHADE_VARIANT(1), SHADE_VARIANT(2), SHADE_VARIANT(3), SHADE_VARIANT(4),
                         SHADE_VARIANT(5), SHADE_VARIANT(6), SHADE_VARIANT(7), SHADE_VARIANT(8), SHADE_VARIANT(9),
                         SHADE_VARIANT(10), SHADE_VARIANT(11), SHADE_VARIANT(12), SHADE_VARIANT(13), SHADE_VARIANT(14),
-                        SHADE_VARIANT(15)}};
+                        SHADE_VARIANT(15)},
+                       &generate_rays<Arch>};
 }
 
 #undef SHADE_VARIANT

@@ -51,6 +51,7 @@ struct KernelTable {
     ClosestCulledFn closest_culled[kShapeKindCount];
     AnyCulledFn any_culled[kShapeKindCount];
     ShadeFn shade[kShadeVariants];
+    GenerateFn generate;
 };
 
 /// The best level this CPU runs.

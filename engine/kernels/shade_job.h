@@ -56,6 +56,22 @@ struct ShadeJob {
     ShadowAppend shadows;
 };
 
+/// Camera rays for one chunk. Per ray (arrays padded to whole packets): the pixel's corner
+/// in image coordinates, the hash keys (global pixel index, sample index) and the lattice
+/// cell of the sample. Written to out[0, count).
+struct GenerateJob {
+    std::size_t count;
+    const float *px, *py, *cell_x, *cell_y;
+    const std::uint32_t *key_pixel, *key_sample;
+    int pattern;  ///< SamplePattern
+    bool jitter;  ///< false: pixel centres (spp = 1)
+    float cols, rows;
+    float origin[3], du[3], dv[3], dback[3];
+    float inv_width, inv_height, weight;
+    RayAppend out;
+};
+using GenerateFn = void (*)(const GenerateJob& job);
+
 /// Shade variants, indexed by lit | shadows << 1 | reflect << 2 | refract << 3.
 inline constexpr int kShadeVariants = 16;
 using ShadeFn = void (*)(const ShadeJob& job);

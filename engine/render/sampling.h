@@ -1,7 +1,8 @@
 #pragma once
-// Where each sample falls inside its pixel. Both engines call this with the same
-// (pixel, sample) pair, so they trace the same rays and the picture never depends on the
-// thread count or the order of work.
+// Where each sample falls inside its pixel. Both engines use these formulas with the same
+// (pixel, sample) pair, in float, so they trace the same rays and the picture never depends
+// on the thread count or the order of work. The hash is 32-bit integer arithmetic so the
+// stream engine's generate kernel computes it in SIMD lanes, bit for bit the same.
 #include <cmath>
 #include <cstdint>
 
@@ -9,18 +10,29 @@
 
 namespace streamrt {
 
-/// splitmix64's finaliser: a good 64-bit mix of a counter.
-inline std::uint64_t mix64(std::uint64_t z) {
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
+/// A 32-bit integer hash with good avalanche (xor-shift-multiply, "lowbias32" constants).
+/// U is std::uint32_t or an xsimd batch of it.
+template <class U>
+inline U hash32(U x) {
+    x = x ^ (x >> 16);
+    x = x * U(0x7feb352du);
+    x = x ^ (x >> 15);
+    x = x * U(0x846ca68bu);
+    return x ^ (x >> 16);
 }
 
-/// A uniform double in [0, 1) from 53 bits of a hash.
-inline double unit_from_bits(std::uint64_t bits) { return double(bits >> 11) * 0x1.0p-53; }
+/// The two hashes of sample k of a pixel (its row-major index in the image).
+template <class U>
+inline void sample_hashes(const U& pixel, const U& k, U& h1, U& h2) {
+    h1 = hash32(pixel * U(0x9e3779b1u) + k * U(0x85ebca77u) + U(1u));
+    h2 = hash32(h1 ^ U(0x5bd1e995u));
+}
+
+/// Top 24 bits of a hash as a float in [0, 1), exactly representable.
+inline float unit_from_hash(std::uint32_t h) { return float(h >> 8) * 0x1p-24f; }
 
 struct PixelSample {
-    double x, y;  ///< offset inside the pixel, in [0, 1)
+    float x, y;  ///< offset inside the pixel, in [0, 1)
 };
 
 /// Lattice used by the grid and stratified patterns: cols x rows = spp exactly, as square
@@ -31,20 +43,25 @@ inline int grid_columns(int spp) {
     return cols;
 }
 
-/// Sample `sample` of `spp` in pixel `pixel` (row-major index). spp = 1 always takes the
-/// pixel centre. grid: cell centres; stratified: one jittered point per cell; random:
-/// independent uniform points.
-inline PixelSample pixel_sample(SamplePattern pattern, int spp, std::uint64_t pixel, int sample) {
-    if (spp == 1) return {0.5, 0.5};
-    const std::uint64_t h = mix64(pixel * 0x9e3779b97f4a7c15ull + std::uint64_t(sample) + 1);
-    const double u = unit_from_bits(h), v = unit_from_bits(mix64(h));
+/// Offset of sample k in its lattice cell (cx, cy) of a cols x rows lattice, from the two
+/// hash values u, v in [0, 1): grid takes cell centres, stratified one uniform point per
+/// cell, random ignores the lattice. The same float operations run in the SIMD kernel.
+inline PixelSample lattice_sample(SamplePattern pattern, int cx, int cy, int cols, int rows, float u, float v) {
     if (pattern == SamplePattern::Random) return {u, v};
+    const float ju = pattern == SamplePattern::Grid ? 0.5f : u;
+    const float jv = pattern == SamplePattern::Grid ? 0.5f : v;
+    return {(float(cx) + ju) / float(cols), (float(cy) + jv) / float(rows)};
+}
+
+/// Sample `sample` of `spp` in pixel `pixel` (row-major index). spp = 1 always takes the
+/// pixel centre.
+inline PixelSample pixel_sample(SamplePattern pattern, int spp, std::uint64_t pixel, int sample) {
+    if (spp == 1) return {0.5f, 0.5f};
+    std::uint32_t h1, h2;
+    sample_hashes(std::uint32_t(pixel), std::uint32_t(sample), h1, h2);
     const int cols = grid_columns(spp);
-    const int rows = spp / cols;
-    const int cx = sample % cols, cy = sample / cols;
-    const double jx = pattern == SamplePattern::Grid ? 0.5 : u;
-    const double jy = pattern == SamplePattern::Grid ? 0.5 : v;
-    return {(cx + jx) / cols, (cy + jy) / rows};
+    return lattice_sample(pattern, sample % cols, sample / cols, cols, spp / cols, unit_from_hash(h1),
+                          unit_from_hash(h2));
 }
 
 }  // namespace streamrt

@@ -34,8 +34,23 @@ struct SortedHits {
     }
 };
 
+/// Per-ray inputs of the generate kernel.
+struct GenerateScratch {
+    AlignedVec<float> px, py, cell_x, cell_y;
+    AlignedVec<std::uint32_t> key_pixel, key_sample;
+    void reserve(std::size_t n) {
+        const std::size_t cap = simd::round_up_lanes(n);
+        if (px.size() < cap) {
+            for (auto* a : {&px, &py, &cell_x, &cell_y}) a->assign(cap, 0.f);
+            key_pixel.assign(cap, 0);
+            key_sample.assign(cap, 0);
+        }
+    }
+};
+
 /// Per-thread buffers, reused from chunk to chunk.
 struct Workspace {
+    GenerateScratch generate;
     RayStream current, next;
     AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of `current`
     ShadowStream shadows;
@@ -78,36 +93,60 @@ struct PipelineStages {
 
     /// generate: camera rays for pixels [first, first + n_pixels) of the tile, spp per pixel,
     /// consecutive, so a pixel's samples share a packet. Weight 1/spp each.
-    static void generate(const StreamScene& sc, const Tile& tile, int first, int n_pixels, RayStream& rays) {
+    static void generate(const StreamScene& sc, const KernelTable& kt, const Tile& tile, int first, int n_pixels,
+                         Workspace& ws) {
+        RayStream& rays = ws.current;
+        GenerateScratch& g = ws.generate;
         const int spp = sc.settings.spp;
-        const float w = 1.f / float(spp);
-        rays.reserve(std::size_t(n_pixels) * std::size_t(spp));
+        const std::size_t n = std::size_t(n_pixels) * std::size_t(spp);
+        rays.reserve(n);
+        g.reserve(n);
+        // Integer bookkeeping (pixel of each ray, sample index, lattice cell) in scalar code;
+        // the hashing, jitter and camera directions in the SIMD kernel.
+        const int cols = grid_columns(spp);
         std::size_t i = 0;
         for (int p = first; p < first + n_pixels; ++p) {
             const int x = tile.x0 + p % tile.width(), y = tile.y0 + p / tile.width();
-            const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x);
+            const std::uint32_t pixel = std::uint32_t(std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x));
+            int cx = 0, cy = 0;
             for (int k = 0; k < spp; ++k, ++i) {
-                float sx = 0.5f, sy = 0.5f;
+                g.px[i] = float(x);
+                g.py[i] = float(y);
                 if constexpr (kJitter) {
-                    const PixelSample ps = pixel_sample(sc.settings.pattern, spp, pixel, k);
-                    sx = float(ps.x);
-                    sy = float(ps.y);
+                    g.key_pixel[i] = pixel;
+                    g.key_sample[i] = std::uint32_t(k);
+                    g.cell_x[i] = float(cx);
+                    g.cell_y[i] = float(cy);
+                    if (++cx == cols) cx = 0, ++cy;
                 }
-                const Vec3f d = sc.camera.direction(float(x) + sx, float(y) + sy);
-                rays.ox[i] = sc.camera.origin.x;
-                rays.oy[i] = sc.camera.origin.y;
-                rays.oz[i] = sc.camera.origin.z;
-                rays.dx[i] = d.x;
-                rays.dy[i] = d.y;
-                rays.dz[i] = d.z;
-                rays.t_max[i] = std::numeric_limits<float>::infinity();
-                rays.wr[i] = rays.wg[i] = rays.wb[i] = w;
-                rays.cone[i] = 0.f;  // a pinhole: the cone starts as a point
                 rays.pixel[i] = p;
                 rays.kind[i] = std::uint8_t(RayKind::Primary);
             }
         }
         rays.count = i;
+        const CameraRays<float>& cam = sc.camera;
+        GenerateJob job{n,
+                        g.px.data(),
+                        g.py.data(),
+                        g.cell_x.data(),
+                        g.cell_y.data(),
+                        g.key_pixel.data(),
+                        g.key_sample.data(),
+                        int(sc.settings.pattern),
+                        kJitter,
+                        float(cols),
+                        float(spp / cols),
+                        {cam.origin.x, cam.origin.y, cam.origin.z},
+                        {cam.du.x, cam.du.y, cam.du.z},
+                        {cam.dv.x, cam.dv.y, cam.dv.z},
+                        {cam.dback.x, cam.dback.y, cam.dback.z},
+                        cam.inv_width,
+                        cam.inv_height,
+                        1.f / float(spp),
+                        {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(),
+                         rays.dz.data(), rays.t_max.data(), rays.wr.data(), rays.wg.data(), rays.wb.data(),
+                         rays.cone.data(), rays.pixel.data(), rays.kind.data(), &rays.count}};
+        kt.generate(job);
     }
 
     /// intersect: closest hit of every ray, one SIMD kernel per shape kind present.
@@ -343,7 +382,7 @@ struct PipelineStages {
         const std::size_t lights = sc.lights.size();
         {
             StageTimer timer(fig(Stage::Generate));
-            generate(sc, tile, first, n_pixels, ws.current);
+            generate(sc, kt, tile, first, n_pixels, ws);
             counts.primary += ws.current.count;
             if (profile) fig(Stage::Generate)->rays_out += ws.current.count, fig(Stage::Generate)->rays_in += std::uint64_t(n_pixels);
         }
