@@ -63,23 +63,31 @@ inline void append(const ShadeJob& job, std::size_t i, const M& active, const Ve
     w.y.store_aligned(wg);
     w.z.store_aligned(wb);
     active.store_aligned(go);
+    // Pointers copied to locals: stores through float* could alias the job's fields, and
+    // the compiler would reload every pointer for every lane.
     const RayAppend& r = job.next;
+    float *const rox = r.ox, *const roy = r.oy, *const roz = r.oz, *const rdx = r.dx, *const rdy = r.dy,
+                 *const rdz = r.dz, *const rtm = r.t_max, *const rwr = r.wr, *const rwg = r.wg, *const rwb = r.wb,
+                 *const rcn = r.cone;
+    std::int32_t* const rpx = r.pixel;
+    std::uint8_t* const rkd = r.kind;
+    const std::int32_t* const src_pixel = job.pixel + i;
     std::size_t j = *r.count;
     for (std::size_t l = 0; l < W; ++l) {
         if (!go[l]) continue;
-        r.ox[j] = ox[l];
-        r.oy[j] = oy[l];
-        r.oz[j] = oz[l];
-        r.dx[j] = dx[l];
-        r.dy[j] = dy[l];
-        r.dz[j] = dz[l];
-        r.t_max[j] = std::numeric_limits<float>::infinity();
-        r.wr[j] = wr[l];
-        r.wg[j] = wg[l];
-        r.wb[j] = wb[l];
-        r.cone[j] = cn[l];
-        r.pixel[j] = job.pixel[i + l];
-        r.kind[j] = std::uint8_t(kind);
+        rox[j] = ox[l];
+        roy[j] = oy[l];
+        roz[j] = oz[l];
+        rdx[j] = dx[l];
+        rdy[j] = dy[l];
+        rdz[j] = dz[l];
+        rtm[j] = std::numeric_limits<float>::infinity();
+        rwr[j] = wr[l];
+        rwg[j] = wg[l];
+        rwb[j] = wb[l];
+        rcn[j] = cn[l];
+        rpx[j] = src_pixel[l];
+        rkd[j] = std::uint8_t(kind);
         ++j;
     }
     *r.count = j;
@@ -149,20 +157,25 @@ void shade_run(const ShadeJob& job) {
                     c.z.store_aligned(scb);
                     send.store_aligned(go);
                     const ShadowAppend& s = job.shadows;
+                    float *const sx = s.ox, *const sy = s.oy, *const sz = s.oz, *const tx = s.dx, *const ty = s.dy,
+                                 *const tz = s.dz, *const tm = s.t_max, *const cr = s.cr, *const cg = s.cg,
+                                 *const cb = s.cb;  // locals: no reload per lane (aliasing)
+                    std::int32_t* const spx = s.pixel;
+                    const std::int32_t* const src_pixel = job.pixel + i;
                     std::size_t j = *s.count;
                     for (std::size_t l2 = 0; l2 < W; ++l2) {
                         if (!go[l2]) continue;
-                        s.ox[j] = sox[l2];
-                        s.oy[j] = soy[l2];
-                        s.oz[j] = soz[l2];
-                        s.dx[j] = sdx[l2];
-                        s.dy[j] = sdy[l2];
-                        s.dz[j] = sdz[l2];
-                        s.t_max[j] = stm[l2];
-                        s.cr[j] = scr[l2];
-                        s.cg[j] = scg[l2];
-                        s.cb[j] = scb[l2];
-                        s.pixel[j] = job.pixel[i + l2];
+                        sx[j] = sox[l2];
+                        sy[j] = soy[l2];
+                        sz[j] = soz[l2];
+                        tx[j] = sdx[l2];
+                        ty[j] = sdy[l2];
+                        tz[j] = sdz[l2];
+                        tm[j] = stm[l2];
+                        cr[j] = scr[l2];
+                        cg[j] = scg[l2];
+                        cb[j] = scb[l2];
+                        spx[j] = src_pixel[l2];
                         ++j;
                     }
                     *s.count = j;
