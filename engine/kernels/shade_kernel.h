@@ -5,8 +5,10 @@
 #include <xsimd/xsimd.hpp>
 
 #include <cstddef>
+#include <cstring>
 #include <limits>
 
+#include "kernels/compress.h"
 #include "kernels/shade_job.h"
 #include "render/shading.h"
 #include "shapes/shapes.h"
@@ -46,51 +48,30 @@ inline Vec3T<B> canonical_normal(ShapeKind kind, const Vec3T<B>& p, const B& par
     return PlaneMath::normal<B>(p, param);
 }
 
+/// Appends the active lanes' rays to the next generation's stream, compacted.
 template <class B, class M>
 inline void append(const ShadeJob& job, std::size_t i, const M& active, const Vec3T<B>& o, const Vec3T<B>& d,
                    const ColorT<B>& w, const B& cone, RayKind kind) {
-    constexpr std::size_t W = B::size;
-    alignas(64) float ox[W], oy[W], oz[W], dx[W], dy[W], dz[W], wr[W], wg[W], wb[W], cn[W];
-    cone.store_aligned(cn);
-    alignas(64) bool go[W];
-    o.x.store_aligned(ox);
-    o.y.store_aligned(oy);
-    o.z.store_aligned(oz);
-    d.x.store_aligned(dx);
-    d.y.store_aligned(dy);
-    d.z.store_aligned(dz);
-    w.x.store_aligned(wr);
-    w.y.store_aligned(wg);
-    w.z.store_aligned(wb);
-    active.store_aligned(go);
-    // Pointers copied to locals: stores through float* could alias the job's fields, and
-    // the compiler would reload every pointer for every lane.
+    using A = typename B::arch_type;
+    const unsigned bits = lane_bits(active);
+    if (bits == 0) return;
     const RayAppend& r = job.next;
-    float *const rox = r.ox, *const roy = r.oy, *const roz = r.oz, *const rdx = r.dx, *const rdy = r.dy,
-                 *const rdz = r.dz, *const rtm = r.t_max, *const rwr = r.wr, *const rwg = r.wg, *const rwb = r.wb,
-                 *const rcn = r.cone;
-    std::int32_t* const rpx = r.pixel;
-    std::uint8_t* const rkd = r.kind;
-    const std::int32_t* const src_pixel = job.pixel + i;
-    std::size_t j = *r.count;
-    for (std::size_t l = 0; l < W; ++l) {
-        if (!go[l]) continue;
-        rox[j] = ox[l];
-        roy[j] = oy[l];
-        roz[j] = oz[l];
-        rdx[j] = dx[l];
-        rdy[j] = dy[l];
-        rdz[j] = dz[l];
-        rtm[j] = std::numeric_limits<float>::infinity();
-        rwr[j] = wr[l];
-        rwg[j] = wg[l];
-        rwb[j] = wb[l];
-        rcn[j] = cn[l];
-        rpx[j] = src_pixel[l];
-        rkd[j] = std::uint8_t(kind);
-        ++j;
-    }
-    *r.count = j;
+    const std::size_t j = *r.count;
+    compress_store(o.x, bits, r.ox + j);
+    compress_store(o.y, bits, r.oy + j);
+    compress_store(o.z, bits, r.oz + j);
+    compress_store(d.x, bits, r.dx + j);
+    compress_store(d.y, bits, r.dy + j);
+    compress_store(d.z, bits, r.dz + j);
+    compress_store(w.x, bits, r.wr + j);
+    compress_store(w.y, bits, r.wg + j);
+    compress_store(w.z, bits, r.wb + j);
+    compress_store(cone, bits, r.cone + j);
+    B(std::numeric_limits<float>::infinity()).store_unaligned(r.t_max + j);
+    const std::size_t n =
+        compress_store(xsimd::batch<std::int32_t, A>::load_unaligned(job.pixel + i), bits, r.pixel + j);
+    std::memset(r.kind + j, int(kind), n);
+    *r.count = j + n;
 }
 
 template <class Arch, bool kLit, bool kShadows, bool kReflect, bool kRefract>
@@ -143,42 +124,21 @@ void shade_run(const ShadeJob& job) {
                     const Vec3T<B> to =
                         l.kind == LightKind::Directional ? ls.to_light : splat<B>(l.pos) - shadow_origin;
                     const ColorT<B> c = mul(w, dl.color);
-                    alignas(64) float sox[W], soy[W], soz[W], sdx[W], sdy[W], sdz[W], stm[W], scr[W], scg[W], scb[W];
-                    alignas(64) bool go[W];
-                    shadow_origin.x.store_aligned(sox);
-                    shadow_origin.y.store_aligned(soy);
-                    shadow_origin.z.store_aligned(soz);
-                    to.x.store_aligned(sdx);
-                    to.y.store_aligned(sdy);
-                    to.z.store_aligned(sdz);
-                    ls.t_max.store_aligned(stm);
-                    c.x.store_aligned(scr);
-                    c.y.store_aligned(scg);
-                    c.z.store_aligned(scb);
-                    send.store_aligned(go);
-                    const ShadowAppend& s = job.shadows;
-                    float *const sx = s.ox, *const sy = s.oy, *const sz = s.oz, *const tx = s.dx, *const ty = s.dy,
-                                 *const tz = s.dz, *const tm = s.t_max, *const cr = s.cr, *const cg = s.cg,
-                                 *const cb = s.cb;  // locals: no reload per lane (aliasing)
-                    std::int32_t* const spx = s.pixel;
-                    const std::int32_t* const src_pixel = job.pixel + i;
-                    std::size_t j = *s.count;
-                    for (std::size_t l2 = 0; l2 < W; ++l2) {
-                        if (!go[l2]) continue;
-                        sx[j] = sox[l2];
-                        sy[j] = soy[l2];
-                        sz[j] = soz[l2];
-                        tx[j] = sdx[l2];
-                        ty[j] = sdy[l2];
-                        tz[j] = sdz[l2];
-                        tm[j] = stm[l2];
-                        cr[j] = scr[l2];
-                        cg[j] = scg[l2];
-                        cb[j] = scb[l2];
-                        spx[j] = src_pixel[l2];
-                        ++j;
-                    }
-                    *s.count = j;
+                    const unsigned bits = lane_bits(send);
+                    const ShadowAppend& sa = job.shadows;
+                    const std::size_t j = *sa.count;
+                    compress_store(shadow_origin.x, bits, sa.ox + j);
+                    compress_store(shadow_origin.y, bits, sa.oy + j);
+                    compress_store(shadow_origin.z, bits, sa.oz + j);
+                    compress_store(to.x, bits, sa.dx + j);
+                    compress_store(to.y, bits, sa.dy + j);
+                    compress_store(to.z, bits, sa.dz + j);
+                    compress_store(ls.t_max, bits, sa.t_max + j);
+                    compress_store(c.x, bits, sa.cr + j);
+                    compress_store(c.y, bits, sa.cg + j);
+                    compress_store(c.z, bits, sa.cb + j);
+                    *sa.count = j + compress_store(xsimd::batch<std::int32_t, Arch>::load_unaligned(job.pixel + i), bits,
+                                                   sa.pixel + j);
                 } else {
                     local = local + mul(w, dl.color);
                 }

@@ -24,9 +24,10 @@ struct RayStream {
     AlignedVec<std::int32_t> pixel;  ///< tile-local pixel the result accumulates into
     AlignedVec<std::uint8_t> kind;   ///< RayKind, for the profile
 
-    /// Makes room for n rays (padded) and sets count = 0; keeps capacity.
+    /// Makes room for n rays (padded, plus a packet of slack for the kernels' compacting
+    /// stores) and sets count = 0; keeps capacity.
     void reserve(std::size_t n) {
-        const std::size_t cap = simd::round_up_lanes(n);
+        const std::size_t cap = simd::round_up_lanes(n) + simd::kMaxLanes;
         if (ox.size() < cap) {
             for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t_max, &wr, &wg, &wb, &cone}) a->resize(cap);
             pixel.resize(cap);
@@ -67,7 +68,7 @@ struct ShadowStream {
     AlignedVec<float> cr, cg, cb;  ///< contribution (already weighted) if unoccluded
     AlignedVec<std::int32_t> pixel;
     void reserve(std::size_t n) {
-        const std::size_t cap = simd::round_up_lanes(n);
+        const std::size_t cap = simd::round_up_lanes(n) + simd::kMaxLanes;  // slack as in RayStream
         if (ox.size() < cap) {
             for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t_max, &cr, &cg, &cb}) a->resize(cap);
             pixel.resize(cap);
