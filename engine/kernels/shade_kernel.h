@@ -124,7 +124,7 @@ void shade_run(const ShadeJob& job) {
             const Vec3T<B> n = select3(facing, n_out, -n_out);
             local = mul(w, ambient_light(job.degree, job.ambient, m, base));
             Vec3T<B> shadow_origin{};
-            if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n);
+            if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, o);
             for (std::size_t li = 0; li < job.n_lights; ++li) {
                 const LightT<float>& l = job.lights[li];
                 const LightSample<B> ls = sample_light(l, p);
@@ -170,11 +170,11 @@ void shade_run(const ShadeJob& job) {
                     local = local + mul(w, dl.color);
                 }
             }
-            if (reflect_here) append(job, i, active, offset_ray_origin(p, n), reflect(d, n), w * B(m.refl), cone, RayKind::Reflected);
+            if (reflect_here) append(job, i, active, offset_ray_origin(p, n, o), reflect(d, n), w * B(m.refl), cone, RayKind::Reflected);
             if (refract_here) {
                 const Vec3T<B> tr = refract(d, n_out, m.ior);
                 const auto out_side = dot(tr, n_out) > B(0.f);
-                append(job, i, active, offset_ray_origin(p, select3(out_side, n_out, -n_out)), tr, w * B(m.trans),
+                append(job, i, active, offset_ray_origin(p, select3(out_side, n_out, -n_out), o), tr, w * B(m.trans),
                        cone, RayKind::Refracted);
             }
         }
