@@ -89,6 +89,7 @@ template <class Arch, bool kLit, bool kShadows, bool kReflect, bool kRefract>
 void shade_run(const ShadeJob& job) {
     using B = xsimd::batch<float, Arch>;
     constexpr std::size_t W = B::size;
+    const simd::FlushDenormals ftz;  // see simd/lanes.h
     const ShadeObject& ob = *job.object;
     const MaterialT<float>& m = *job.material;
     const bool reflect_here = kReflect && job.spawn && m.refl > 0.f;
