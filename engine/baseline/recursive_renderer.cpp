@@ -115,7 +115,7 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
         if (!dl.lit) continue;
         const ColorT<double>& c = dl.color;
         if (s.degree >= 5) {
-            const Vec3d from = offset_ray_origin(hit.point, n);
+            const Vec3d from = offset_ray_origin(hit.point, n, ray.origin);
             const Vec3d to = l.kind == LightKind::Directional ? ls.to_light : l.pos - from;
             ++counts.shadow;
             if (occluded({from, to}, ls.t_max)) continue;
@@ -127,13 +127,13 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     if (s.degree >= 3 && m.refl > 0) {
         const Vec3d r = reflect(ray.dir, n);
         ++counts.reflected;
-        color = color + trace({offset_ray_origin(hit.point, n), r, cone}, depth + 1, counts) * m.refl;
+        color = color + trace({offset_ray_origin(hit.point, n, ray.origin), r, cone}, depth + 1, counts) * m.refl;
     }
     if (s.degree >= 4 && m.trans > 0) {
         const Vec3d t = refract(ray.dir, n_out, m.ior);
         const Vec3d side = dot(t, n_out) > 0 ? n_out : -n_out;
         ++counts.refracted;
-        color = color + trace({offset_ray_origin(hit.point, side), t, cone}, depth + 1, counts) * m.trans;
+        color = color + trace({offset_ray_origin(hit.point, side, ray.origin), t, cone}, depth + 1, counts) * m.trans;
     }
     return color;
 }

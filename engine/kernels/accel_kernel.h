@@ -135,6 +135,7 @@ inline float object_t_single(const Vec3f& o, const Vec3f& d, const ObjectXf& ob,
 
 template <class Arch>
 void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object) {
+    const simd::FlushDenormals ftz;  // see simd/lanes.h
     using namespace accel_detail;
     using B = xsimd::batch<float, Arch>;
     constexpr std::size_t W = B::size;
@@ -194,6 +195,7 @@ void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object
 
 template <class Arch>
 void bvh_any_packet(const AccelView& bvh, RayView rays) {
+    const simd::FlushDenormals ftz;  // see simd/lanes.h
     using namespace accel_detail;
     using B = xsimd::batch<float, Arch>;
     constexpr std::size_t W = B::size;
@@ -260,6 +262,7 @@ inline int node_hits_single(const accel::WideNode& n, const Vec3f& o, const Vec3
 
 template <class Arch, class NodeArch>
 void bvh_closest_single(const AccelView& bvh, RayView rays, std::int32_t* object) {
+    const simd::FlushDenormals ftz;  // see simd/lanes.h
     using namespace accel_detail;
     StackEntry stack[kStack];
     for (std::size_t i = 0; i < rays.count; ++i) {
@@ -299,6 +302,7 @@ void bvh_closest_single(const AccelView& bvh, RayView rays, std::int32_t* object
 
 template <class Arch, class NodeArch>
 void bvh_any_single(const AccelView& bvh, RayView rays) {
+    const simd::FlushDenormals ftz;  // see simd/lanes.h
     using namespace accel_detail;
     StackEntry stack[kStack];
     for (std::size_t i = 0; i < rays.count; ++i) {

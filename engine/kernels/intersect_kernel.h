@@ -4,6 +4,8 @@
 // with one level's flags can be picked by the linker for another's callers.
 #include <xsimd/xsimd.hpp>
 
+#include <limits>
+
 #include "kernels/generate_kernel.h"
 #include "kernels/kernel_table.h"
 #include "kernels/shade_kernel.h"
@@ -65,6 +67,12 @@ void closest_hit_impl(RayView rays, std::int32_t* object, const ObjectXf* objs, 
     using T = typename ComputeType<Shape>::type;
     using B = xsimd::batch<T, Arch>;
     constexpr std::size_t W = B::size;
+    const simd::FlushDenormals ftz;
+    // A double-precision shape can return a t outside float's range: beyond it for a
+    // denormal direction (a normal double), below it for a huge one (|d| ~ 3e38). Stored into
+    // the float stream they became +inf or 0 with an object id: a hit at infinity or on the
+    // ray origin. Such t are misses.
+    const B t_limit(T(std::numeric_limits<float>::max())), t_floor(T(std::numeric_limits<float>::min()));
     for (std::size_t i = 0; i < rays.count; i += W) {  // padding makes the last packet safe
         const RayPacket<B> r{{load_lanes<B>(rays.ox + i), load_lanes<B>(rays.oy + i), load_lanes<B>(rays.oz + i)},
                              {load_lanes<B>(rays.dx + i), load_lanes<B>(rays.dy + i), load_lanes<B>(rays.dz + i)}};
@@ -79,7 +87,7 @@ void closest_hit_impl(RayView rays, std::int32_t* object, const ObjectXf* objs, 
             if (bounds && !packet_meets_box<B, T>(r, inv, bounds[k], best)) continue;
             const RayPacket<B> c = to_canonical<B, T>(r, objs[k]);
             const B t = Shape::template hit_t<B>(c.o, c.d, B(T(objs[k].param)), B(T(0)), best);
-            const auto closer = t < best;
+            const auto closer = (t < best) && (t <= t_limit) && (t >= t_floor);
             best = xsimd::select(closer, t, best);
             best_id = xsimd::select(closer, B(T(objs[k].id)), best_id);
         }
@@ -101,6 +109,7 @@ void any_hit_impl(RayView rays, const ObjectXf* objs, const ObjectBounds* bounds
     using T = typename ComputeType<Shape>::type;
     using B = xsimd::batch<T, Arch>;
     constexpr std::size_t W = B::size;
+    const simd::FlushDenormals ftz;
     for (std::size_t i = 0; i < rays.count; i += W) {
         B t_max = load_lanes<B>(rays.t_max + i);
         auto open = t_max > B(T(0));  // lanes not yet blocked (padding lanes have t_max < 0)

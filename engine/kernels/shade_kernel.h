@@ -78,6 +78,7 @@ template <class Arch, bool kLit, bool kShadows, bool kReflect, bool kRefract>
 void shade_run(const ShadeJob& job) {
     using B = xsimd::batch<float, Arch>;
     constexpr std::size_t W = B::size;
+    const simd::FlushDenormals ftz;  // see simd/lanes.h
     const ShadeObject& ob = *job.object;
     const MaterialT<float>& m = *job.material;
     const bool reflect_here = kReflect && job.spawn && m.refl > 0.f;
@@ -113,7 +114,7 @@ void shade_run(const ShadeJob& job) {
             const Vec3T<B> n = select3(facing, n_out, -n_out);
             local = mul(w, ambient_light(job.degree, job.ambient, m, base));
             Vec3T<B> shadow_origin{};
-            if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n);
+            if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, o);
             for (std::size_t li = 0; li < job.n_lights; ++li) {
                 const LightT<float>& l = job.lights[li];
                 const LightSample<B> ls = sample_light(l, p);
@@ -143,11 +144,11 @@ void shade_run(const ShadeJob& job) {
                     local = local + mul(w, dl.color);
                 }
             }
-            if (reflect_here) append(job, i, active, offset_ray_origin(p, n), reflect(d, n), w * B(m.refl), cone, RayKind::Reflected);
+            if (reflect_here) append(job, i, active, offset_ray_origin(p, n, o), reflect(d, n), w * B(m.refl), cone, RayKind::Reflected);
             if (refract_here) {
                 const Vec3T<B> tr = refract(d, n_out, m.ior);
                 const auto out_side = dot(tr, n_out) > B(0.f);
-                append(job, i, active, offset_ray_origin(p, select3(out_side, n_out, -n_out)), tr, w * B(m.trans),
+                append(job, i, active, offset_ray_origin(p, select3(out_side, n_out, -n_out), o), tr, w * B(m.trans),
                        cone, RayKind::Refracted);
             }
         }

@@ -210,7 +210,7 @@ struct PipelineStages {
                 const Vec3f n = dot(n_out, d) < 0.f ? n_out : -n_out;
                 add(accum, px, mul(w, ambient_light(s.degree, float(s.ambient), m, base)));
                 Vec3f shadow_origin{};
-                if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n);
+                if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, o);
                 for (const LightT<float>& l : sc.lights) {
                     const LightSample<float> ls = sample_light(l, p);
                     const DirectLight<float> dl = direct_light(s.degree, m, base, n, d, l, ls);
@@ -240,7 +240,7 @@ struct PipelineStages {
                     if (m.refl > 0.f) {
                         const std::size_t j = next.count++;
                         const Vec3f r = reflect(d, n);
-                        const Vec3f from = offset_ray_origin(p, n);
+                        const Vec3f from = offset_ray_origin(p, n, o);
                         push(next, j, from, r, w * m.refl, cone, px, RayKind::Reflected);
                         ++counts.reflected;
                     }
@@ -249,7 +249,7 @@ struct PipelineStages {
                     if (m.trans > 0.f) {
                         const std::size_t j = next.count++;
                         const Vec3f tr = refract(d, n_out, m.ior);
-                        const Vec3f from = offset_ray_origin(p, dot(tr, n_out) > 0.f ? n_out : -n_out);
+                        const Vec3f from = offset_ray_origin(p, dot(tr, n_out) > 0.f ? n_out : -n_out, o);
                         push(next, j, from, tr, w * m.trans, cone, px, RayKind::Refracted);
                         ++counts.refracted;
                     }

@@ -8,14 +8,41 @@
 namespace streamrt {
 
 namespace {
+
+/// The scene moved so that the camera's eye is at the origin (camera-relative rendering).
+/// The stream engine works in float; world coordinates of 1e6 keep only ~0.06 units of
+/// resolution, so a scene placed 1e6 units away lost its contact shadows and got holes and
+/// acne. Every float the engine sees (rays, hit points, light positions) is now relative to
+/// the eye and as small as the scene itself, whatever its placement. The translation is
+/// applied in double: Md' = T(-e) Md and Mi' = Mi T(e) (from the exact Mi, not re-inverted).
+/// The checker pattern needs world positions: MaterialT::cell_offset carries e / cell,
+/// reduced modulo the pattern's period of 2 cells (exactly, in double).
+Scene rebased_on_eye(const Scene& scene, glm::dvec3& eye) {
+    Scene r = scene;
+    const RenderSettings& s = scene.settings;
+    const glm::dmat4 cam = scene.camera.world_from_canonical(s.width, s.height);
+    eye = transform_point(cam, {0.0, 0.0, 1.0});
+    const glm::dmat4 to_eye = translate_matrix(-eye), from_eye = translate_matrix(eye);
+    r.camera.look_at = false;
+    r.camera.md = to_eye * cam;
+    for (Object& o : r.objects) {
+        o.xf.md = to_eye * o.xf.md;
+        o.xf.mi = o.xf.mi * from_eye;
+    }
+    for (Light& l : r.lights) l.pos -= eye;
+    return r;
+}
+
 void rows3x4(const glm::dmat4& m, float* out) {
     for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 4; ++c) out[r * 4 + c] = float(m[c][r]);  // glm is column-major
 }
 }  // namespace
 
-StreamScene::StreamScene(const Scene& scene)
-    : settings(scene.settings), camera(CameraRays<float>::from(scene)) {
+StreamScene::StreamScene(const Scene& original) : settings(original.settings) {
+    glm::dvec3 eye;
+    const Scene scene = rebased_on_eye(original, eye);
+    camera = CameraRays<float>::from(scene);
     const RenderSettings& s = scene.settings;
     background = {float(s.background.x), float(s.background.y), float(s.background.z)};
     bool any_refl = false, any_trans = false;
@@ -29,7 +56,13 @@ StreamScene::StreamScene(const Scene& scene)
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c) so.mn[r * 3 + c] = float(o.xf.mn[c][r]);
         objects.push_back(so);
-        materials.push_back(MaterialT<float>::from(o.material));
+        MaterialT<float> mat = MaterialT<float>::from(o.material);
+        const auto period = [&](double e) {  // e / cell modulo 2, in [0, 2)
+            const double c = e / o.material.cell;
+            return float(c - 2.0 * std::floor(c * 0.5));
+        };
+        mat.cell_offset = {period(eye.x), period(eye.y), period(eye.z)};
+        materials.push_back(mat);
         ObjectXf xf{};
         std::copy(std::begin(so.mi), std::end(so.mi), xf.m);
         xf.param = so.param;

@@ -26,7 +26,7 @@ struct StreamFeatures {
 struct StreamScene {
     RenderSettings settings;
     StreamFeatures features;
-    CameraRays<float> camera;
+    CameraRays<float> camera;  ///< everything below is relative to the eye (stream_scene.cpp)
     std::vector<ShadeObject> objects;
     std::vector<MaterialT<float>> materials;  ///< per object
     std::vector<LightT<float>> lights;

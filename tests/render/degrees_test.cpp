@@ -123,15 +123,21 @@ TEST_CASE("Snell's law and total internal reflection") {
     CHECK(s.y == doctest::Approx(-1.0));
 }
 
-TEST_CASE("ray origin offset scales with the magnitude of the point") {
+TEST_CASE("ray origin offset scales with the magnitude of the point and of the ray origin") {
     const Vec3f n{0, 1, 0};
     for (float scale : {1e-4f, 1.f, 1e5f, 1e6f}) {
         CAPTURE(scale);
-        const Vec3f p{scale, scale, scale};
-        const Vec3f q = offset_ray_origin(p, n);
+        const Vec3f p{scale, 0.f, scale};  // on a y = 0 floor
+        const Vec3f eye{0.f, scale, 3 * scale};
+        const Vec3f q = offset_ray_origin(p, n, eye);
         CHECK(q.y > p.y);
         CHECK(q.x == p.x);
-        // At most a few hundred ulps of the coordinate, never a fixed epsilon.
-        CHECK((q.y - p.y) / std::max(scale, 1.f / 32) < 1e-3f);
+        // Scale-free: the same fraction of the scene at every scale, and at most a few
+        // hundred ulps of the largest coordinate (never a fixed epsilon).
+        CHECK((q.y - p.y) / (3 * scale) == doctest::Approx(1.0 / 131072));
+        const Vec3d qd = offset_ray_origin(Vec3d{scale, 0, scale}, Vec3d{0, 1, 0}, Vec3d{0, scale, 3.0 * scale});
+        CHECK(qd.y / (3.0 * scale) == doctest::Approx(1.0 / 68719476736.0));
     }
+    // A point at the exact origin still moves.
+    CHECK(offset_ray_origin(Vec3f{0, 0, 0}, n, Vec3f{0, 0, 0}).y > 0.f);
 }
