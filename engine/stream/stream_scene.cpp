@@ -18,7 +18,12 @@ StreamScene::StreamScene(const Scene& scene)
         const Object& o = scene.objects[i];
         ShadeObject so{};
         so.kind = o.kind;
-        so.param = float(o.minor);
+        so.param = float(o.param());
+        if (o.kind == ShapeKind::Mesh && o.mesh) {
+            so.mesh = &o.mesh->view();
+            meshes.push_back(o.mesh);
+            has_meshes = true;
+        }
         rows3x4(o.xf.mi, so.mi);
         rows3x4(o.xf.md, so.md);
         for (int r = 0; r < 3; ++r)
@@ -29,6 +34,7 @@ StreamScene::StreamScene(const Scene& scene)
         std::copy(std::begin(so.mi), std::end(so.mi), xf.m);
         xf.param = so.param;
         xf.id = std::int32_t(i);
+        xf.mesh = so.mesh;
         groups[int(o.kind)].push_back(xf);
         any_refl |= o.material.refl > 0;
         any_trans |= o.material.trans > 0;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kernels/kernel_table.h"
+#include "mesh/mesh.h"
 #include "render/camera_rays.h"
 #include "render/shading.h"
 #include "scene/scene.h"
@@ -37,6 +38,9 @@ struct StreamScene {
     /// The object hierarchy, when the scene is traced with one (stream/stream_accel.h); the
     /// intersect and occlusion stages then use it instead of `groups`.
     std::shared_ptr<const StreamAccel> accel;
+    /// The meshes the objects use (kept alive here: ShadeObject and ObjectXf point into them).
+    std::vector<std::shared_ptr<const Mesh>> meshes;
+    bool has_meshes = false;
 
     explicit StreamScene(const Scene& scene);
 };
