@@ -29,6 +29,7 @@ bool RecursiveRenderer::test_object(std::size_t i, const RayD& ray, double t_min
     const Vec3d oc = apply_point(ob.mi, ray.origin);
     const Vec3d dc = apply_vector(ob.mi, ray.dir);
     if (ob.kind == ShapeKind::Mesh) {
+        if (!ob.mesh) return false;
         // The mesh's own hierarchy, walked in its canonical space (t is the world ray's t).
         const double start = t_max;
         if (mesh_closest(ob.mesh->view(), ob.mesh->bvh, oc, dc, t_min, t_max, c.tri, c.u, c.v) && t_max < start) {
@@ -88,6 +89,7 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
     const auto blocks = [&](std::size_t i, double tm) {
         const PreparedObject& ob = objects_[i];
         if (ob.kind != ShapeKind::Mesh) return test_object(i, ray, 0.0, tm, o);
+        if (!ob.mesh) return false;
         return mesh_any(ob.mesh->view(), ob.mesh->bvh, apply_point(ob.mi, ray.origin), apply_vector(ob.mi, ray.dir),
                         0.0, tm);
     };
