@@ -161,7 +161,7 @@ TEST_CASE("meshes: triangle test basics, both faces, barycentrics, t range") {
     CHECK(triangle_hit(rf, Vec3f{0, 0, 0}, Vec3f{1, 0, 0}, Vec3f{0, 1, 0}, 0.f, 10.f).t == doctest::Approx(0.5f));
 }
 
-TEST_CASE("meshes: degenerate triangles are dropped; normals; memory") {
+TEST_CASE("meshes: degenerate triangles are dropped, normals, memory") {
     const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0};
     const auto m = Mesh::build("t", pos, {0, 1, 2, 0, 1, 3, 0, 0, 1, 0, 1, 7});
     CHECK(m->triangle_count() == 1);
@@ -279,7 +279,7 @@ TEST_CASE("meshes: tessellated spheres against the analytic sphere, silhouettes 
     CHECK(previous <= 8);
 }
 
-TEST_CASE("meshes: an OBJ file through the parser; both engines agree; errors carry file:line:col") {
+TEST_CASE("meshes: an OBJ file through the parser, both engines agree, errors carry file:line:col") {
     const fs::path dir = fs::temp_directory_path() / ("streamrt_mesh_test_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     REQUIRE(write_obj((dir / "ball.obj").string(), icosphere(2)));
