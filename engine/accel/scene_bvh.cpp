@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "mesh/mesh.h"
+
 #include "parallel/parallelism.h"
 
 namespace streamrt::accel {
@@ -28,6 +30,10 @@ bool object_world_bounds(const Object& o, double lo[3], double hi[3]) {
     // The canonical box through Md: centre +- |M| half-extent (the box of the 8 corners).
     double c[3] = {0, 0, 0}, e[3] = {1, 1, 1};
     if (o.kind == ShapeKind::Torus) e[0] = e[2] = 1 + o.minor, e[1] = o.minor;
+    if (o.kind == ShapeKind::Mesh) {
+        if (!o.mesh || o.mesh->triangle_count() == 0) return false;
+        for (int a = 0; a < 3; ++a) c[a] = 0.5 * (o.mesh->lo[a] + o.mesh->hi[a]), e[a] = 0.5 * (o.mesh->hi[a] - o.mesh->lo[a]);
+    }
     for (int a = 0; a < 3; ++a) {
         double mid = m[3][a], ext = 0;
         for (int k = 0; k < 3; ++k) {

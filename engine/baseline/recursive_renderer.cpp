@@ -4,6 +4,7 @@
 
 #include "render/sampling.h"
 #include "shapes/shapes.h"
+#include "shapes/triangle_math.h"
 
 namespace streamrt {
 
@@ -16,24 +17,35 @@ inline Vec3d apply_vector(const glm::dmat4& m, const Vec3d& v) { return to_vec(t
 RecursiveRenderer::RecursiveRenderer(const Scene& scene)
     : scene_(scene), bvh_(accel::SceneBvh::build_for(scene)), camera_(CameraRays<double>::from(scene)) {
     for (const Object& o : scene.objects) {
-        objects_.push_back({o.kind, o.minor, o.xf.mi, o.xf.md, o.xf.mn});
+        objects_.push_back({o.kind, o.param(), o.xf.mi, o.xf.md, o.xf.mn, o.mesh.get()});
         materials_.push_back(MaterialT<double>::from(o.material));
     }
     for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(l));
 }
 
-bool RecursiveRenderer::test_object(std::size_t i, const RayD& ray, double t_min, double& t_max, Vec3d& o,
-                                    Vec3d& d) const {
+bool RecursiveRenderer::test_object(std::size_t i, const RayD& ray, double t_min, double& t_max,
+                                    Candidate& c) const {
     const PreparedObject& ob = objects_[i];
     const Vec3d oc = apply_point(ob.mi, ray.origin);
     const Vec3d dc = apply_vector(ob.mi, ray.dir);
+    if (ob.kind == ShapeKind::Mesh) {
+        if (!ob.mesh) return false;
+        // The mesh's own hierarchy, walked in its canonical space (t is the world ray's t).
+        const double start = t_max;
+        if (mesh_closest(ob.mesh->view(), ob.mesh->bvh, oc, dc, t_min, t_max, c.tri, c.u, c.v) && t_max < start) {
+            c.o = oc;
+            c.d = dc;
+            return true;
+        }
+        return false;
+    }
     const double t = visit_shape(ob.kind, [&](auto shape) {
         return shape.template hit_t<double>(oc, dc, ob.param, t_min, t_max);
     });
     if (!(t < t_max)) return false;
     t_max = t;
-    o = oc;
-    d = dc;
+    c.o = oc;
+    c.d = dc;
     return true;
 }
 
@@ -43,25 +55,27 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
     // object and the closest hit is a plain comparison of t.
     int best = -1;
     double best_t = t_max;
-    Vec3d best_o{}, best_d{};
+    Candidate cand;
     if (bvh_) {
         for (std::uint32_t i : bvh_->unbounded)
-            if (test_object(i, ray, t_min, best_t, best_o, best_d)) best = int(i);
+            if (test_object(i, ray, t_min, best_t, cand)) best = int(i);
         const accel::Bvh& h = bvh_->bvh;
         accel::traverse_closest<double>(h, ray.origin, ray.dir, best_t,
                                         [&](std::uint32_t first, std::uint32_t count, double& tm) {
                                             for (std::uint32_t k = first; k < first + count; ++k)
-                                                if (test_object(h.prim_index[k], ray, t_min, tm, best_o, best_d))
+                                                if (test_object(h.prim_index[k], ray, t_min, tm, cand))
                                                     best = int(h.prim_index[k]);
                                         });
     } else {
         for (std::size_t i = 0; i < objects_.size(); ++i)
-            if (test_object(i, ray, t_min, best_t, best_o, best_d)) best = int(i);
+            if (test_object(i, ray, t_min, best_t, cand)) best = int(i);
     }
     if (best < 0) return false;
     const PreparedObject& ob = objects_[std::size_t(best)];
-    const Vec3d pc = best_o + best_d * best_t;
-    const Vec3d nc = visit_shape(ob.kind, [&](auto shape) { return shape.template normal<double>(pc, ob.param); });
+    const Vec3d pc = cand.o + cand.d * best_t;
+    const Vec3d nc = ob.kind == ShapeKind::Mesh
+                         ? mesh_normal<double>(ob.mesh->view(), cand.tri, cand.u, cand.v, ob.param != 0.0)
+                         : visit_shape(ob.kind, [&](auto shape) { return shape.template normal<double>(pc, ob.param); });
     hit.object = best;
     hit.t = best_t;
     hit.point = apply_point(ob.md, pc);
@@ -70,26 +84,29 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
 }
 
 bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
-    Vec3d o, d;
+    Candidate o;
+    // Meshes answer with an any-hit walk of their own hierarchy.
+    const auto blocks = [&](std::size_t i, double tm) {
+        const PreparedObject& ob = objects_[i];
+        if (ob.kind != ShapeKind::Mesh) return test_object(i, ray, 0.0, tm, o);
+        if (!ob.mesh) return false;
+        return mesh_any(ob.mesh->view(), ob.mesh->bvh, apply_point(ob.mi, ray.origin), apply_vector(ob.mi, ray.dir),
+                        0.0, tm);
+    };
     if (bvh_) {
         for (std::uint32_t i : bvh_->unbounded) {
-            double tm = t_max;
-            if (test_object(i, ray, 0.0, tm, o, d)) return true;
+            if (blocks(i, t_max)) return true;
         }
         const accel::Bvh& h = bvh_->bvh;
         return accel::traverse_any<double>(h, ray.origin, ray.dir, t_max,
                                            [&](std::uint32_t first, std::uint32_t count, double tm) {
-                                               for (std::uint32_t k = first; k < first + count; ++k) {
-                                                   double t = tm;
-                                                   if (test_object(h.prim_index[k], ray, 0.0, t, o, d)) return true;
-                                               }
+                                               for (std::uint32_t k = first; k < first + count; ++k)
+                                                   if (blocks(h.prim_index[k], tm)) return true;
                                                return false;
                                            });
     }
-    for (std::size_t i = 0; i < objects_.size(); ++i) {
-        double tm = t_max;
-        if (test_object(i, ray, 0.0, tm, o, d)) return true;
-    }
+    for (std::size_t i = 0; i < objects_.size(); ++i)
+        if (blocks(i, t_max)) return true;
     return false;
 }
 

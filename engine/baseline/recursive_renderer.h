@@ -13,6 +13,7 @@
 #include "render/camera_rays.h"
 #include "render/render_stats.h"
 #include "render/shading.h"
+#include "mesh/mesh_trace.h"
 #include "scene/scene.h"
 
 namespace streamrt {
@@ -55,9 +56,17 @@ class RecursiveRenderer {
         double param;
         glm::dmat4 mi, md;
         glm::dmat3 mn;
+        const Mesh* mesh;  ///< Mesh only
+    };
+    /// What a closer hit leaves behind: the canonical ray, and for a mesh the triangle and
+    /// its barycentric coordinates.
+    struct Candidate {
+        Vec3d o, d;
+        std::uint32_t tri = 0;
+        double u = 0, v = 0;
     };
     /// Tests object i in its canonical space; shrinks t_max and records it on a closer hit.
-    bool test_object(std::size_t i, const RayD& ray, double t_min, double& t_max, Vec3d& o, Vec3d& d) const;
+    bool test_object(std::size_t i, const RayD& ray, double t_min, double& t_max, Candidate& c) const;
     const Scene& scene_;
     std::unique_ptr<accel::SceneBvh> bvh_;  ///< null: the handout's loop over all objects
     CameraRays<double> camera_;

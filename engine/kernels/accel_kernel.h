@@ -84,7 +84,52 @@ inline void with_shape(std::uint32_t kind, F&& f) {
         case ShapeKind::Cone: f(ConeMath{}); break;
         case ShapeKind::Torus: f(TorusMath{}); break;
         case ShapeKind::Plane: f(PlaneMath{}); break;
+        case ShapeKind::Mesh: break;  // not closed-form: the leaf loops call the mesh walk instead
     }
+}
+
+/// A mesh object in a leaf: the packet at `base` into the mesh's canonical space, then its
+/// own hierarchy. Shrinks best (and writes the mesh hit of the lanes it shrank).
+template <class Arch>
+inline void mesh_leaf_closest(const RayView& rays, std::size_t base, const ObjectXf& ob,
+                              xsimd::batch<float, Arch>& best) {
+    using B = xsimd::batch<float, Arch>;
+    const RayPacket<B> r{{B::load_aligned(rays.ox + base), B::load_aligned(rays.oy + base), B::load_aligned(rays.oz + base)},
+                         {B::load_aligned(rays.dx + base), B::load_aligned(rays.dy + base), B::load_aligned(rays.dz + base)}};
+    const RayPacket<B> c = to_canonical<B, float>(r, ob);
+    mesh_closest_packet(*ob.mesh, c.o, c.d, best, rays.prim ? rays.prim + base : nullptr,
+                        rays.bu ? rays.bu + base : nullptr, rays.bv ? rays.bv + base : nullptr);
+}
+
+/// The same for one ray broadcast into a packet (single-ray traversal): lane 0's result,
+/// written at index i of the mesh-hit arrays.
+template <class Arch>
+inline float mesh_single_closest(const RayView& rays, std::size_t i, const Vec3f& o, const Vec3f& d, const ObjectXf& ob,
+                                 float t_max) {
+    using B = xsimd::batch<float, Arch>;
+    constexpr std::size_t W = B::size;
+    const RayPacket<B> r{{B(o.x), B(o.y), B(o.z)}, {B(d.x), B(d.y), B(d.z)}};
+    const RayPacket<B> c = to_canonical<B, float>(r, ob);
+    B best(t_max);
+    alignas(64) std::int32_t p[W];
+    alignas(64) float u[W], v[W];
+    mesh_closest_packet(*ob.mesh, c.o, c.d, best, p, u, v);
+    const float t = best.get(0);
+    if (t < t_max && rays.prim) {
+        rays.prim[i] = p[0];
+        rays.bu[i] = u[0];
+        rays.bv[i] = v[0];
+    }
+    return t < t_max ? t : kInfF;
+}
+
+template <class Arch>
+inline bool mesh_single_any(const Vec3f& o, const Vec3f& d, const ObjectXf& ob, float t_max) {
+    using B = xsimd::batch<float, Arch>;
+    const RayPacket<B> r{{B(o.x), B(o.y), B(o.z)}, {B(d.x), B(d.y), B(d.z)}};
+    const RayPacket<B> c = to_canonical<B, float>(r, ob);
+    const B tm(t_max);
+    return xsimd::any(mesh_any_packet(*ob.mesh, c.o, c.d, tm, tm > B(0.f)));
 }
 
 /// Nearest hit t in (0, t_max) of the rays at `base` (W lanes, in memory) with one object, in
@@ -157,6 +202,12 @@ void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count; ++k) {
                     const AccelObject& ob = bvh.prims[k];
+                    if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
+                        const B before = best;
+                        mesh_leaf_closest<Arch>(rays, i, ob.xf, best);
+                        best_id = xsimd::select(best < before, B(float(ob.xf.id)), best_id);
+                        continue;
+                    }
                     with_shape(ob.kind, [&](auto shape) {
                         const B t = object_t<Arch, decltype(shape)>(rays, i, ob.xf, best);
                         const auto closer = t < best;
@@ -214,6 +265,16 @@ void bvh_any_packet(const AccelView& bvh, RayView rays) {
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count && xsimd::any(open); ++k) {
                     const AccelObject& ob = bvh.prims[k];
+                    if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
+                        const RayPacket<B> r{{B::load_aligned(rays.ox + i), B::load_aligned(rays.oy + i),
+                                              B::load_aligned(rays.oz + i)},
+                                             {B::load_aligned(rays.dx + i), B::load_aligned(rays.dy + i),
+                                              B::load_aligned(rays.dz + i)}};
+                        const RayPacket<B> c = to_canonical<B, float>(r, ob.xf);
+                        open = open && !mesh_any_packet(*ob.xf.mesh, c.o, c.d, t_max, open);
+                        t_max = xsimd::select(open, t_max, B(0.f));
+                        continue;
+                    }
                     with_shape(ob.kind, [&](auto shape) {
                         const B t = object_t<Arch, decltype(shape)>(rays, i, ob.xf, t_max);
                         open = open && !(t < t_max);
@@ -279,6 +340,14 @@ void bvh_closest_single(const AccelView& bvh, RayView rays, std::int32_t* object
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count; ++k) {
                     const AccelObject& ob = bvh.prims[k];
+                    if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
+                        const float t = mesh_single_closest<Arch>(rays, i, o, d, ob.xf, best);
+                        if (t < best) {
+                            best = t;
+                            best_id = ob.xf.id;
+                        }
+                        continue;
+                    }
                     with_shape(ob.kind, [&](auto shape) {
                         const float t = object_t_single<Arch, decltype(shape)>(o, d, ob.xf, best);
                         if (t < best) {
@@ -318,6 +387,10 @@ void bvh_any_single(const AccelView& bvh, RayView rays) {
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count && !blocked; ++k) {
                     const AccelObject& ob = bvh.prims[k];
+                    if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
+                        blocked = mesh_single_any<Arch>(o, d, ob.xf, t_max);
+                        continue;
+                    }
                     with_shape(ob.kind, [&](auto shape) {
                         blocked = object_t_single<Arch, decltype(shape)>(o, d, ob.xf, t_max) < t_max;
                     });

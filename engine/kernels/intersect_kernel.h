@@ -8,6 +8,7 @@
 
 #include "kernels/generate_kernel.h"
 #include "kernels/kernel_table.h"
+#include "kernels/mesh_kernel.h"
 #include "kernels/shade_kernel.h"
 #include "shapes/shapes.h"
 
@@ -142,6 +143,74 @@ void any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
     any_hit_impl<Arch, Shape>(rays, objs, nullptr, n_objs);
 }
 
+/// Closest hit against mesh objects: each packet, brought into a mesh's canonical space by
+/// its Mi like the canonical shapes, walks that mesh's own hierarchy (kernels/mesh_kernel.h).
+template <class Arch>
+void mesh_closest_hit(RayView rays, std::int32_t* object, const ObjectXf* objs, std::size_t n_objs) {
+    using B = xsimd::batch<float, Arch>;
+    constexpr std::size_t W = B::size;
+    for (std::size_t i = 0; i < rays.count; i += W) {
+        const RayPacket<B> r{{B::load_aligned(rays.ox + i), B::load_aligned(rays.oy + i), B::load_aligned(rays.oz + i)},
+                             {B::load_aligned(rays.dx + i), B::load_aligned(rays.dy + i), B::load_aligned(rays.dz + i)}};
+        B best = B::load_aligned(rays.t_max + i);
+        const B start = best;
+        B best_id(-1.f);
+        for (std::size_t k = 0; k < n_objs; ++k) {
+            if (!objs[k].mesh) continue;
+            const RayPacket<B> c = to_canonical<B, float>(r, objs[k]);
+            const B before = best;
+            mesh_closest_packet(*objs[k].mesh, c.o, c.d, best, rays.prim ? rays.prim + i : nullptr,
+                                rays.bu ? rays.bu + i : nullptr, rays.bv ? rays.bv + i : nullptr);
+            best_id = xsimd::select(best < before, B(float(objs[k].id)), best_id);
+        }
+        if (!xsimd::any(best < start)) continue;
+        alignas(64) float t_out[W], id_out[W];
+        best.store_aligned(t_out);
+        best_id.store_aligned(id_out);
+        for (std::size_t l = 0; l < W && i + l < rays.count; ++l) {
+            if (id_out[l] >= 0.f) {
+                rays.t_max[i + l] = t_out[l];
+                object[i + l] = static_cast<std::int32_t>(id_out[l]);
+            }
+        }
+    }
+}
+
+/// Any hit against mesh objects (shadow rays): t_max = 0 for blocked rays.
+template <class Arch>
+void mesh_any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
+    using B = xsimd::batch<float, Arch>;
+    constexpr std::size_t W = B::size;
+    for (std::size_t i = 0; i < rays.count; i += W) {
+        B t_max = B::load_aligned(rays.t_max + i);
+        auto open = t_max > B(0.f);
+        if (!xsimd::any(open)) continue;
+        const RayPacket<B> r{{B::load_aligned(rays.ox + i), B::load_aligned(rays.oy + i), B::load_aligned(rays.oz + i)},
+                             {B::load_aligned(rays.dx + i), B::load_aligned(rays.dy + i), B::load_aligned(rays.dz + i)}};
+        for (std::size_t k = 0; k < n_objs && xsimd::any(open); ++k) {
+            if (!objs[k].mesh) continue;
+            const RayPacket<B> c = to_canonical<B, float>(r, objs[k]);
+            open = open && !mesh_any_packet(*objs[k].mesh, c.o, c.d, t_max, open);
+            t_max = xsimd::select(open, t_max, B(0.f));
+        }
+        alignas(64) float out[W];
+        t_max.store_aligned(out);
+        for (std::size_t l = 0; l < W && i + l < rays.count; ++l)
+            if (out[l] <= 0.f) rays.t_max[i + l] = 0.f;
+    }
+}
+
+/// Meshes walk their own hierarchy; the per-object box adds nothing to that.
+template <class Arch>
+void mesh_closest_culled(RayView rays, std::int32_t* object, const ObjectXf* objs, const ObjectBounds*,
+                         std::size_t n_objs) {
+    mesh_closest_hit<Arch>(rays, object, objs, n_objs);
+}
+template <class Arch>
+void mesh_any_culled(RayView rays, const ObjectXf* objs, const ObjectBounds*, std::size_t n_objs) {
+    mesh_any_hit<Arch>(rays, objs, n_objs);
+}
+
 #define SHADE_VARIANT(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8)>
 template <class Arch>
 KernelTable make_table(Isa isa, const char* name) {
@@ -149,14 +218,18 @@ KernelTable make_table(Isa isa, const char* name) {
                        name,
                        int(xsimd::batch<float, Arch>::size),
                        {&closest_hit<Arch, SphereMath>, &closest_hit<Arch, CubeMath>, &closest_hit<Arch, CylinderMath>,
-                        &closest_hit<Arch, ConeMath>, &closest_hit<Arch, TorusMath>, &closest_hit<Arch, PlaneMath>},
+                        &closest_hit<Arch, ConeMath>, &closest_hit<Arch, TorusMath>, &closest_hit<Arch, PlaneMath>,
+                        &mesh_closest_hit<Arch>},
                        {&any_hit<Arch, SphereMath>, &any_hit<Arch, CubeMath>, &any_hit<Arch, CylinderMath>,
-                        &any_hit<Arch, ConeMath>, &any_hit<Arch, TorusMath>, &any_hit<Arch, PlaneMath>},
+                        &any_hit<Arch, ConeMath>, &any_hit<Arch, TorusMath>, &any_hit<Arch, PlaneMath>,
+                        &mesh_any_hit<Arch>},
                        {&closest_hit_impl<Arch, SphereMath>, &closest_hit_impl<Arch, CubeMath>,
                         &closest_hit_impl<Arch, CylinderMath>, &closest_hit_impl<Arch, ConeMath>,
-                        &closest_hit_impl<Arch, TorusMath>, &closest_hit_impl<Arch, PlaneMath>},
+                        &closest_hit_impl<Arch, TorusMath>, &closest_hit_impl<Arch, PlaneMath>,
+                        &mesh_closest_culled<Arch>},
                        {&any_hit_impl<Arch, SphereMath>, &any_hit_impl<Arch, CubeMath>, &any_hit_impl<Arch, CylinderMath>,
-                        &any_hit_impl<Arch, ConeMath>, &any_hit_impl<Arch, TorusMath>, &any_hit_impl<Arch, PlaneMath>},
+                        &any_hit_impl<Arch, ConeMath>, &any_hit_impl<Arch, TorusMath>, &any_hit_impl<Arch, PlaneMath>,
+                        &mesh_any_culled<Arch>},
                        {SHADE_VARIANT(0), SHADE_VARIANT(1), SHADE_VARIANT(2), SHADE_VARIANT(3), SHADE_VARIANT(4),
                         SHADE_VARIANT(5), SHADE_VARIANT(6), SHADE_VARIANT(7), SHADE_VARIANT(8), SHADE_VARIANT(9),
                         SHADE_VARIANT(10), SHADE_VARIANT(11), SHADE_VARIANT(12), SHADE_VARIANT(13), SHADE_VARIANT(14),

@@ -8,17 +8,20 @@
 #include <vector>
 
 #include "kernels/shade_job.h"
+#include "mesh/mesh_view.h"
 #include "scene/scene.h"
 #include "stream/ray_stream.h"
 
 namespace streamrt {
 
 /// One object as the kernels see it: Mi's top three rows (world -> canonical), broadcast
-/// into every lane, the shape parameter (torus minor radius) and the scene object index.
+/// into every lane, the shape parameter (torus minor radius; 1 for a smooth mesh), the scene
+/// object index, and for a mesh its triangles and hierarchy.
 struct ObjectXf {
     float m[12];  ///< row-major 3x4
     float param;
     std::int32_t id;
+    const MeshView* mesh = nullptr;  ///< ShapeKind::Mesh only
 };
 
 /// An object's world-space bounding box, padded outwards; the flat kernels skip an object
@@ -28,7 +31,9 @@ struct ObjectBounds {
 };
 
 /// Closest hit: for each ray, shrinks t_max to the nearest hit among objs and writes that
-/// object's id into object[]. Rays that hit nothing keep t_max and object untouched.
+/// object's id into object[]. Rays that hit nothing keep t_max and object untouched. Mesh
+/// kernels also write the triangle and its barycentrics into rays.prim/bu/bv (when given)
+/// whenever they find a closer hit, so those hold the winning mesh hit's values.
 using ClosestHitFn = void (*)(RayView rays, std::int32_t* object, const ObjectXf* objs, std::size_t n_objs);
 /// Any hit (shadow rays): sets t_max to 0 for every ray blocked by one of objs; packets whose
 /// rays are all blocked already are skipped.

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "mesh/mesh_view.h"
 #include "render/shading.h"
 #include "scene/scene.h"
 
@@ -13,10 +14,11 @@ namespace streamrt {
 /// What shading needs of one object, beside the kernels' ObjectXf.
 struct ShadeObject {
     ShapeKind kind;
-    float param;
+    float param;  ///< torus minor radius; mesh: 1 smooth, 0 flat
     float mi[12];  ///< world -> canonical, row-major 3x4 (to rebuild the canonical hit point)
     float md[12];  ///< canonical -> world
     float mn[9];   ///< normals, row-major 3x3
+    const MeshView* mesh = nullptr;  ///< ShapeKind::Mesh only
 };
 
 
@@ -54,6 +56,10 @@ struct ShadeJob {
     // ... and the rays it spawns.
     RayAppend next;
     ShadowAppend shadows;
+    // Mesh objects only: the hit triangle and its barycentrics per ray (same indexing).
+    const std::int32_t* prim = nullptr;
+    const float* bu = nullptr;
+    const float* bv = nullptr;
 };
 
 /// Camera rays for one chunk. Per ray (arrays padded to whole packets): the pixel's corner

@@ -44,8 +44,43 @@ inline Vec3T<B> canonical_normal(ShapeKind kind, const Vec3T<B>& p, const B& par
         case ShapeKind::Cone: return ConeMath::normal<B>(p, param);
         case ShapeKind::Torus: return TorusMath::normal<B>(p, param);
         case ShapeKind::Plane: break;
+        case ShapeKind::Mesh: break;  // mesh_normals() below
     }
     return PlaneMath::normal<B>(p, param);
+}
+
+/// Canonical normals of a mesh's hits, gathered lane by lane from the hit triangles: the face
+/// normal, or the vertex normals interpolated at the barycentrics (mesh/mesh_trace.h's
+/// mesh_normal, the same float expressions). Lanes past the run get +z.
+template <class B>
+inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
+    constexpr std::size_t W = B::size;
+    const MeshView& m = *job.object->mesh;
+    const bool smooth = job.object->param != 0.f;
+    alignas(64) float nx[W], ny[W], nz[W];
+    for (std::size_t l = 0; l < W; ++l) {
+        nx[l] = ny[l] = 0.f;
+        nz[l] = 1.f;
+        if (i + l >= job.end) continue;
+        const std::size_t k = std::size_t(job.prim[i + l]);
+        if (!smooth) {
+            const float* p = m.tri + 9 * k;
+            const float e1x = p[3] - p[0], e1y = p[4] - p[1], e1z = p[5] - p[2];
+            const float e2x = p[6] - p[0], e2y = p[7] - p[1], e2z = p[8] - p[2];
+            nx[l] = e1y * e2z - e1z * e2y;
+            ny[l] = e1z * e2x - e1x * e2z;
+            nz[l] = e1x * e2y - e1y * e2x;
+        } else {
+            const float u = job.bu[i + l], v = job.bv[i + l], w = 1.f - u - v;
+            const float* n0 = m.vertex_normals + 3 * std::size_t(m.index[3 * k]);
+            const float* n1 = m.vertex_normals + 3 * std::size_t(m.index[3 * k + 1]);
+            const float* n2 = m.vertex_normals + 3 * std::size_t(m.index[3 * k + 2]);
+            nx[l] = n0[0] * w + n1[0] * u + n2[0] * v;
+            ny[l] = n0[1] * w + n1[1] * u + n2[1] * v;
+            nz[l] = n0[2] * w + n1[2] * u + n2[2] * v;
+        }
+    }
+    return {B::load_aligned(nx), B::load_aligned(ny), B::load_aligned(nz)};
 }
 
 /// Appends the active lanes' rays to the next generation's stream, compacted.
@@ -103,7 +138,9 @@ void shade_run(const ShadeJob& job) {
         const B cone = cone_in + B(job.spread) * t;
         ColorT<B> base;
         Vec3T<B> n_out;
-        if (kLit || m.checker) n_out = apply_normal(ob.mn, canonical_normal(ob.kind, pc, B(ob.param)));
+        if (kLit || m.checker)
+            n_out = apply_normal(ob.mn, ob.kind == ShapeKind::Mesh ? mesh_normals<B>(job, i)
+                                                                    : canonical_normal(ob.kind, pc, B(ob.param)));
         if (m.checker) base = surface_color(m, p, n_out, footprint_width(cone_in, B(job.spread), t, dot(d, n_out)));
         else base = splat<B>(m.color);
         ColorT<B> local;

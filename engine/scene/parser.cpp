@@ -3,6 +3,8 @@
 // the offending token (the key, the value or the statement word).
 #include "scene/parser.h"
 
+#include "mesh/mesh.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -13,6 +15,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -369,6 +372,7 @@ class Parser {
   private:
     std::map<std::string, Material, std::less<>> materials_;
     std::vector<fs::path> open_;  // the include chain being read
+    std::map<fs::path, std::shared_ptr<const Mesh>> meshes_;  // by file identity: loaded once, shared
     int files_ = 0;
 
     void statement(std::string_view line, const std::string& file, int line_no, int depth) {
@@ -383,11 +387,12 @@ class Parser {
         else if (w == "light") light(st, toks);
         else if (w == "material") material(st, toks);
         else if (w == "include") include(st, toks, depth);
+        else if (w == "mesh") shape(st, toks, ShapeKind::Mesh);
         else if (auto kind = shape_from_word(w)) shape(st, toks, *kind);
         else
             st.fail_here("unknown statement " + quote(w) +
                          " (expected image, ambient, background, camera, light, material, "
-                         "sphere, cube, cylinder, cone, torus, plane or include)");
+                         "sphere, cube, cylinder, cone, torus, plane, mesh or include)");
     }
 
     /// The single positional value of `ambient`, `background` and `include`.
@@ -554,6 +559,7 @@ class Parser {
     void shape(Statement& st, const std::vector<Token>& toks, ShapeKind kind) {
         std::vector<std::string_view> keys = join({{"material"}, kMaterialKeys, kTransformKeys});
         if (kind == ShapeKind::Torus) keys.push_back("minor");
+        if (kind == ShapeKind::Mesh) keys.insert(keys.end(), {"file", "smooth"});
         st.read_args(toks, 1, keys);
         Object obj;
         obj.kind = kind;
@@ -565,12 +571,36 @@ class Parser {
             if (apply_material_key(st, a, obj.material)) continue;
             if (apply_transform_key(st, a, md)) continue;
             if (a.key == "minor") obj.minor = st.positive(a);
+            else if (a.key == "smooth") {
+                if (a.value == "true") obj.smooth = true;
+                else if (a.value == "false") obj.smooth = false;
+                else st.fail(a.value_col, "expected true or false for 'smooth', got " + quote(a.value));
+            } else if (a.key == "file") obj.mesh = mesh_file(st, a);
         }
+        if (kind == ShapeKind::Mesh && !obj.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
         if (singular(md))
             st.fail_here(std::string(st.word()) +
                          ": the composed transform is singular (or not finite)");
         obj.xf = Transform::from_direct(md);
         scene.objects.push_back(obj);
+    }
+
+    /// The mesh of an OBJ file named relative to the statement's file, read once per file.
+    std::shared_ptr<const Mesh> mesh_file(const Statement& st, const Arg& a) {
+        const fs::path base = fs::path(st.file()).parent_path();
+        const fs::path target = (base / fs::path(std::string(a.value))).lexically_normal();
+        const fs::path id = identity_of(target);
+        if (const auto it = meshes_.find(id); it != meshes_.end()) return it->second;
+        std::error_code ec;
+        if (!fs::is_regular_file(target, ec))
+            st.fail(a.value_col, "cannot open mesh file " + quote(target.string()));
+        try {
+            auto mesh = load_obj_mesh(target.string());
+            meshes_.emplace(id, mesh);
+            return mesh;
+        } catch (const std::exception& e) {
+            st.fail(a.value_col, quote(target.string()) + ": " + e.what());
+        }
     }
 
     void include(Statement& st, const std::vector<Token>& toks, int depth) {

@@ -10,6 +10,7 @@ const char* shape_kind_name(ShapeKind k) {
         case ShapeKind::Cone: return "cone";
         case ShapeKind::Torus: return "torus";
         case ShapeKind::Plane: return "plane";
+        case ShapeKind::Mesh: return "mesh";
     }
     return "?";
 }

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,8 @@
 #include "core/transform.h"
 
 namespace streamrt {
+
+struct Mesh;
 
 /// Canonical shapes (docs/scene-format.md gives each exact definition).
 enum class ShapeKind : std::uint8_t {
@@ -22,8 +25,9 @@ enum class ShapeKind : std::uint8_t {
     Cone,      ///< base radius 1 at y=-1, apex at y=+1, base capped
     Torus,     ///< major radius 1 around the y axis in the xz-plane, minor radius per object
     Plane,     ///< y = 0, normal +y, infinite
+    Mesh,      ///< a triangle mesh in its own coordinates (engine/mesh/mesh.h); not closed-form
 };
-inline constexpr int kShapeKindCount = 6;
+inline constexpr int kShapeKindCount = 7;
 const char* shape_kind_name(ShapeKind k);
 
 struct Material {
@@ -43,9 +47,15 @@ struct Material {
 struct Object {
     ShapeKind kind = ShapeKind::Sphere;
     double minor = 0.25;  ///< torus minor radius (canonical units); unused by other shapes
+    std::shared_ptr<const Mesh> mesh;  ///< Mesh only: the triangles, shared by every object using the file
+    bool smooth = false;  ///< Mesh only: interpolated vertex normals instead of the flat face normal
     Material material;
     Transform xf;  ///< Md, Mi, Mn
     SourceLoc where;  ///< the statement that made it, for messages
+
+    /// The per-object shape parameter the kernels and shading receive: the torus minor
+    /// radius, 1 for a smooth mesh, 0 for a flat one.
+    double param() const { return kind == ShapeKind::Mesh ? (smooth ? 1.0 : 0.0) : minor; }
 };
 
 enum class LightKind : std::uint8_t { Point, Spot, Directional };

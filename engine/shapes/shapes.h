@@ -25,7 +25,9 @@ struct TorusMath {
     static Vec3T<V> normal(const Vec3T<V>& p, V minor) { return torus_normal(p, minor); }
 };
 
-/// Calls f(XxxMath{}) for the shape kind k.
+/// Calls f(XxxMath{}) for the shape kind k. Meshes are not closed-form shapes: callers handle
+/// ShapeKind::Mesh before (mesh/mesh_trace.h, kernels/mesh_kernel.h); here it falls through
+/// to the plane so that every call still compiles to a total switch.
 template <class F>
 decltype(auto) visit_shape(ShapeKind k, F&& f) {
     switch (k) {
@@ -35,6 +37,7 @@ decltype(auto) visit_shape(ShapeKind k, F&& f) {
         case ShapeKind::Cone: return f(ConeMath{});
         case ShapeKind::Torus: return f(TorusMath{});
         case ShapeKind::Plane: break;
+        case ShapeKind::Mesh: break;
     }
     return f(PlaneMath{});
 }

@@ -92,6 +92,12 @@ struct RayView {
     std::size_t count;
     const float *ox, *oy, *oz, *dx, *dy, *dz;
     float* t_max;  ///< closest-hit kernels shrink it to the best t; any-hit kernels set 0 on occlusion
+    // Mesh hits (closest hit only; nullptr when not wanted): triangle number and barycentric
+    // coordinates (weights of its second and third vertices), meaningful for rays whose
+    // closest object is a mesh.
+    std::int32_t* prim = nullptr;
+    float* bu = nullptr;
+    float* bv = nullptr;
 };
 
 inline RayView view_of(RayStream& r) {

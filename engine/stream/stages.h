@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "kernels/kernel_table.h"
+#include "mesh/mesh_trace.h"
 #include "parallel/parallelism.h"
 #include "render/render_stats.h"
 #include "render/sampling.h"
@@ -21,15 +22,29 @@ namespace streamrt {
 /// shade kernel shares one object: its transforms and material are broadcast, not gathered.
 struct SortedHits {
     std::size_t count = 0;
-    AlignedVec<float> ox, oy, oz, dx, dy, dz, t, wr, wg, wb, cone, lr, lg, lb;
-    AlignedVec<std::int32_t> pixel;
+    AlignedVec<float> ox, oy, oz, dx, dy, dz, t, wr, wg, wb, cone, lr, lg, lb, bu, bv;
+    AlignedVec<std::int32_t> pixel, prim;
     std::vector<std::uint32_t> run_start;  ///< per object, then one past the end
     void reserve(std::size_t n) {
         // Kernels read a whole packet past the last ray of a run.
         const std::size_t cap = simd::round_up_lanes(n) + simd::kMaxLanes;
         if (ox.size() < cap) {
-            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t, &wr, &wg, &wb, &cone, &lr, &lg, &lb}) a->resize(cap);
+            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t, &wr, &wg, &wb, &cone, &lr, &lg, &lb, &bu, &bv}) a->resize(cap);
             pixel.resize(cap);
+            prim.resize(cap);
+        }
+    }
+};
+
+/// Per ray, the triangle a mesh hit landed on and its barycentrics (read for mesh objects only).
+struct MeshHits {
+    AlignedVec<std::int32_t> prim;
+    AlignedVec<float> u, v;
+    void reserve(std::size_t cap) {
+        if (prim.size() < cap) {
+            prim.resize(cap);
+            u.resize(cap);
+            v.resize(cap);
         }
     }
 };
@@ -53,6 +68,7 @@ struct Workspace {
     GenerateScratch generate;
     RayStream current, next;
     AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of `current`
+    MeshHits mesh_hits;               ///< triangle and barycentrics per ray of `current` (mesh hits)
     ShadowStream shadows;
     SortedHits sorted;
     std::vector<std::uint32_t> slot;
@@ -151,12 +167,19 @@ struct PipelineStages {
 
     /// intersect: closest hit of every ray, one SIMD kernel per shape kind present.
     static void intersect(const StreamScene& sc, const KernelTable& kt, RayStream& rays,
-                          AlignedVec<std::int32_t>& object, StageFigures* fig) {
+                          AlignedVec<std::int32_t>& object, MeshHits& mesh_hits, StageFigures* fig) {
         rays.pad_tail();
         if (object.size() < rays.capacity()) object.resize(rays.capacity());
         std::fill_n(object.begin(), rays.count, -1);
+        RayView view = view_of(rays);
+        if (sc.has_meshes) {  // mesh kernels report the triangle and barycentrics here
+            mesh_hits.reserve(rays.capacity());
+            view.prim = mesh_hits.prim.data();
+            view.bu = mesh_hits.u.data();
+            view.bv = mesh_hits.v.data();
+        }
         if (sc.accel) {  // the object hierarchy (stream/stream_accel.h)
-            sc.accel->closest(kt, view_of(rays), object.data(), rays.count > 0 && rays.kind[0] == std::uint8_t(RayKind::Primary));
+            sc.accel->closest(kt, view, object.data(), rays.count > 0 && rays.kind[0] == std::uint8_t(RayKind::Primary));
             if (fig) fig->lanes_used += rays.count, fig->lanes_total += rays.count;
             return;
         }
@@ -164,9 +187,9 @@ struct PipelineStages {
             const auto& group = sc.groups[k];
             if (group.empty()) continue;
             if (sc.group_bounded[k])
-                kt.closest_culled[k](view_of(rays), object.data(), group.data(), sc.group_bounds[k].data(), group.size());
+                kt.closest_culled[k](view, object.data(), group.data(), sc.group_bounds[k].data(), group.size());
             else
-                kt.closest[k](view_of(rays), object.data(), group.data(), group.size());
+                kt.closest[k](view, object.data(), group.data(), group.size());
             if (fig) {
                 fig->lanes_used += rays.count;
                 fig->lanes_total += stage_detail::lanes_for(rays.count, k == int(ShapeKind::Torus) ? kt.float_lanes / 2 : kt.float_lanes);
@@ -177,8 +200,9 @@ struct PipelineStages {
     /// shade + spawn: local terms by degree into the tile (or into shadow rays when degree 5
     /// asks for visibility), reflected and refracted rays appended to `next` (the compaction:
     /// only surviving rays move on). Misses bring the background.
-    static void shade(const StreamScene& sc, const RayStream& rays, const AlignedVec<std::int32_t>& object, int depth,
-                      RayStream& next, ShadowStream& shadows, float* accum, RayCounts& counts) {
+    static void shade(const StreamScene& sc, const RayStream& rays, const AlignedVec<std::int32_t>& object,
+                      const MeshHits& mesh_hits, int depth, RayStream& next, ShadowStream& shadows, float* accum,
+                      RayCounts& counts) {
         using namespace stage_detail;
         const RenderSettings& s = sc.settings;
         const bool may_spawn = kSecondary && depth < s.depth;
@@ -198,7 +222,11 @@ struct PipelineStages {
             // bring point and normal back with Md and Mn, as the baseline does.
             const Vec3f pc = apply_point(ob.mi, o) + apply_vector(ob.mi, d) * t;
             const Vec3f p = apply_point(ob.md, pc);
-            const Vec3f nc = visit_shape(ob.kind, [&](auto shape) { return shape.template normal<float>(pc, ob.param); });
+            const Vec3f nc =
+                ob.kind == ShapeKind::Mesh
+                    ? mesh_normal<float>(*ob.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i], mesh_hits.v[i],
+                                         ob.param != 0.f)
+                    : visit_shape(ob.kind, [&](auto shape) { return shape.template normal<float>(pc, ob.param); });
             const Vec3f n_out = apply_normal(ob.mn, nc);
             const float cone = rays.cone[i] + sc.camera.spread * t;
             const ColorT<float> base =
@@ -300,6 +328,11 @@ struct PipelineStages {
                 h.wb[j] = rays.wb[i];
                 h.cone[j] = rays.cone[i];
                 h.pixel[j] = rays.pixel[i];
+                if (sc.has_meshes) {
+                    h.prim[j] = ws.mesh_hits.prim[i];
+                    h.bu[j] = ws.mesh_hits.u[i];
+                    h.bv[j] = ws.mesh_hits.v[i];
+                }
             }
         }
         const std::size_t next_before = ws.next.count;
@@ -314,6 +347,9 @@ struct PipelineStages {
                       nx.kind.data(), &nx.count},
                      {sh.ox.data(), sh.oy.data(), sh.oz.data(), sh.dx.data(), sh.dy.data(), sh.dz.data(),
                       sh.t_max.data(), sh.cr.data(), sh.cg.data(), sh.cb.data(), sh.pixel.data(), &sh.count}};
+        job.prim = h.prim.data();
+        job.bu = h.bu.data();
+        job.bv = h.bv.data();
         const ShadeFn fn = kt.shade[(kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0)];
         for (std::size_t k = 0; k < n_obj; ++k) {
             if (h.run_start[k] == h.run_start[k + 1]) continue;
@@ -391,7 +427,7 @@ struct PipelineStages {
             RayStream& rays = ws.current;
             {
                 StageTimer timer(fig(Stage::Intersect));
-                intersect(sc, kt, rays, ws.object, fig(Stage::Intersect));
+                intersect(sc, kt, rays, ws.object, ws.mesh_hits, fig(Stage::Intersect));
                 if (profile) fig(Stage::Intersect)->rays_in += rays.count, fig(Stage::Intersect)->rays_out += rays.count;
             }
             {
@@ -400,7 +436,7 @@ struct PipelineStages {
                 ws.next.reserve(kSecondary ? rays.count * 2 : 0);
                 if constexpr (kShadows) ws.shadows.reserve(rays.count * lights);
                 if (scalar_shade || sc.objects.size() > kSortedShadeMaxObjects)
-                    shade(sc, rays, ws.object, depth, ws.next, ws.shadows, accum, counts);
+                    shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, accum, counts);
                 else
                     shade_sorted(sc, kt, rays, ws.object, depth, ws, accum, counts);
                 if (profile) {

@@ -1,5 +1,7 @@
 #include "stream/stream_accel.h"
 
+#include "mesh/mesh.h"
+
 namespace streamrt {
 
 namespace {
@@ -10,8 +12,9 @@ void rows3x4(const glm::dmat4& m, float* out) {
 ObjectXf object_xf(const Object& o, std::uint32_t id) {
     ObjectXf xf{};
     rows3x4(o.xf.mi, xf.m);
-    xf.param = float(o.minor);
+    xf.param = float(o.param());
     xf.id = std::int32_t(id);
+    xf.mesh = o.mesh ? &o.mesh->view() : nullptr;
     return xf;
 }
 }  // namespace

@@ -46,11 +46,17 @@ StreamScene::StreamScene(const Scene& original) : settings(original.settings) {
     const RenderSettings& s = scene.settings;
     background = {float(s.background.x), float(s.background.y), float(s.background.z)};
     bool any_refl = false, any_trans = false;
+    std::fill(std::begin(group_bounded), std::end(group_bounded), true);
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         const Object& o = scene.objects[i];
         ShadeObject so{};
         so.kind = o.kind;
-        so.param = float(o.minor);
+        so.param = float(o.param());
+        if (o.kind == ShapeKind::Mesh && o.mesh) {
+            so.mesh = &o.mesh->view();
+            meshes.push_back(o.mesh);
+            has_meshes = true;
+        }
         rows3x4(o.xf.mi, so.mi);
         rows3x4(o.xf.md, so.md);
         for (int r = 0; r < 3; ++r)
@@ -67,6 +73,7 @@ StreamScene::StreamScene(const Scene& original) : settings(original.settings) {
         std::copy(std::begin(so.mi), std::end(so.mi), xf.m);
         xf.param = so.param;
         xf.id = std::int32_t(i);
+        xf.mesh = so.mesh;
         groups[int(o.kind)].push_back(xf);
         double lo[3], hi[3];
         ObjectBounds box{};

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kernels/kernel_table.h"
+#include "mesh/mesh.h"
 #include "render/camera_rays.h"
 #include "render/shading.h"
 #include "scene/scene.h"
@@ -36,11 +37,14 @@ struct StreamScene {
     /// World bounds per object of each group, for the per-packet culling of the flat kernels;
     /// a kind with an unbounded member (the plane) is tested without culling.
     std::vector<ObjectBounds> group_bounds[kShapeKindCount];
-    bool group_bounded[kShapeKindCount] = {true, true, true, true, true, true};
+    bool group_bounded[kShapeKindCount];  ///< set in the constructor
     ColorT<float> background;
     /// The object hierarchy, when the scene is traced with one (stream/stream_accel.h); the
     /// intersect and occlusion stages then use it instead of `groups`.
     std::shared_ptr<const StreamAccel> accel;
+    /// The meshes the objects use (kept alive here: ShadeObject and ObjectXf point into them).
+    std::vector<std::shared_ptr<const Mesh>> meshes;
+    bool has_meshes = false;
 
     explicit StreamScene(const Scene& scene);
 };

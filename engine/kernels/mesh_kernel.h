@@ -1,0 +1,178 @@
+#pragma once
+// The SIMD mesh kernels: a packet of rays (already in the mesh's canonical space, as for the
+// canonical shapes) walks the mesh's 8-wide BVH together; leaves run the watertight triangle
+// test (shapes/triangle_math.h) on the whole packet, one broadcast triangle at a time.
+// Included only by kernels/isa_*.cpp through intersect_kernel.h, inside their own namespace.
+#include <xsimd/xsimd.hpp>
+
+#include <cstdint>
+#include <limits>
+
+#include "mesh/mesh_view.h"
+#include "shapes/triangle_math.h"
+
+namespace streamrt::STREAMRT_ISA_NAMESPACE {
+
+namespace mesh_detail {
+
+constexpr int kStack = accel::kNodeWidth * 64;
+
+struct Entry {
+    std::int32_t child;
+    std::uint32_t count;
+    float t;
+};
+
+/// Box test for the mesh walk. Boxes are padded outwards (accel::conservative_box) and the
+/// far distance is widened by 2 gamma(3) (Ize 2013, "Robust BVH ray traversal"), so float
+/// rounding in the slabs can never drop a box the ray touches: a ray through a shared edge
+/// still reaches both triangles' leaves, flat boxes (axis-aligned triangles) included.
+template <class B>
+inline auto robust_box(const accel::WideNode& n, int j, const Vec3T<B>& o, const Vec3T<B>& inv, const B& t_max,
+                       B& t_near) {
+    constexpr float kWiden = 1.f + 2.f * (3.f * 0x1p-24f) / (1.f - 3.f * 0x1p-24f);
+    B tn(0.f), tf = t_max;
+    const auto slab = [&](float lo, float hi, const B& oc, const B& ic) {
+        const B a = (B(lo) - oc) * ic, b = (B(hi) - oc) * ic;
+        const B mn = xsimd::select(a < b, a, b), mx = xsimd::select(a < b, b, a);
+        tn = xsimd::select(mn > tn, mn, tn);  // NaN (0 * inf): the slab does not limit
+        tf = xsimd::select(mx < tf, mx, tf);
+    };
+    slab(n.lo_x[j], n.hi_x[j], o.x, inv.x);
+    slab(n.lo_y[j], n.hi_y[j], o.y, inv.y);
+    slab(n.lo_z[j], n.hi_z[j], o.z, inv.z);
+    t_near = tn;
+    return tn <= tf * B(kWiden);
+}
+
+template <class B>
+inline Vec3T<B> vertex(const MeshView& m, std::uint32_t k, int j) {
+    const float* p = m.tri + 9 * std::size_t(k) + 3 * j;
+    return {B(p[0]), B(p[1]), B(p[2])};
+}
+
+template <class B>
+inline float lanes_max(const B& v) {
+    alignas(64) float a[B::size];
+    v.store_aligned(a);
+    float r = a[0];
+    for (std::size_t l = 1; l < B::size; ++l) r = r > a[l] ? r : a[l];
+    return r;
+}
+template <class B>
+inline float lanes_min_where(const B& v, const decltype(B(0.f) < B(0.f))& m) {
+    alignas(64) float a[B::size];
+    xsimd::select(m, v, B(std::numeric_limits<float>::infinity())).store_aligned(a);
+    float r = a[0];
+    for (std::size_t l = 1; l < B::size; ++l) r = r < a[l] ? r : a[l];
+    return r;
+}
+
+}  // namespace mesh_detail
+
+/// Closest hit of the canonical packet (o, d) with the mesh for t in (0, best): shrinks best
+/// per lane and, for the lanes it shrank, writes triangle number and barycentrics into
+/// prim/u/v[0 .. W) (when prim is not null).
+template <class B>
+inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, B& best, std::int32_t* prim,
+                                float* u, float* v) {
+    using namespace mesh_detail;
+    using I = xsimd::batch<std::int32_t, typename B::arch_type>;
+    constexpr std::size_t W = B::size;
+    if (!m.nodes) return;
+    const B start = best;
+    float best_max = lanes_max(best);
+    if (!(best_max > 0.f)) return;
+    const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
+    const WatertightRay<B> wr = watertight_ray(o, d);
+    B bu(0.f), bv(0.f);
+    I bprim(-1);
+    Entry stack[kStack];
+    int sp = 0;
+    stack[sp++] = {0, 0, 0.f};
+    while (sp > 0) {
+        const Entry e = stack[--sp];
+        if (e.t > best_max) continue;
+        if (e.count > 0) {
+            for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
+                const TriangleHit<B> h = triangle_hit(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2),
+                                                      B(0.f), best);
+                const auto closer = h.t < best;
+                if (!xsimd::any(closer)) continue;
+                best = xsimd::select(closer, h.t, best);
+                bu = xsimd::select(closer, h.u, bu);
+                bv = xsimd::select(closer, h.v, bv);
+                bprim = xsimd::select(xsimd::bool_cast(closer), I(std::int32_t(k)), bprim);
+            }
+            best_max = lanes_max(best);
+            continue;
+        }
+        const accel::WideNode& n = m.nodes[e.child];
+        Entry hits[accel::kNodeWidth];
+        int nh = 0;
+        for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
+            B tn;
+            const auto hit = robust_box(n, j, o, inv, best, tn);
+            if (!xsimd::any(hit)) continue;
+            // farthest first, so the nearest is popped first
+            const Entry en{n.child[j], n.count[j], lanes_min_where(tn, hit)};
+            int k = nh++;
+            while (k > 0 && hits[k - 1].t < en.t) {
+                hits[k] = hits[k - 1];
+                --k;
+            }
+            hits[k] = en;
+        }
+        for (int k = 0; k < nh; ++k) stack[sp++] = hits[k];
+    }
+    const auto improved = best < start;
+    if (!prim || !xsimd::any(improved)) return;
+    alignas(64) std::int32_t p_out[W];
+    alignas(64) float u_out[W], v_out[W];
+    alignas(64) bool go[W];
+    bprim.store_aligned(p_out);
+    bu.store_aligned(u_out);
+    bv.store_aligned(v_out);
+    improved.store_aligned(go);
+    for (std::size_t l = 0; l < W; ++l)
+        if (go[l]) {
+            prim[l] = p_out[l];
+            u[l] = u_out[l];
+            v[l] = v_out[l];
+        }
+}
+
+/// Any hit for t in (0, t_max) of the lanes in `open`: the lanes the mesh blocks.
+template <class B, class M>
+inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, const B& t_max, M open) {
+    using namespace mesh_detail;
+    M blocked = B(0.f) != B(0.f);
+    if (!m.nodes || !xsimd::any(open)) return blocked;
+    const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
+    const WatertightRay<B> wr = watertight_ray(o, d);
+    Entry stack[kStack];
+    int sp = 0;
+    stack[sp++] = {0, 0, 0.f};
+    while (sp > 0) {
+        const Entry e = stack[--sp];
+        if (e.count > 0) {
+            for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
+                const TriangleHit<B> h = triangle_hit(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2),
+                                                      B(0.f), t_max);
+                const auto now = open && (h.t < t_max);
+                blocked = blocked || now;
+                open = open && !now;
+            }
+            if (!xsimd::any(open)) break;  // every lane is blocked
+            continue;
+        }
+        const accel::WideNode& n = m.nodes[e.child];
+        for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
+            B tn;
+            if (xsimd::any(robust_box(n, j, o, inv, t_max, tn) && open)) stack[sp++] = {n.child[j], n.count[j], 0.f};
+        }
+    }
+    return blocked;
+}
+
+}  // namespace streamrt::STREAMRT_ISA_NAMESPACE

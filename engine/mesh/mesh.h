@@ -1,0 +1,65 @@
+#pragma once
+// Triangle meshes: the triangles of one OBJ file (or a generated surface) in the mesh's own
+// coordinates, which are the canonical space of every object that uses it (placed by Md like
+// the canonical shapes). Each mesh has its own BVH (accel::Bvh over the triangle boxes) and
+// is stored once however many objects use it: the scene hierarchy holds instances.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "accel/bvh.h"
+#include "mesh/mesh_view.h"
+#include "simd/lanes.h"
+
+namespace streamrt {
+
+struct Mesh {
+    std::string name;                   ///< the file it came from, for messages
+    simd::AlignedVec<float> tri;        ///< 9 per triangle, leaf order
+    std::vector<std::uint32_t> index;   ///< 3 per triangle, leaf order
+    std::vector<float> vertex_normals;  ///< 3 per vertex
+    accel::Bvh bvh;                     ///< prim_index is dropped: triangles are stored in leaf order
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  ///< bounds of the vertices
+    std::size_t dropped = 0;            ///< degenerate triangles left out
+    MeshView kernel_view{};             ///< pointers into the above, set once built (stable: the mesh is immutable)
+
+    std::size_t triangle_count() const { return index.size() / 3; }
+    const MeshView& view() const { return kernel_view; }
+    /// Bytes held by the mesh (triangles, indices, normals, BVH nodes).
+    std::size_t memory_bytes() const;
+
+    /// Builds a mesh from vertex positions (3 floats each) and triangles (3 vertex numbers
+    /// each, counter-clockwise seen from outside). Triangles with a repeated vertex, an
+    /// out-of-range vertex or zero area are dropped. May return a mesh with no triangles.
+    static std::shared_ptr<const Mesh> build(std::string name, const std::vector<float>& positions,
+                                             const std::vector<std::uint32_t>& triangles,
+                                             const accel::BuildOptions& options = {});
+};
+
+/// Reads a Wavefront OBJ file (tinyobjloader; polygons are triangulated, materials, texture
+/// coordinates and normals in the file are ignored). Throws std::runtime_error with a
+/// message (no location) for a missing, unreadable or malformed file or one with no
+/// triangles.
+std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path);
+
+// ---- generated surfaces (tests, benchmarks, the sample scene) -----------------------------
+
+/// Vertices and triangles of a generated surface.
+struct MeshData {
+    std::vector<float> positions;
+    std::vector<std::uint32_t> triangles;
+};
+
+/// The unit sphere as a UV sphere: `rings` bands of latitude, `segments` of longitude, all
+/// vertices on the sphere, shared (closed, no cracks by construction), poles single vertices.
+MeshData uv_sphere(int rings, int segments);
+/// The unit sphere as a subdivided icosahedron (20 * 4^level triangles), vertices on it.
+MeshData icosphere(int level);
+/// The cube [-1,1]^3, each face an n x n grid of quads cut into two triangles, closed.
+MeshData cube_mesh(int n);
+/// Writes positions and triangles as an OBJ file (v / f lines, 1-based); false on failure.
+bool write_obj(const std::string& path, const MeshData& m);
+
+}  // namespace streamrt

@@ -1,0 +1,141 @@
+#pragma once
+// Watertight ray/triangle intersection (Woop, Benthin & Wald 2013, "Watertight Ray/Triangle
+// Intersection", JCGT 2(1)), written once for V = double (baseline), float and xsimd float
+// batches (the mesh kernels).
+//
+// The ray is turned into a space where it starts at the origin and runs along +z: the axis
+// of its largest direction component becomes z (kz), the other two x and y (swapped when
+// d[kz] < 0 so the winding is kept), and a shear makes the direction (0, 0, 1). A vertex's
+// sheared coordinates depend only on the vertex and the ray, so two triangles sharing an edge
+// compute the same two products for it, in the same order, and their edge functions are
+// exact negations of each other (round-to-nearest is symmetric; no FMA may be contracted
+// here: the kernel files are built with -ffp-contract=off). A ray through a shared edge has
+// that edge function exactly 0 in both triangles and is accepted by both; a ray beside it is
+// accepted by exactly one. An edge function that rounds to 0 in float is recomputed in double
+// (the products of two floats are exact in double), as the paper does.
+#include <type_traits>
+
+#include "core/vec3.h"
+#include "shapes/quadratic.h"
+#include "simd/lanes.h"
+
+namespace streamrt {
+
+/// The per-ray part of the test, computed once per ray (or per packet of rays).
+template <class V>
+struct WatertightRay {
+    using Mask = decltype(V(0) < V(0));
+    Vec3T<V> o;
+    Mask kx0, kx1, ky0, ky1, kz0, kz1;  ///< axis k of the permutation is 0, 1 (else 2)
+    V sx, sy, sz;                        ///< shear constants
+};
+
+template <class V>
+struct TriangleHit {
+    V t;  ///< +inf on a miss
+    V u;  ///< barycentric weight of p1
+    V v;  ///< barycentric weight of p2 (p0 has 1 - u - v)
+};
+
+namespace tri_detail {
+template <class V, class M>
+inline V pick(const M& is0, const M& is1, const Vec3T<V>& a) {
+    return simd::select(is0, a.x, simd::select(is1, a.y, a.z));
+}
+
+/// Recomputes in double the edge functions that came out exactly 0 in float.
+template <class V>
+inline void edge_fallback(V& U, V& Vv, V& W, const V& ax, const V& ay, const V& bx, const V& by, const V& cx,
+                          const V& cy) {
+    if constexpr (std::is_same_v<simd::scalar_t<V>, float>) {
+        using simd::any;
+        if (!any((U == V(0.f)) || (Vv == V(0.f)) || (W == V(0.f)))) return;
+        if constexpr (std::is_same_v<V, float>) {
+            U = float(double(cx) * double(by) - double(cy) * double(bx));
+            Vv = float(double(ax) * double(cy) - double(ay) * double(cx));
+            W = float(double(bx) * double(ay) - double(by) * double(ax));
+        } else {
+            constexpr std::size_t N = V::size;
+            alignas(64) float a[6][N], out[3][N];
+            ax.store_aligned(a[0]);
+            ay.store_aligned(a[1]);
+            bx.store_aligned(a[2]);
+            by.store_aligned(a[3]);
+            cx.store_aligned(a[4]);
+            cy.store_aligned(a[5]);
+            for (std::size_t l = 0; l < N; ++l) {
+                const double Ax = a[0][l], Ay = a[1][l], Bx = a[2][l], By = a[3][l], Cx = a[4][l], Cy = a[5][l];
+                out[0][l] = float(Cx * By - Cy * Bx);
+                out[1][l] = float(Ax * Cy - Ay * Cx);
+                out[2][l] = float(Bx * Ay - By * Ax);
+            }
+            U = V::load_aligned(out[0]);
+            Vv = V::load_aligned(out[1]);
+            W = V::load_aligned(out[2]);
+        }
+    }
+}
+}  // namespace tri_detail
+
+/// Sets up the ray (origin o, direction d, not necessarily unit) for triangle tests.
+template <class V>
+inline WatertightRay<V> watertight_ray(const Vec3T<V>& o, const Vec3T<V>& d) {
+    using namespace simd;
+    WatertightRay<V> r;
+    r.o = o;
+    const V ax = abs(d.x), ay = abs(d.y), az = abs(d.z);
+    const auto z0 = (ax >= ay) && (ax >= az);
+    const auto z1 = !z0 && (ay >= az);
+    const auto z2 = !z0 && !z1;
+    const V dz = select(z0, d.x, select(z1, d.y, d.z));
+    const auto neg = dz < V(0);
+    const auto pos = !neg;
+    // Nominal kx = kz + 1, ky = kz + 2 (mod 3); swapped when d[kz] < 0.
+    r.kz0 = z0;
+    r.kz1 = z1;
+    r.kx0 = (z2 && pos) || (z1 && neg);
+    r.kx1 = (z0 && pos) || (z2 && neg);
+    r.ky0 = (z1 && pos) || (z2 && neg);
+    r.ky1 = (z2 && pos) || (z0 && neg);
+    const V dx = tri_detail::pick(r.kx0, r.kx1, d);
+    const V dy = tri_detail::pick(r.ky0, r.ky1, d);
+    r.sz = V(1) / dz;
+    r.sx = dx * r.sz;
+    r.sy = dy * r.sz;
+    return r;
+}
+
+/// Nearest hit in (t_min, t_max) with the triangle (p0, p1, p2), t = +inf on a miss. Both
+/// faces count. t is measured along the direction given to watertight_ray().
+template <class V>
+inline TriangleHit<V> triangle_hit(const WatertightRay<V>& r, const Vec3T<V>& p0, const Vec3T<V>& p1,
+                                   const Vec3T<V>& p2, V t_min, V t_max) {
+    using namespace simd;
+    using tri_detail::pick;
+    const Vec3T<V> a = p0 - r.o, b = p1 - r.o, c = p2 - r.o;
+    const V akz = pick(r.kz0, r.kz1, a), bkz = pick(r.kz0, r.kz1, b), ckz = pick(r.kz0, r.kz1, c);
+    const V ax = pick(r.kx0, r.kx1, a) - r.sx * akz, ay = pick(r.ky0, r.ky1, a) - r.sy * akz;
+    const V bx = pick(r.kx0, r.kx1, b) - r.sx * bkz, by = pick(r.ky0, r.ky1, b) - r.sy * bkz;
+    const V cx = pick(r.kx0, r.kx1, c) - r.sx * ckz, cy = pick(r.ky0, r.ky1, c) - r.sy * ckz;
+    V U = cx * by - cy * bx;
+    V Vv = ax * cy - ay * cx;
+    V W = bx * ay - by * ax;
+    tri_detail::edge_fallback(U, Vv, W, ax, ay, bx, by, cx, cy);
+    const auto outside = ((U < V(0)) || (Vv < V(0)) || (W < V(0))) && ((U > V(0)) || (Vv > V(0)) || (W > V(0)));
+    const V det = U + Vv + W;
+    const V T = U * (r.sz * akz) + Vv * (r.sz * bkz) + W * (r.sz * ckz);
+    const auto ok = !outside && (det != V(0));
+    const V inv_det = V(1) / select(ok, det, V(1));
+    const V t = T * inv_det;
+    const auto hit = ok && (t > t_min) && (t < t_max);
+    return {select(hit, t, infinity_v<V>()), Vv * inv_det, W * inv_det};
+}
+
+/// Unnormalised geometric normal (p1 - p0) x (p2 - p0): outward for counter-clockwise
+/// triangles seen from outside (the OBJ convention).
+template <class V>
+inline Vec3T<V> triangle_normal(const Vec3T<V>& p0, const Vec3T<V>& p1, const Vec3T<V>& p2) {
+    return cross(p1 - p0, p2 - p0);
+}
+
+}  // namespace streamrt

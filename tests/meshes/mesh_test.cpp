@@ -1,0 +1,346 @@
+// Triangle meshes: the watertight triangle test in double, float and every SIMD level (flat
+// kernels and the scene hierarchy's packet and single-ray walks) never lets a ray through a
+// closed mesh or between triangles at shared edges and vertices; tessellated spheres against
+// the analytic sphere; OBJ files through the parser; both engines on a mesh scene.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "accel/scene_bvh.h"
+#include "image/image_compare.h"
+#include "kernels/kernel_table.h"
+#include "mesh/mesh.h"
+#include "mesh/mesh_trace.h"
+#include "parallel/parallelism.h"
+#include "render/camera_rays.h"
+#include "render/render.h"
+#include "scene/parser.h"
+#include "stream/stream_accel.h"
+
+using namespace streamrt;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr float kInfF = std::numeric_limits<float>::infinity();
+
+struct Rays {
+    std::vector<Vec3f> o, d;
+    void add(const Vec3f& a, const Vec3f& b) {
+        o.push_back(a);
+        d.push_back(b);
+    }
+};
+
+Object mesh_object(const std::shared_ptr<const Mesh>& m, const glm::dmat4& md = glm::dmat4(1.0)) {
+    Object o;
+    o.kind = ShapeKind::Mesh;
+    o.mesh = m;
+    o.xf = Transform::from_direct(md);
+    return o;
+}
+
+void fill(RayStream& rs, const Rays& r, float t_max) {
+    rs.reserve(r.o.size());
+    for (std::size_t i = 0; i < r.o.size(); ++i) {
+        rs.ox[i] = r.o[i].x, rs.oy[i] = r.o[i].y, rs.oz[i] = r.o[i].z;
+        rs.dx[i] = r.d[i].x, rs.dy[i] = r.d[i].y, rs.dz[i] = r.d[i].z;
+        rs.t_max[i] = t_max;
+    }
+    rs.count = r.o.size();
+    rs.pad_tail();
+}
+
+/// Every ray must hit the mesh (placed with the identity) for some t in (0, t_limit): checked
+/// with the baseline's double walk, the same walk in float, and on every ISA level the flat
+/// mesh kernels (closest and any hit) and the scene hierarchy's packet and single-ray walks.
+void check_all_hit(const std::shared_ptr<const Mesh>& mesh, const Rays& r, float t_limit = kInfF) {
+    const MeshView& mv = mesh->view();
+    std::size_t miss_d = 0, miss_f = 0;
+    for (std::size_t i = 0; i < r.o.size(); ++i) {
+        double td = t_limit;
+        std::uint32_t tri = 0;
+        double u = 0, v = 0;
+        if (!mesh_closest<double>(mv, mesh->bvh, vec_cast<double>(r.o[i]), vec_cast<double>(r.d[i]), 0.0, td, tri, u, v))
+            ++miss_d;
+        float tf = t_limit, uf = 0, vf = 0;
+        if (!mesh_closest<float>(mv, mesh->bvh, r.o[i], r.d[i], 0.f, tf, tri, uf, vf)) ++miss_f;
+    }
+    CHECK(miss_d == 0);
+    CHECK(miss_f == 0);
+
+    Scene s;
+    s.objects.push_back(mesh_object(mesh));
+    ObjectXf xf{};
+    xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
+    xf.id = 0;
+    xf.mesh = &mv;
+    for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
+        if (!isa_supported(isa)) continue;
+        const std::string isa_str = isa_name(isa);
+        CAPTURE(isa_str);
+        const KernelTable& kt = kernel_table(isa);
+        RayStream rs;
+        fill(rs, r, t_limit);
+        AlignedVec<std::int32_t> id(rs.capacity(), -1), prim(rs.capacity(), -1);
+        AlignedVec<float> bu(rs.capacity()), bv(rs.capacity());
+        RayView view = view_of(rs);
+        view.prim = prim.data(), view.bu = bu.data(), view.bv = bv.data();
+        kt.closest[int(ShapeKind::Mesh)](view, id.data(), &xf, 1);
+        std::size_t misses = 0, bad_prim = 0;
+        for (std::size_t i = 0; i < rs.count; ++i) {
+            misses += id[i] != 0;
+            bad_prim += prim[i] < 0 || std::uint32_t(prim[i]) >= mv.n_tris;
+        }
+        CHECK(misses == 0);
+        CHECK(bad_prim == 0);
+        RayStream sh;
+        fill(sh, r, t_limit == kInfF ? 1e30f : t_limit);
+        kt.any[int(ShapeKind::Mesh)](view_of(sh), &xf, 1);
+        std::size_t open = 0;
+        for (std::size_t i = 0; i < sh.count; ++i) open += sh.t_max[i] != 0.f;
+        CHECK(open == 0);
+        for (accel::Traversal tr : {accel::Traversal::Packet, accel::Traversal::Single}) {
+            accel::accel_config().primary = accel::accel_config().shadow = tr;
+            StreamAccel sa(s, accel::SceneBvh::build(s));
+            RayStream rs2;
+            fill(rs2, r, t_limit);
+            AlignedVec<std::int32_t> id2(rs2.capacity(), -1);
+            sa.closest(kt, view_of(rs2), id2.data(), true);
+            std::size_t m2 = 0;
+            for (std::size_t i = 0; i < rs2.count; ++i) m2 += id2[i] != 0;
+            CHECK(m2 == 0);
+            RayStream sh2;
+            fill(sh2, r, t_limit == kInfF ? 1e30f : t_limit);
+            sa.any(kt, view_of(sh2));
+            std::size_t o2 = 0;
+            for (std::size_t i = 0; i < sh2.count; ++i) o2 += sh2.t_max[i] != 0.f;
+            CHECK(o2 == 0);
+        }
+        accel::accel_config() = accel::AccelConfig{};
+    }
+}
+
+Vec3f random_unit(std::mt19937& rng) {
+    std::normal_distribution<float> n(0.f, 1.f);
+    for (;;) {
+        const Vec3f v{n(rng), n(rng), n(rng)};
+        const float l = length(v);
+        if (l > 1e-3f) return v * (1.f / l);
+    }
+}
+
+std::shared_ptr<const Mesh> build(const MeshData& d) { return Mesh::build("generated", d.positions, d.triangles); }
+
+}  // namespace
+
+TEST_CASE("meshes: triangle test basics, both faces, barycentrics, t range") {
+    const Vec3d p0{0, 0, 0}, p1{1, 0, 0}, p2{0, 1, 0};
+    const WatertightRay<double> r = watertight_ray(Vec3d{0.25, 0.5, 1}, Vec3d{0, 0, -2});
+    const TriangleHit<double> h = triangle_hit(r, p0, p1, p2, 0.0, 10.0);
+    CHECK(h.t == doctest::Approx(0.5));
+    CHECK(h.u == doctest::Approx(0.25));
+    CHECK(h.v == doctest::Approx(0.5));
+    // from below (back face) too
+    const WatertightRay<double> back = watertight_ray(Vec3d{0.25, 0.5, -1}, Vec3d{0, 0, 1});
+    CHECK(triangle_hit(back, p0, p1, p2, 0.0, 10.0).t == doctest::Approx(1.0));
+    // outside, beyond t_max, behind the origin
+    CHECK(std::isinf(triangle_hit(watertight_ray(Vec3d{0.8, 0.8, 1}, Vec3d{0, 0, -1}), p0, p1, p2, 0.0, 10.0).t));
+    CHECK(std::isinf(triangle_hit(r, p0, p1, p2, 0.0, 0.4).t));
+    CHECK(std::isinf(triangle_hit(watertight_ray(Vec3d{0.25, 0.5, 1}, Vec3d{0, 0, 1}), p0, p1, p2, 0.0, 10.0).t));
+    // parallel to the plane of the triangle
+    CHECK(std::isinf(triangle_hit(watertight_ray(Vec3d{-1, 0.2, 0}, Vec3d{1, 0, 0}), p0, p1, p2, 0.0, 10.0).t));
+    // float agrees
+    const WatertightRay<float> rf = watertight_ray(Vec3f{0.25f, 0.5f, 1}, Vec3f{0, 0, -2});
+    CHECK(triangle_hit(rf, Vec3f{0, 0, 0}, Vec3f{1, 0, 0}, Vec3f{0, 1, 0}, 0.f, 10.f).t == doctest::Approx(0.5f));
+}
+
+TEST_CASE("meshes: degenerate triangles are dropped, normals, memory") {
+    const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0};
+    const auto m = Mesh::build("t", pos, {0, 1, 2, 0, 1, 3, 0, 0, 1, 0, 1, 7});
+    CHECK(m->triangle_count() == 1);
+    CHECK(m->dropped == 3);  // collinear, repeated vertex, missing vertex
+    const Vec3d n = mesh_normal<double>(m->view(), 0, 0.3, 0.3, false);
+    CHECK(n.z > 0);
+    const Vec3d ns = mesh_normal<double>(m->view(), 0, 0.3, 0.3, true);
+    CHECK(ns.z == doctest::Approx(1.0));
+    CHECK(m->memory_bytes() > 0);
+}
+
+TEST_CASE("meshes: a closed cube mesh: 1e5 random rays from inside all hit (double, float, every SIMD level)") {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-0.999f, 0.999f);
+    for (int n : {1, 3}) {
+        CAPTURE(n);
+        const auto cube = build(cube_mesh(n));
+        CHECK(cube->triangle_count() == std::size_t(12 * n * n));
+        Rays r;
+        for (int i = 0; i < 100000; ++i) r.add({u(rng), u(rng), u(rng)}, random_unit(rng));
+        // From the centre exactly at the cube's vertices, edge points and grid lines.
+        for (int i = 0; i < 2000; ++i) {
+            const int a = int(rng() % 3);
+            Vec3f t{float(int(rng() % 2) * 2 - 1), float(int(rng() % 2) * 2 - 1), float(int(rng() % 2) * 2 - 1)};
+            const float g = -1.f + 2.f * float(rng() % std::uint32_t(n + 1)) / float(n);
+            (a == 0 ? t.x : a == 1 ? t.y : t.z) = (i % 2) ? g : u(rng);
+            r.add({0, 0, 0}, t);
+            r.add({u(rng) * 0.5f, u(rng) * 0.5f, u(rng) * 0.5f}, t - r.o.back());
+        }
+        check_all_hit(cube, r);
+    }
+}
+
+TEST_CASE("meshes: rays aimed exactly at shared edges and vertices of a tessellated sphere never miss") {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u01(0.f, 1.f);
+    for (const MeshData& d : {uv_sphere(6, 12), uv_sphere(24, 48), icosphere(3)}) {
+        const auto m = build(d);
+        Rays from_out, from_in;
+        for (std::size_t k = 0; k < d.triangles.size(); k += 3)
+            for (int j = 0; j < 3; ++j) {
+                const auto vtx = [&](std::size_t idx) {
+                    const std::uint32_t v = d.triangles[idx];
+                    return Vec3f{d.positions[3 * v], d.positions[3 * v + 1], d.positions[3 * v + 2]};
+                };
+                const Vec3f a = vtx(k + std::size_t(j)), b = vtx(k + std::size_t((j + 1) % 3));
+                for (const Vec3f target : {a, (a + b) * 0.5f, a + (b - a) * u01(rng)}) {
+                    const Vec3f o = normalize(target + random_unit(rng) * 0.7f) * 4.f;
+                    from_out.add(o, target - o);  // reaches the surface at t ~ 1
+                    from_in.add({0, 0, 0}, target);
+                    const Vec3f inner = random_unit(rng) * (0.3f * u01(rng));
+                    from_in.add(inner, target - inner);
+                }
+            }
+        CAPTURE(m->triangle_count());
+        check_all_hit(m, from_out, 1.001f);
+        check_all_hit(m, from_in, 1.001f);
+    }
+}
+
+TEST_CASE("meshes: tessellated spheres against the analytic sphere, silhouettes agree within the tessellation error") {
+    constexpr int kSize = 64;
+    const auto scene_with = [](const Object& o) {
+        Scene s;
+        s.settings.width = s.settings.height = kSize;
+        s.settings.spp = 1;
+        s.settings.degree = 0;
+        s.camera.look_at = true;
+        s.camera.eye = {0.3, 0.5, 3.5};
+        s.camera.fov = 40;
+        s.objects.push_back(o);
+        return s;
+    };
+    Object sphere;
+    sphere.kind = ShapeKind::Sphere;
+    const Scene analytic = scene_with(sphere);
+    const CameraRays<double> cam = CameraRays<double>::from(analytic);
+    Parallelism par(2);
+    std::size_t previous = std::size_t(-1);
+    for (const MeshData& d : {uv_sphere(8, 16), uv_sphere(16, 32), uv_sphere(32, 64), uv_sphere(64, 128)}) {
+        const auto m = build(d);
+        // The inscribed polyhedron contains the ball of radius r_in (its nearest face plane).
+        double r_in = 1.0;
+        for (std::uint32_t k = 0; k < m->view().n_tris; ++k) {
+            const Vec3d p0 = mesh_vertex<double>(m->view(), k, 0);
+            const Vec3d n = normalize(mesh_normal<double>(m->view(), k, 0, 0, false));
+            r_in = std::min(r_in, std::abs(dot(n, p0)));
+        }
+        CAPTURE(m->triangle_count());
+        CAPTURE(r_in);
+        const Scene tess = scene_with(mesh_object(m));
+        std::size_t outside_band = 0, extra = 0, differ = 0;
+        for (EngineKind e : {EngineKind::Recursive, EngineKind::Stream}) {
+            const Framebuffer a = render_scene(analytic, e, par).image;
+            const Framebuffer b = render_scene(tess, e, par).image;
+            for (int y = 0; y < kSize; ++y)
+                for (int x = 0; x < kSize; ++x) {
+                    const bool in_a = a.pixel(x, y)[0] > 0.5f, in_b = b.pixel(x, y)[0] > 0.5f;
+                    if (in_a == in_b) continue;
+                    ++differ;
+                    // distance of the pixel's ray from the centre
+                    const Vec3d dir = cam.direction(x + 0.5, y + 0.5);
+                    const Vec3d c = cam.origin - dir * dot(cam.origin, dir);
+                    const double r_perp = length(c);
+                    if (in_b && !in_a) ++extra;  // the mesh lies inside the sphere
+                    else if (r_perp < r_in - 1e-4 || r_perp > 1 + 1e-4) ++outside_band;
+                }
+        }
+        MESSAGE(m->triangle_count() << " triangles: r_in " << r_in << ", silhouette pixels differing " << differ);
+        CHECK(extra <= 1);
+        CHECK(outside_band == 0);
+        CHECK(differ <= previous);
+        previous = differ;
+    }
+    CHECK(previous <= 8);
+}
+
+TEST_CASE("meshes: an OBJ file through the parser, both engines agree, errors carry file:line:col") {
+    const fs::path dir = fs::temp_directory_path() / ("streamrt_mesh_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    REQUIRE(write_obj((dir / "ball.obj").string(), icosphere(2)));
+    REQUIRE(write_obj((dir / "box.obj").string(), cube_mesh(2)));
+    {
+        std::ofstream(dir / "empty.obj") << "# nothing\nv 0 0 0\n";
+        std::ofstream(dir / "flat.obj") << "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n";
+        std::ofstream(dir / "quad.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+    }
+    const std::string cfg = (dir / "scene.cfg").string();
+    const std::string text =
+        "image width=96 height=72 spp=2 degree=5 depth=3\n"
+        "camera eye=0,2,6 look=0,0.5,0\n"
+        "light point pos=3,6,4\n"
+        "plane color=0.5,0.5,0.5 checker=0.2,0.2,0.2\n"
+        "mesh file=ball.obj smooth=true color=1,0.5,0.2 spec=0.5 translate=-1.2,1,0\n"
+        "mesh file=ball.obj color=0.2,0.5,1 scale=0.7 translate=1.2,0.7,0\n"
+        "mesh file=box.obj color=0.8,0.8,0.8 refl=0.5 scale=0.4 rotate_y=30 translate=0,0.4,-1.5\n"
+        "mesh file=quad.obj scale=0.3 translate=0,0,1\n";
+    const Scene s = parse_scene(text, cfg);
+    REQUIRE(s.objects.size() == 5);
+    CHECK(s.objects[1].kind == ShapeKind::Mesh);
+    CHECK(s.objects[1].smooth);
+    CHECK(!s.objects[2].smooth);
+    CHECK(s.objects[1].mesh == s.objects[2].mesh);  // one file, loaded once
+    CHECK(s.objects[1].mesh->triangle_count() == 320);
+    CHECK(s.objects[4].mesh->triangle_count() == 2);  // the quad, triangulated
+    Parallelism par(2);
+    for (accel::AccelMode mode : {accel::AccelMode::Flat, accel::AccelMode::Bvh}) {
+        accel::accel_config().mode = mode;
+        const Framebuffer a = render_scene(s, EngineKind::Stream, par).image;
+        const Framebuffer b = render_scene(s, EngineKind::Recursive, par).image;
+        const ImageDifference d = compare_images(a, b);
+        CAPTURE(d.psnr);
+        CAPTURE(d.share_over);
+        CHECK(d.psnr >= 50.0);
+        CHECK(d.share_over <= 0.001);
+        // The scalar shade stage gives the same picture as the SIMD one.
+        EngineOptions opt;
+        opt.scalar_shade = true;
+        const ImageDifference ds = compare_images(render_scene(s, EngineKind::Stream, par, nullptr, opt).image, a);
+        CHECK(ds.psnr >= 50.0);
+    }
+    accel::accel_config() = accel::AccelConfig{};
+
+    const auto error_of = [&](const std::string& t) {
+        try {
+            parse_scene(t, cfg);
+        } catch (const SceneError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    const std::string where = cfg + ":2:";
+    CHECK(error_of("\nmesh file=missing.obj\n").rfind(where + "11: cannot open mesh file", 0) == 0);
+    CHECK(error_of("\nmesh file=empty.obj\n").find(where + "11:") == 0);
+    CHECK(error_of("\nmesh file=empty.obj\n").find("no faces") != std::string::npos);
+    CHECK(error_of("\nmesh file=flat.obj\n").find("non-zero area") != std::string::npos);
+    CHECK(error_of("\nmesh file=. \n").rfind(where + "11:", 0) == 0);
+    CHECK(error_of("\nmesh color=1,1,1\n").rfind(where + "1: mesh needs 'file=PATH'", 0) == 0);
+    CHECK(error_of("\nmesh file=ball.obj smooth=yes\n").rfind(where + "27: expected true or false", 0) == 0);
+    CHECK(error_of("\nsphere file=ball.obj\n").rfind(where + "8: unknown key 'file'", 0) == 0);
+    fs::remove_all(dir);
+}
