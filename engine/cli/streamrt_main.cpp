@@ -18,6 +18,7 @@
 #include "image/image_io.h"
 #include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
+#include "render/limits.h"
 #include "render/render.h"
 #include "scene/parser.h"
 
@@ -58,6 +59,7 @@ void check_output_path(const std::string& out, const std::string& scene_path) {
     const fs::path target = fs::absolute(out, ec);
     if (fs::exists(scene_path, ec) && fs::exists(target, ec) && fs::equivalent(target, scene_path, ec))
         throw UsageError("output '" + out + "' is the scene file itself");
+    if (fs::is_directory(target, ec)) throw UsageError("output '" + out + "' is a folder");
     const fs::path dir = target.parent_path();
     if (!fs::is_directory(dir, ec)) throw UsageError("output folder '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0) throw UsageError("output folder '" + dir.string() + "' is not writable");
@@ -140,8 +142,14 @@ int run(int argc, char** argv) {
     try {
         app.parse(args);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+        // One line, like every other error (CLI11's own report adds a second line).
+        std::fprintf(stderr, "streamrt: %s (see --help)\n", e.what());
+        return 2;
     }
+    // From here on Ctrl-C (or SIGTERM) asks the render to stop; nothing is written then.
+    std::signal(SIGINT, on_sigint);
+    std::signal(SIGTERM, on_sigint);
 
     Scene scene = load_scene(opt.scene_path);
     RenderSettings& s = scene.settings;
@@ -155,6 +163,10 @@ int run(int argc, char** argv) {
     if (opt.sampler == "stratified") s.pattern = SamplePattern::Stratified;
     if (!opt.output.empty()) s.output = opt.output;
     check_output_path(s.output, opt.scene_path);
+    // Refuse, before allocating anything big, a render that cannot fit in this machine.
+    const EngineKind engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
+    const int jobs = opt.jobs > 0 ? opt.jobs : oneapi::tbb::info::default_concurrency();
+    check_render_memory(scene, engine == EngineKind::Stream || opt.compare, jobs);
     if (opt.check_only) {
         if (!opt.quiet)
             std::printf("%s: ok (%zu objects, %zu lights, %dx%d, spp %d, degree %d)\n", opt.scene_path.c_str(),
@@ -162,10 +174,8 @@ int run(int argc, char** argv) {
         return 0;
     }
 
-    std::signal(SIGINT, on_sigint);
-    std::signal(SIGTERM, on_sigint);
+    if (g_cancel.load()) throw Interrupted{};
     Parallelism par(opt.jobs);
-    const EngineKind engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
     EngineOptions eo;
     if (!opt.isa.empty()) {
         parse_isa(opt.isa, eo.isa);
