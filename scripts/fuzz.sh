@@ -18,14 +18,14 @@ bin="$out/scene_fuzz"
 # Rebuild when a source is newer than the binary.
 rebuild=0
 [[ -x $bin ]] || rebuild=1
-for s in "${sources[@]}" engine/scene/*.h engine/core/*.h engine/render/limits.h; do
+for s in "${sources[@]}" engine/scene/*.h engine/core/*.h engine/render/limits.h tests/fuzz/*.h; do
   [[ $s -nt $bin ]] && rebuild=1
 done
 if ((rebuild)); then
   echo "fuzz.sh: building $bin with $CXX"
   "$CXX" -std=c++20 -O1 -g -fno-omit-frame-pointer \
     -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-    -Iengine "${sources[@]}" -o "$bin"
+    -Iengine -Itests "${sources[@]}" -o "$bin"
 fi
 # Seed corpus: every example scene plus the regression inputs.
 cp -n scenes/*.cfg scenes/degrees/*.cfg "$out/corpus/" 2>/dev/null || true

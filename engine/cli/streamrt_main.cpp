@@ -1,7 +1,11 @@
 // streamrt: renders a .cfg scene (docs/scene-format.md) with the stream or the recursive engine.
 #include <CLI/CLI.hpp>
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <atomic>
 #include <chrono>
@@ -63,6 +67,14 @@ void check_output_path(const std::string& out, const std::string& scene_path) {
     const fs::path dir = target.parent_path();
     if (!fs::is_directory(dir, ec)) throw UsageError("output folder '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0) throw UsageError("output folder '" + dir.string() + "' is not writable");
+    // access() says yes to root everywhere; creating the file is what matters (read-only
+    // file systems, /proc, ...). Probe with a temporary name, removed at once.
+    const fs::path probe = dir / ("." + target.filename().string() + ".probe" + std::to_string(::getpid()));
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+    if (fd < 0)
+        throw UsageError("output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
+    ::close(fd);
+    ::unlink(probe.c_str());
 }
 
 std::string format_seconds(double s) {
