@@ -94,3 +94,13 @@ TEST_CASE("fuzz regressions: a finite Md whose inverse overflows is rejected as 
     // 1e300 overflows there (1e400) although the exact inverse is finite; rejected too.
     CHECK(error_of("sphere scale=1e100 translate=1e300,0,0\n").find("singular") != std::string::npos);
 }
+
+TEST_CASE("fuzz regressions: a huge rotation angle is reduced without overflowing a long") {
+    // -5.5e31 degrees is an exact multiple of 90 whose quarter turns do not fit in a long
+    // (undefined behaviour before); now taken modulo a full turn.
+    const Scene sc = parse_scene("cone rotate_x=-55555555555555555555555555555555\n", "t.cfg");
+    REQUIRE(sc.objects.size() == 1);
+    CHECK(streamrt_fuzz::check_scene(sc) == "");
+    const Scene big = parse_scene("cube rotate_y=1e300 rotate_z=-1e308\n", "t.cfg");
+    CHECK(streamrt_fuzz::check_scene(big) == "");
+}
