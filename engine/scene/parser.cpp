@@ -588,6 +588,11 @@ class Parser {
 
     void include(Statement& st, const std::vector<Token>& toks, int depth) {
         const Token& t = single_value(st, toks, "a file path");
+        // A NUL would make the file opened differ from the file named (the OS stops at it);
+        // no control byte belongs in a path here.
+        for (const char c : t.text)
+            if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+                st.fail(t.column, "include path " + quote(t.text) + " contains a control byte");
         const fs::path base = fs::path(st.file()).parent_path();
         const fs::path target = (base / fs::path(std::string(t.text))).lexically_normal();
         const std::string shown = target.string();

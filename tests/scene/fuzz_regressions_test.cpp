@@ -104,3 +104,16 @@ TEST_CASE("fuzz regressions: a huge rotation angle is reduced without overflowin
     const Scene big = parse_scene("cube rotate_y=1e300 rotate_z=-1e308\n", "t.cfg");
     CHECK(streamrt_fuzz::check_scene(big) == "");
 }
+
+TEST_CASE("fuzz regressions: an include path with a NUL byte is refused, not truncated") {
+    // "bad.cfg\0(g" used to open bad.cfg (the OS stops at the NUL) and report its errors
+    // under a file name containing a NUL.
+    FuzzDir tmp;
+    const std::string input = tmp.dir.string() + "/input.cfg";
+    try {
+        parse_scene(std::string("include bad.cfg\0(g\n", 19), input);
+        FAIL("expected a SceneError");
+    } catch (const SceneError& e) {
+        CHECK(std::string(e.what()) == input + ":1:9: include path 'bad.cfg\\x00(g' contains a control byte");
+    }
+}
