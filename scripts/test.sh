@@ -1,7 +1,13 @@
 #!/usr/bin/env bash
-# Second command of the README (and CI): install, build from scratch, run every test.
+# Second command of the README (and CI): install, build from scratch, run every test, then
+# run them again under ASan + UBSan.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install_deps.sh
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j2
+# The same suite built with AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/;
+# docs/robustness.md has the time it takes). SKIP_SANITIZE=1 skips it.
+if [[ ${SKIP_SANITIZE:-0} != 1 ]]; then
+  JOBS=${JOBS:-2} scripts/sanitize.sh asan
+fi

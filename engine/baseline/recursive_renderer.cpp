@@ -178,6 +178,7 @@ Framebuffer RecursiveRenderer::render(Parallelism& par, RenderProgress* progress
         RayCounts counts;
         for (int y = tile.y0; y < tile.y1; ++y)
             for (int x = tile.x0; x < tile.x1; ++x) {
+                if (progress && progress->cancelled()) return;  // seen within one pixel
                 const ColorT<double> c = render_pixel(x, y, counts);
                 float* px = fb.pixel(x, y);
                 px[0] = float(c.x);

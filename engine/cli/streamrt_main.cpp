@@ -1,7 +1,11 @@
 // streamrt: renders a .cfg scene (docs/scene-format.md) with the stream or the recursive engine.
 #include <CLI/CLI.hpp>
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <atomic>
 #include <chrono>
@@ -19,6 +23,7 @@
 #include "image/image_io.h"
 #include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
+#include "render/limits.h"
 #include "render/render.h"
 #include "scene/parser.h"
 
@@ -61,9 +66,18 @@ void check_output_path(const std::string& out, const std::string& scene_path) {
     const fs::path target = fs::absolute(out, ec);
     if (fs::exists(scene_path, ec) && fs::exists(target, ec) && fs::equivalent(target, scene_path, ec))
         throw UsageError("output '" + out + "' is the scene file itself");
+    if (fs::is_directory(target, ec)) throw UsageError("output '" + out + "' is a folder");
     const fs::path dir = target.parent_path();
     if (!fs::is_directory(dir, ec)) throw UsageError("output folder '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0) throw UsageError("output folder '" + dir.string() + "' is not writable");
+    // access() says yes to root everywhere; creating the file is what matters (read-only
+    // file systems, /proc, ...). Probe with a temporary name, removed at once.
+    const fs::path probe = dir / ("." + target.filename().string() + ".probe" + std::to_string(::getpid()));
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+    if (fd < 0)
+        throw UsageError("output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
+    ::close(fd);
+    ::unlink(probe.c_str());
 }
 
 std::string format_seconds(double s) {
@@ -149,8 +163,14 @@ int run(int argc, char** argv) {
     try {
         app.parse(args);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+        // One line, like every other error (CLI11's own report adds a second line).
+        std::fprintf(stderr, "streamrt: %s (see --help)\n", e.what());
+        return 2;
     }
+    // From here on Ctrl-C (or SIGTERM) asks the render to stop; nothing is written then.
+    std::signal(SIGINT, on_sigint);
+    std::signal(SIGTERM, on_sigint);
 
     Scene scene = load_scene(opt.scene_path);
     RenderSettings& s = scene.settings;
@@ -164,6 +184,10 @@ int run(int argc, char** argv) {
     if (opt.sampler == "stratified") s.pattern = SamplePattern::Stratified;
     if (!opt.output.empty()) s.output = opt.output;
     check_output_path(s.output, opt.scene_path);
+    // Refuse, before allocating anything big, a render that cannot fit in this machine.
+    const EngineKind engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
+    const int jobs = opt.jobs > 0 ? opt.jobs : oneapi::tbb::info::default_concurrency();
+    check_render_memory(scene, engine == EngineKind::Stream || opt.compare, jobs);
     if (opt.check_only) {
         if (!opt.quiet)
             std::printf("%s: ok (%zu objects, %zu lights, %dx%d, spp %d, degree %d)\n", opt.scene_path.c_str(),
@@ -174,10 +198,8 @@ int run(int argc, char** argv) {
     accel::accel_config().mode = opt.accel == "bvh"    ? accel::AccelMode::Bvh
                                  : opt.accel == "flat" ? accel::AccelMode::Flat
                                                        : accel::AccelMode::Auto;
-    std::signal(SIGINT, on_sigint);
-    std::signal(SIGTERM, on_sigint);
+    if (g_cancel.load()) throw Interrupted{};
     Parallelism par(opt.jobs);
-    const EngineKind engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
     EngineOptions eo;
     if (!opt.isa.empty()) {
         parse_isa(opt.isa, eo.isa);

@@ -24,7 +24,9 @@ namespace {
 void exact_sin_cos(double degrees, double& s, double& c) {
     const double turns = degrees / 90.0;
     if (turns == std::floor(turns)) {
-        const long q = ((long(turns) % 4) + 4) % 4;
+        // fmod first: a huge angle (1e30 degrees) is an exact multiple of 90 whose quarter
+        // turns do not fit in a long.
+        const int q = (int(std::fmod(turns, 4.0)) + 4) % 4;
         const double ss[4] = {0, 1, 0, -1}, cc[4] = {1, 0, -1, 0};
         s = ss[q];
         c = cc[q];

@@ -42,15 +42,23 @@ struct Arg {
     int value_col = 0;
 };
 
+/// 's' for messages: at most 60 bytes, control bytes written as \xNN so that a message is
+/// always one printable line.
 std::string quote(std::string_view s) {
     constexpr std::size_t kMax = 60;
     std::string out = "'";
-    if (s.size() > kMax) {
-        out.append(s.substr(0, kMax));
-        out += "...";
-    } else {
-        out.append(s);
+    for (std::size_t i = 0; i < s.size() && i < kMax; ++i) {
+        const unsigned char c = static_cast<unsigned char>(s[i]);
+        if (c < 0x20 || c == 0x7f) {
+            static const char hex[] = "0123456789abcdef";
+            out += "\\x";
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        } else {
+            out += char(c);
+        }
     }
+    if (s.size() > kMax) out += "...";
     out += '\'';
     return out;
 }
@@ -113,7 +121,12 @@ bool all_finite(const glm::dmat4& m) {
     return true;
 }
 
-bool singular(const glm::dmat4& m) { return !all_finite(m) || relative_determinant(m) < kSingular; }
+/// Not usable as Md: not finite, (nearly) singular, or with an inverse that overflows (a tiny
+/// scale followed by a huge translation gives a finite Md whose Mi is not).
+bool singular(const glm::dmat4& m) {
+    if (!all_finite(m) || !(relative_determinant(m) >= kSingular)) return true;
+    return !all_finite(glm::inverse(m));
+}
 
 /// One statement being read: its location, its word and (for keyed statements) its arguments.
 class Statement {
@@ -605,6 +618,11 @@ class Parser {
 
     void include(Statement& st, const std::vector<Token>& toks, int depth) {
         const Token& t = single_value(st, toks, "a file path");
+        // A NUL would make the file opened differ from the file named (the OS stops at it);
+        // no control byte belongs in a path here.
+        for (const char c : t.text)
+            if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+                st.fail(t.column, "include path " + quote(t.text) + " contains a control byte");
         const fs::path base = fs::path(st.file()).parent_path();
         const fs::path target = (base / fs::path(std::string(t.text))).lexically_normal();
         const std::string shown = target.string();

@@ -37,7 +37,7 @@ std::vector<std::string> StreamRenderer::built_stages() const {
 
 template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
 void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, float* accum, RayCounts& counts,
-                                 StreamProfile* profile) {
+                                 StreamProfile* profile, const RenderProgress* cancel) {
     using Stages = PipelineStages<kLighting, kShadows, kReflect, kRefract, kJitter>;
     const StreamScene& sc = self.scene_;
     const int spp = sc.settings.spp;
@@ -47,6 +47,7 @@ void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, f
     const int pixels_per_chunk = std::max(1, int(kMaxChunkRays / std::size_t(spp)));
     static thread_local Workspace ws;
     for (int first = 0; first < tile_pixels; first += pixels_per_chunk) {
+        if (cancel && cancel->cancelled()) return;
         const int n_pixels = std::min(pixels_per_chunk, tile_pixels - first);
         Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile, self.scalar_shade_);
     }
@@ -84,7 +85,7 @@ Framebuffer StreamRenderer::render(Parallelism& par, RenderProgress* progress, S
         StreamProfile local;
         // Tile-local accumulation in a fixed order: the result cannot depend on scheduling.
         float accum[kTileSize * kTileSize * 3] = {};
-        tile_fn_(*this, tile, accum, counts, profile ? &local : nullptr);
+        tile_fn_(*this, tile, accum, counts, profile ? &local : nullptr, progress);
         {
             StageTimer timer(profile ? &local.stages[int(Stage::Accumulate)] : nullptr);
             for (int y = tile.y0; y < tile.y1; ++y)

@@ -30,10 +30,13 @@ class StreamRenderer {
     static constexpr std::size_t kMaxChunkRays = 4096;
 
   private:
-    using TileFn = void (*)(const StreamRenderer&, const Tile&, float* accum, RayCounts&, StreamProfile*);
+    // `cancel` (may be null) is polled between chunks, so an interrupt is seen within one chunk.
+    using TileFn = void (*)(const StreamRenderer&, const Tile&, float* accum, RayCounts&, StreamProfile*,
+                            const RenderProgress* cancel);
     template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
     static void render_tile(const StreamRenderer& self, const Tile& tile, float* accum, RayCounts& counts,
-                            StreamProfile* profile);
+                            StreamProfile* profile,
+                            const RenderProgress* cancel);
     TileFn select_tile_fn() const;
 
     StreamScene scene_;

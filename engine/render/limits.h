@@ -1,0 +1,37 @@
+#pragma once
+// Limits checked before anything big is allocated: a render whose worst-case memory exceeds
+// the machine's physical memory is refused with a message saying what it would need.
+#include <cstdint>
+#include <string>
+
+#include "scene/scene.h"
+
+namespace streamrt {
+
+/// Worst-case bytes a render needs, by part (doubles: the worst case can exceed 2^64).
+struct MemoryEstimate {
+    double framebuffer_bytes = 0;  ///< width*height*3 floats
+    double output_bytes = 0;       ///< calibrated copy, 8-bit copy and encoded file while writing
+    double per_thread_bytes = 0;   ///< ray streams of one worker (stream engine) or its stack
+    int threads = 1;
+    double total_bytes = 0;        ///< framebuffer + output + threads * per_thread
+    int branching = 1;             ///< secondary rays one hit can spawn (1 or 2)
+    double peak_stream_rays = 0;   ///< largest ray generation of one chunk (stream engine)
+};
+
+/// The stream engine keeps at most max(4096, spp) primary rays per chunk and thread; each
+/// bounce can multiply a generation by the number of secondary rays a hit spawns (2 when a
+/// material both reflects and transmits at the scene's degree), up to `depth` times.
+MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, int threads);
+
+/// Physical memory of the machine: sysconf(_SC_PHYS_PAGES) * page size (0 if unknown).
+double physical_memory_bytes();
+
+/// Throws UsageError (one line, what it would need and what there is) when the estimate
+/// exceeds `limit_bytes` (default: physical memory; a limit <= 0 means unknown: no check).
+void check_render_memory(const Scene& scene, bool stream_engine, int threads, double limit_bytes = -1);
+
+/// "12.0 GiB", "512 KiB", "3.5e+70 GiB".
+std::string format_bytes(double bytes);
+
+}  // namespace streamrt

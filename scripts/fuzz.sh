@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Builds the scene-parser fuzz target (tests/fuzz/scene_fuzz.cpp) with clang++ and libFuzzer
+# (+ AddressSanitizer + UndefinedBehaviorSanitizer) into build-fuzz/ and runs it for SECONDS
+# (default 60) in one process on one core, from a corpus seeded with scenes/. Crashing inputs land in
+# build-fuzz/artifacts/; keep each as tests/fuzz/regressions/<name>.cfg once fixed.
+# Usage: scripts/fuzz.sh [SECONDS] [extra libFuzzer flags...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+shift || true
+CXX=${FUZZ_CXX:-clang++-14}
+command -v "$CXX" >/dev/null || CXX=clang++
+out=build-fuzz
+mkdir -p "$out/corpus" "$out/artifacts"
+sources=(tests/fuzz/scene_fuzz.cpp engine/scene/parser.cpp engine/scene/scene.cpp
+         engine/core/transform.cpp engine/render/limits.cpp)
+bin="$out/scene_fuzz"
+# Rebuild when a source is newer than the binary.
+rebuild=0
+[[ -x $bin ]] || rebuild=1
+for s in "${sources[@]}" engine/scene/*.h engine/core/*.h engine/render/limits.h tests/fuzz/*.h; do
+  [[ $s -nt $bin ]] && rebuild=1
+done
+if ((rebuild)); then
+  echo "fuzz.sh: building $bin with $CXX"
+  "$CXX" -std=c++20 -O1 -g -fno-omit-frame-pointer \
+    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
+    -Iengine -Itests "${sources[@]}" -o "$bin"
+fi
+# Seed corpus: every example scene plus the regression inputs.
+cp -n scenes/*.cfg scenes/degrees/*.cfg "$out/corpus/" 2>/dev/null || true
+for f in tests/fuzz/regressions/*; do [[ -f $f ]] && cp -n "$f" "$out/corpus/"; done
+echo "fuzz.sh: running for ${seconds}s (corpus $(ls "$out/corpus" | wc -l) files)"
+exec "$bin" "$out/corpus" -dict=tests/fuzz/scene.dict -max_total_time="$seconds" \
+  -max_len=4096 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  -artifact_prefix="$out/artifacts/" "$@"

@@ -1,0 +1,320 @@
+// The streamrt command end to end (the binary is STREAMRT_BINARY): exit codes, one-line
+// errors, --check, output-path checks before rendering, limits, and Ctrl-C.
+#include <doctest/doctest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Dir {
+    fs::path path;
+    Dir() {
+        static int counter = 0;
+        path = fs::temp_directory_path() /
+               ("streamrt_cli_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~Dir() {
+        std::error_code ec;
+        fs::permissions(path, fs::perms::owner_all, fs::perm_options::add, ec);
+        fs::remove_all(path, ec);
+    }
+    fs::path write(const std::string& name, const std::string& text) const {
+        std::ofstream(path / name, std::ios::binary) << text;
+        return path / name;
+    }
+    std::vector<std::string> files() const {
+        std::vector<std::string> out;
+        for (const auto& e : fs::directory_iterator(path)) out.push_back(e.path().filename().string());
+        return out;
+    }
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+struct Run {
+    int code = -1;
+    std::string out, err;
+};
+
+/// Runs streamrt with `args` (already shell-quoted), capturing stdout and stderr.
+Run streamrt(const std::string& args) {
+    static int counter = 0;
+    const fs::path base = fs::temp_directory_path() /
+                          ("streamrt_cli_io_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    const std::string cmd = std::string("'") + STREAMRT_BINARY + "' " + args + " >'" + base.string() +
+                            ".out' 2>'" + base.string() + ".err'";
+    const int status = std::system(cmd.c_str());
+    Run r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = slurp(base.string() + ".out");
+    r.err = slurp(base.string() + ".err");
+    fs::remove(base.string() + ".out");
+    fs::remove(base.string() + ".err");
+    return r;
+}
+
+std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
+
+/// One line on stderr, "streamrt: " then the message.
+void check_one_line_error(const Run& r, const std::string& needle) {
+    INFO("stderr: ", r.err);
+    CHECK(r.err.rfind("streamrt: ", 0) == 0);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK(r.err.find(needle) != std::string::npos);
+}
+
+const char* kSmallScene =
+    "image width=32 height=24 spp=1 depth=2 degree=5 output=out.png\n"
+    "camera eye=0,1,6 look=0,0,0\n"
+    "light point pos=5,8,5\n"
+    "sphere color=1,0,0\n";
+
+}  // namespace
+
+TEST_CASE("cli: --check validates a scene without rendering") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kSmallScene);
+    const Run ok = streamrt("--check " + q(scene) + " -o " + q(d.path / "x.png"));
+    CHECK(ok.code == 0);
+    CHECK(ok.out.find("ok (1 objects, 1 lights, 32x24") != std::string::npos);
+    CHECK(!fs::exists(d.path / "x.png"));
+    CHECK(d.files().size() == 1);  // no probe file left behind
+
+    const fs::path bad = d.write("bad.cfg", "image width=32\nsphere radius=2\n");
+    const Run r = streamrt("--check " + q(bad));
+    CHECK(r.code == 2);
+    check_one_line_error(r, bad.string() + ":2:8: unknown key 'radius' for 'sphere' (expected one of:");
+
+    const Run missing = streamrt("--check " + q(d.path / "nope.cfg"));
+    CHECK(missing.code == 2);
+    check_one_line_error(missing, "nope.cfg: cannot open scene file");
+
+    for (const auto& name : {"whitted.cfg", "shapes.cfg", "cornell.cfg", "random_spheres.cfg"}) {
+        const Run s = streamrt("--check -q " + q(fs::path(STREAMRT_SOURCE_DIR) / "scenes" / name) + " -o " +
+                               q(d.path / "o.png"));
+        INFO(name, ": ", s.err);
+        CHECK(s.code == 0);
+    }
+}
+
+TEST_CASE("cli: bad command lines are one-line errors with exit status 2") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kSmallScene);
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"--width 1000000000", "--width"}, {"--width 1e9", "--width"},   {"--height 0", "--height"},
+        {"--depth 1000000", "--depth"},    {"--spp 100000000", "--spp"}, {"--degree 6", "--degree"},
+        {"--engine gpu", "--engine"},      {"-j 0", "--jobs"},           {"--no-such-option", "no-such-option"},
+    };
+    for (const auto& [args, needle] : cases) {
+        const Run r = streamrt("--check " + q(scene) + " " + args);
+        INFO(args);
+        CHECK(r.code == 2);
+        check_one_line_error(r, needle);
+    }
+    const Run none = streamrt("");
+    CHECK(none.code == 2);
+    check_one_line_error(none, "scene is required");
+}
+
+TEST_CASE("cli: absurd scene values are refused with their location") {
+    Dir d;
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"image width=1e9\n", ":1:13: 'width' must be in [1, 32768], got '1e9'"},
+        {"image depth=1000000\n", ":1:13: 'depth' must be in [0, 256]"},
+        {"image spp=1e8\n", ":1:11: 'spp' must be in [1, 65536]"},
+        {"image height=32769\n", ":1:14: 'height' must be in [1, 32768]"},
+    };
+    for (const auto& [text, needle] : cases) {
+        const fs::path scene = d.write("s.cfg", text);
+        const Run r = streamrt("--check " + q(scene));
+        INFO(text);
+        CHECK(r.code == 2);
+        check_one_line_error(r, scene.string() + needle);
+    }
+}
+
+TEST_CASE("cli: a render that cannot fit in memory is refused before it starts") {
+    Dir d;
+    // Glass that both reflects and transmits at depth 256: up to 2^256 rays per primary ray.
+    const fs::path scene = d.write("deep.cfg",
+                                   "image width=64 height=64 depth=256 degree=5\n"
+                                   "material glass refl=0.5 trans=0.5 ior=1.5\nsphere material=glass\n");
+    const Run r = streamrt(q(scene) + " -o " + q(d.path / "deep.png"));
+    CHECK(r.code == 2);
+    check_one_line_error(r, "would need about");
+    CHECK(r.err.find("2^256") != std::string::npos);
+    CHECK(r.err.find("but this machine has") != std::string::npos);
+    CHECK(!fs::exists(d.path / "deep.png"));
+    // The same scene is fine for the recursive engine (its memory does not grow with 2^depth)...
+    const Run rec = streamrt("--check --engine recursive " + q(scene) + " -o " + q(d.path / "deep.png"));
+    CHECK(rec.code == 0);
+    // ...and for the stream engine at a sane depth.
+    const Run shallow = streamrt("--check --depth 5 " + q(scene) + " -o " + q(d.path / "deep.png"));
+    CHECK(shallow.code == 0);
+}
+
+TEST_CASE("cli: output path mistakes are caught before rendering, nothing is created") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kSmallScene);
+    SUBCASE("missing folder") {
+        const fs::path out = d.path / "no" / "such" / "x.png";
+        const Run r = streamrt(q(scene) + " -o " + q(out));
+        CHECK(r.code == 2);
+        check_one_line_error(r, "output folder '" + (d.path / "no" / "such").string() + "' does not exist");
+        CHECK(!fs::exists(d.path / "no"));
+    }
+    SUBCASE("read-only folder") {
+        // root may write anywhere permissions say otherwise; /proc refuses new files even to root.
+        fs::path ro = "/proc";
+        if (::geteuid() != 0) {
+            ro = d.path / "ro";
+            fs::create_directories(ro);
+            fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+        }
+        const Run r = streamrt(q(scene) + " -o " + q(ro / "x.png"));
+        CHECK(r.code == 2);
+        check_one_line_error(r, "output folder '" + ro.string() + "' is not writable");
+        CHECK(!fs::exists(ro / "x.png"));
+    }
+    SUBCASE("the scene file itself") {
+        const fs::path same = d.write("same.ppm", kSmallScene);
+        const Run r = streamrt(q(same) + " -o " + q(same));
+        CHECK(r.code == 2);
+        check_one_line_error(r, "is the scene file itself");
+        CHECK(slurp(same) == kSmallScene);
+    }
+    SUBCASE("a folder") {
+        fs::create_directories(d.path / "dir.png");
+        const Run r = streamrt(q(scene) + " -o " + q(d.path / "dir.png"));
+        CHECK(r.code == 2);
+        check_one_line_error(r, "is a folder");
+    }
+    SUBCASE("unknown format") {
+        const Run r = streamrt(q(scene) + " -o " + q(d.path / "x.jpg"));
+        CHECK(r.code == 2);
+        check_one_line_error(r, "unknown image format");
+        CHECK(!fs::exists(d.path / "x.jpg"));
+    }
+}
+
+TEST_CASE("cli: a render writes the image and leaves no temporary file") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kSmallScene);
+    for (const std::string ext : {".png", ".ppm", ".pfm"}) {
+        const fs::path out = d.path / ("img" + ext);
+        const Run r = streamrt("-q -j1 " + q(scene) + " -o " + q(out));
+        INFO(ext, ": ", r.err);
+        CHECK(r.code == 0);
+        CHECK(fs::file_size(out) > 100);
+    }
+    CHECK(d.files().size() == 4);  // the scene and the three images, nothing else
+}
+
+namespace {
+
+/// Starts streamrt with argv in a child (stdout and stderr to `log`), returns its pid.
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+    std::fflush(nullptr);  // or the child would flush our buffered output again
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        if (!std::freopen(log.c_str(), "w", stderr) || !std::freopen("/dev/null", "w", stdout)) ::_exit(99);
+        std::vector<char*> argv;
+        argv.push_back(const_cast<char*>(STREAMRT_BINARY));
+        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        ::execv(STREAMRT_BINARY, argv.data());
+        ::_exit(98);
+    }
+    return pid;
+}
+
+/// Waits up to `limit` for the child; returns its wait status, or -1 (and kills it) on timeout.
+int wait_for(pid_t pid, std::chrono::milliseconds limit, std::chrono::milliseconds& took) {
+    const auto start = std::chrono::steady_clock::now();
+    int status = 0;
+    for (;;) {
+        const pid_t done = ::waitpid(pid, &status, WNOHANG);
+        took = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start);
+        if (done == pid) return status;
+        if (took > limit) {
+            ::kill(pid, SIGKILL);
+            ::waitpid(pid, &status, 0);
+            return -1;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+}
+
+// Long enough that it is still rendering after 0.3 s on any machine (and under sanitizers).
+const char* kLongScene =
+    "image width=2048 height=2048 spp=64 depth=8 degree=5 output=long.png\n"
+    "camera eye=0,1,6 look=0,0,0\n"
+    "light point pos=5,8,5\nlight point pos=-5,8,5\n"
+    "material glass refl=0.3 trans=0.6 ior=1.5\n"
+    "sphere material=glass\ncube translate=2,0,0 refl=0.5\nplane translate=0,-1,0 checker=0,0,0\n";
+
+// The promise is one second. ThreadSanitizer slows the renderer 5-15 times and delivers a
+// signal only when the thread next enters an intercepted call, so its build gets 5 s.
+#if defined(__SANITIZE_THREAD__)
+constexpr std::chrono::milliseconds kStopLimit{5000};
+#else
+constexpr std::chrono::milliseconds kStopLimit{1000};
+#endif
+
+}  // namespace
+
+TEST_CASE("cli: Ctrl-C stops a render within a second, exit 130, no image and no temporary file") {
+    for (const std::string engine : {"stream", "recursive"}) {
+        Dir d;
+        const fs::path scene = d.write("long.cfg", kLongScene);
+        const fs::path out = d.path / "long.png";
+        const pid_t pid = spawn({"-j2", "--engine", engine, scene.string(), "-o", out.string()}, d.path / "log");
+        REQUIRE(pid > 0);
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        REQUIRE(::kill(pid, SIGINT) == 0);
+        std::chrono::milliseconds took{0};
+        const int status = wait_for(pid, kStopLimit, took);
+        const std::string err = slurp(d.path / "log");
+        INFO(engine, ": stopped after ", took.count(), " ms; stderr: ", err);
+        REQUIRE(status != -1);
+        CHECK(WIFEXITED(status));
+        CHECK(WEXITSTATUS(status) == 130);
+        CHECK(err == "streamrt: interrupted, no image written\n");
+        CHECK(!fs::exists(out));
+        fs::remove(d.path / "log");
+        CHECK(d.files() == std::vector<std::string>{"long.cfg"});
+    }
+}
+
+TEST_CASE("cli: a killed render leaves no image and no temporary file") {
+    Dir d;
+    const fs::path scene = d.write("long.cfg", kLongScene);
+    const pid_t pid = spawn({"-j2", scene.string(), "-o", (d.path / "long.png").string()}, "/dev/null");
+    REQUIRE(pid > 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    ::kill(pid, SIGKILL);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    CHECK(WIFSIGNALED(status));
+    CHECK(d.files() == std::vector<std::string>{"long.cfg"});
+}

@@ -1,0 +1,30 @@
+#pragma once
+// The small set of scene files the fuzz target's inputs may `include` by name; the
+// regression test (tests/scene/fuzz_regressions_test.cpp) rebuilds the same tree so every
+// saved input runs exactly as it did under the fuzzer.
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace streamrt_fuzz {
+
+inline void write_file(const std::filesystem::path& p, const std::string& text) {
+    std::ofstream(p, std::ios::binary) << text;
+}
+
+// A valid fragment, a chain, a self-cycle, a mutual cycle, a file with an error, a file in a
+// sub-folder going back up, an empty file, a file including itself after two others.
+inline void make_include_tree(const std::filesystem::path& dir) {
+    std::filesystem::create_directories(dir / "sub");
+    write_file(dir / "a.cfg", "material m color=1,0,0 refl=0.5 trans=0.5 ior=1.5\nlight point pos=0,5,0\n");
+    write_file(dir / "b.cfg", "include a.cfg\nimage width=8 height=8\n");
+    write_file(dir / "self.cfg", "include self.cfg\n");
+    write_file(dir / "c1.cfg", "include c2.cfg\n");
+    write_file(dir / "c2.cfg", "include c1.cfg\n");
+    write_file(dir / "bad.cfg", "sphere scale=0\n");
+    write_file(dir / "empty.cfg", "");
+    write_file(dir / "sub" / "up.cfg", "include ../a.cfg\ncamera eye=0,0,5 look=0,0,0\n");
+    write_file(dir / "twice.cfg", "include empty.cfg\ninclude empty.cfg\ninclude twice.cfg\n");
+}
+
+}  // namespace streamrt_fuzz

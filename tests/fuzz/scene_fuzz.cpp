@@ -1,0 +1,54 @@
+// libFuzzer target for the whole load-validate path: parse_scene() on arbitrary bytes (with
+// `include` resolved inside a private temporary folder holding a few small scene files,
+// tests/fuzz/include_tree.h), then the checks the command line makes before rendering
+// (camera placement for the image size, the memory estimate). Built and run by
+// scripts/fuzz.sh. Beyond "no crash, no sanitizer report" it asserts the parser's contract
+// (tests/fuzz/scene_contract.h) and aborts when it is broken.
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "fuzz/include_tree.h"
+#include "fuzz/scene_contract.h"
+
+namespace {
+namespace fs = std::filesystem;
+std::string g_name;  // the fuzz input's file name, inside the temporary folder
+
+void require(const std::string& broken) {
+    if (broken.empty()) return;
+    std::fprintf(stderr, "scene_fuzz: contract broken: %s\n", broken.c_str());
+    std::abort();
+}
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+    char tmpl[] = "/tmp/streamrt_fuzz_XXXXXX";
+    if (!::mkdtemp(tmpl)) std::abort();
+    static const fs::path dir(tmpl);
+    streamrt_fuzz::make_include_tree(dir);
+    std::atexit([] {
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+    });
+    // Relative includes resolve against the input's folder (the working directory is left
+    // alone: libFuzzer writes its artifacts relative to it).
+    g_name = (dir / "input.cfg").string();
+    return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    const std::string_view text(reinterpret_cast<const char*>(data), size);
+    try {
+        const streamrt::Scene sc = streamrt::parse_scene(text, g_name);
+        require(streamrt_fuzz::check_scene(sc));
+    } catch (const streamrt::SceneError& e) {
+        require(streamrt_fuzz::check_error(e));
+    }
+    return 0;
+}
