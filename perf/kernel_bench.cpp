@@ -11,12 +11,14 @@
 // box, so about half of them hit. Counters:
 //   rays/s        rays through the kernel per second (each ray tested against every object)
 //   tests/s       ray-object tests per second (rays/s x objects)
-//   cycles/test   TSC cycles per ray-object test (the TSC runs at the nominal frequency,
-//                 see "tsc_ghz" in the context; turbo makes the true core cycles higher)
+//   cycles/test   CPU time per ray-object test x the TSC frequency ("tsc_ghz" in the context,
+//                 the nominal clock; turbo makes the true core cycles somewhat higher)
 // BM_arith_limit/<isa>: the sphere kernel's floating-point mix (perf/arith_limit.h) on
 // independent chains: the most ray-sphere tests per second the arithmetic units can do.
 #include <benchmark/benchmark.h>
 #include <x86intrin.h>
+
+#include <time.h>
 
 #include <chrono>
 #include <cmath>
@@ -33,6 +35,14 @@
 using namespace streamrt;
 
 namespace {
+
+/// This thread's CPU time in seconds: cycles are counted on it, not on the wall clock, so that
+/// time spent descheduled on a shared machine does not count.
+double thread_cpu_seconds() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 double measure_tsc_ghz() {
     const auto t0 = std::chrono::steady_clock::now();
@@ -104,7 +114,7 @@ void BM_kernel(benchmark::State& state, Isa isa, ShapeKind kind, bool closest) {
     const ClosestHitFn ch = kt.closest[int(kind)];
     const AnyHitFn ah = kt.any[int(kind)];
     RayView v = view_of(f.rays);
-    const unsigned long long c0 = __rdtsc();
+    const double c0 = thread_cpu_seconds();
     for (auto _ : state) {
         std::copy(f.t_max0.begin(), f.t_max0.end(), f.rays.t_max.begin());  // a fresh packet each time
         if (closest) ch(v, f.object.data(), f.objs.data(), n_objs);
@@ -112,7 +122,7 @@ void BM_kernel(benchmark::State& state, Isa isa, ShapeKind kind, bool closest) {
         benchmark::DoNotOptimize(f.rays.t_max.data());
         benchmark::ClobberMemory();
     }
-    const double cycles = double(__rdtsc() - c0);
+    const double cycles = (thread_cpu_seconds() - c0) * tsc_ghz() * 1e9;
     const double rays = double(state.iterations()) * double(n_rays);
     state.counters["rays/s"] = benchmark::Counter(rays, benchmark::Counter::kIsRate);
     state.counters["tests/s"] = benchmark::Counter(rays * double(n_objs), benchmark::Counter::kIsRate);
@@ -122,9 +132,9 @@ void BM_kernel(benchmark::State& state, Isa isa, ShapeKind kind, bool closest) {
 
 void BM_arith_limit(benchmark::State& state, perf::MixRunner r) {
     const std::int64_t tests = 8 * 1024;  // packets of W lanes per call
-    const unsigned long long c0 = __rdtsc();
+    const double c0 = thread_cpu_seconds();
     for (auto _ : state) benchmark::DoNotOptimize(r.run(tests, perf::kSphereFma, perf::kSphereDiv, perf::kSphereSqrt));
-    const double cycles = double(__rdtsc() - c0);
+    const double cycles = (thread_cpu_seconds() - c0) * tsc_ghz() * 1e9;
     const double lane_tests = double(state.iterations()) * double(tests) * r.lanes;
     state.counters["tests/s"] = benchmark::Counter(lane_tests, benchmark::Counter::kIsRate);
     state.counters["cycles/test"] = cycles / lane_tests;
@@ -137,9 +147,9 @@ void BM_arith_limit(benchmark::State& state, perf::MixRunner r) {
 void BM_fma_peak(benchmark::State& state, perf::MixRunner r) {
     const std::int64_t tests = 8 * 1024;
     const int n = 64;
-    const unsigned long long c0 = __rdtsc();
+    const double c0 = thread_cpu_seconds();
     for (auto _ : state) benchmark::DoNotOptimize(r.run(tests, n, 0, 0));
-    const double cycles = double(__rdtsc() - c0);
+    const double cycles = (thread_cpu_seconds() - c0) * tsc_ghz() * 1e9;
     const double lane_fmas = double(state.iterations()) * double(tests) * n * r.lanes;
     state.counters["fma/s"] = benchmark::Counter(lane_fmas, benchmark::Counter::kIsRate);
     state.counters["vec_fma/cycle"] = lane_fmas / r.lanes / cycles;
