@@ -11,7 +11,7 @@ stratified, made once and cached in BUILD/perf/reference/. Writes
   BUILD/perf/error_vs_time.csv     scene, engine, sampler, spp, seconds, rmse, psnr, relmse
   BUILD/perf/precision.csv         scene, sampler, spp, stream-vs-recursive rmse/psnr/relmse at
                                    equal spp and equal samples: what single precision costs
-and, when matplotlib is there (/usr/bin/python3), one log-log plot per scene into docs/img/
+(BUILD/perf-quick/ with --quick) and, when matplotlib is there (/usr/bin/python3), one log-log plot per scene into docs/img/
 (scripts/plot_perf.py --errors draws them again from the CSV).
 Seconds are streamrt's render clock (-j as given, default 2), median of --runs.
 """
@@ -30,24 +30,25 @@ ENGINES = ("stream", "recursive")
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--quick", action="store_true", help="one scene, spp up to 16, 240x135: a smoke run")
+    ap.add_argument("--quick", action="store_true", help="one scene, spp up to 16, 160x90, 128 spp reference: a smoke run")
     ap.add_argument("--scenes", help="comma-separated scene files (default whitted, shapes, cornell)")
     ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"))
-    ap.add_argument("--width", type=int, help="default 480 (quick 240)")
-    ap.add_argument("--height", type=int, help="default 270 (quick 135)")
+    ap.add_argument("--width", type=int, help="default 320 (quick 160)")
+    ap.add_argument("--height", type=int, help="default 180 (quick 90)")
     ap.add_argument("--max-spp", type=int, help="default 64 (quick 16)")
-    ap.add_argument("--ref-spp", type=int, default=1024, help="reference spp (default 1024)")
+    ap.add_argument("--ref-spp", type=int, help="reference spp (default 512, quick 128)")
     ap.add_argument("-j", "--jobs", type=int, default=2)
     ap.add_argument("--runs", type=int, default=1, help="timed renders per point (median)")
     ap.add_argument("--img", default=os.path.join(pc.ROOT, "docs", "img"), help="where the plots go")
     args = ap.parse_args(argv)
-    w = args.width or (240 if args.quick else 480)
-    h = args.height or (135 if args.quick else 270)
+    w = args.width or (160 if args.quick else 320)
+    h = args.height or (90 if args.quick else 180)
+    args.ref_spp = args.ref_spp or (128 if args.quick else 512)
     max_spp = args.max_spp or (16 if args.quick else 64)
     names = args.scenes.split(",") if args.scenes else (
         ["scenes/whitted.cfg"] if args.quick else ["scenes/whitted.cfg", "scenes/shapes.cfg", "scenes/cornell.cfg"])
     exe = pc.binary(args.build)
-    out_dir = os.path.join(args.build, "perf")
+    out_dir = os.path.join(args.build, "perf-quick" if args.quick else "perf")
     ref_dir = os.path.join(out_dir, "reference")
     img_dir = os.path.join(out_dir, "evt-images")
     for d in (ref_dir, img_dir):
