@@ -5,7 +5,8 @@ Debian's python3-matplotlib: run with /usr/bin/python3).
 usage: /usr/bin/python3 scripts/plot_perf.py [--results build/perf/results.json]
                                              [--errors build/perf/error_vs_time.csv] [--img docs/img]
 Writes scaling_resolution.png, scaling_objects.png, scaling_threads.png (from results.json)
-and evt_<scene>.png (from error_vs_time.csv) into --img.
+evt_<scene>.png (from error_vs_time.csv) and kernels_sphere.png (from perf/kernel_bench's JSON,
+whose summary table is printed in Markdown) into --img.
 """
 import argparse
 import csv
@@ -119,10 +120,77 @@ def plot_results(json_path, img_dir, suffix=""):
     return out
 
 
+def kernel_rows(json_path):
+    """Google Benchmark JSON of perf/kernel_bench -> (kernel rows, limits per isa, context)."""
+    data = json.load(open(json_path))
+    rows, limits, peaks = [], {}, {}
+    for b in data["benchmarks"]:
+        parts = b["name"].split("/")
+        if parts[0] == "BM_kernel":
+            args = dict(p.split(":") for p in parts[4:])
+            rows.append(dict(shape=parts[1], mode=parts[2], isa=parts[3], rays=int(args["rays"]),
+                             objs=int(args["objs"]), tests=b["tests/s"], rays_s=b["rays/s"], cycles=b["cycles/test"]))
+        elif parts[0] == "BM_arith_limit":
+            limits[parts[1]] = (b["tests/s"], b["cycles/test"])
+        elif parts[0] == "BM_fma_peak":
+            peaks[parts[1]] = (b["fma/s"], b["vec_fma/cycle"])
+    return rows, limits, peaks, data.get("context", {})
+
+
+def kernel_markdown(json_path):
+    rows, limits, peaks, ctx = kernel_rows(json_path)
+    isas = [i for i in ("sse2", "sse4.2", "avx2", "avx512") if i in limits]
+    out = ["TSC %.2f GHz. Arithmetic limit of the sphere test (BM_arith_limit) and FMA peak (BM_fma_peak):" %
+           float(ctx.get("tsc_ghz", "0")), "",
+           "| isa | FMA peak (G lane-FMA/s) | vector FMA / TSC cycle | sphere-test limit (M tests/s) | cycles/test |",
+           "|---|---|---|---|---|"]
+    for i in isas:
+        out.append("| %s | %.1f | %.2f | %.0f | %.2f |" % (i, peaks[i][0] / 1e9, peaks[i][1], limits[i][0] / 1e6,
+                                                          limits[i][1]))
+    out += ["", "Closest-hit kernels, M ray-object tests/s (cycles/test), 4096 rays x 8 objects; "
+            "in brackets 16 rays x 1 object:", "",
+            "| shape | " + " | ".join(isas) + " |", "|---|" + "---|" * len(isas)]
+    for shape in ("sphere", "cube", "cylinder", "cone", "torus", "plane"):
+        cells = []
+        for i in isas:
+            big = [r for r in rows if r["shape"] == shape and r["isa"] == i and r["mode"] == "closest"
+                   and r["rays"] == 4096 and r["objs"] == 8]
+            small = [r for r in rows if r["shape"] == shape and r["isa"] == i and r["mode"] == "closest"
+                     and r["rays"] == 16 and r["objs"] == 1]
+            cells.append("%.0f (%.1f) [%.0f]" % (big[0]["tests"] / 1e6, big[0]["cycles"], small[0]["tests"] / 1e6)
+                         if big and small else "")
+        out.append("| %s | %s |" % (shape, " | ".join(cells)))
+    return "\n".join(out)
+
+
+def plot_kernels(json_path, img_dir, suffix=""):
+    rows, limits, _, _ = kernel_rows(json_path)
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    colors = {"sse2": "tab:gray", "sse4.2": "tab:olive", "avx2": "tab:green", "avx512": "tab:purple"}
+    for isa, col in colors.items():
+        for objs, style in ((8, "-"), (1, ":")):
+            pts = sorted((r["rays"], r["tests"]) for r in rows if r["shape"] == "sphere" and r["mode"] == "closest"
+                         and r["isa"] == isa and r["objs"] == objs)
+            if pts:
+                ax.plot([p[0] for p in pts], [p[1] / 1e6 for p in pts], style, marker="o", markersize=3, color=col,
+                        label="%s, %d obj" % (isa, objs))
+        if isa in limits:
+            ax.axhline(limits[isa][0] / 1e6, color=col, linestyle="--", linewidth=0.8)
+    ax.set_xscale("log", base=2)
+    ax.set_xlabel("rays per call (packet stream)")
+    ax.set_ylabel("M ray-sphere tests/s (one core)")
+    ax.set_title("sphere closest-hit kernel; dashed: arithmetic limit")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    return [_save(fig, os.path.join(img_dir, "kernels_sphere%s.png" % suffix))]
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description="Plot perf-suite results and error-vs-time sweeps.")
     ap.add_argument("--results", default=os.path.join(ROOT, "build", "perf", "results.json"))
     ap.add_argument("--errors", default=os.path.join(ROOT, "build", "perf", "error_vs_time.csv"))
+    ap.add_argument("--kernels", default=os.path.join(ROOT, "build", "perf", "kernels.json"),
+                    help="perf/kernel_bench --benchmark_out JSON (a summary table is printed)")
     ap.add_argument("--img", default=os.path.join(ROOT, "docs", "img"))
     ap.add_argument("--suffix", default="", help="appended to each PNG name")
     args = ap.parse_args(argv)
@@ -131,6 +199,9 @@ def main(argv=None):
         made += plot_results(args.results, args.img, args.suffix)
     if os.path.exists(args.errors):
         made += plot_errors(args.errors, args.img, args.suffix)
+    if os.path.exists(args.kernels):
+        made += plot_kernels(args.kernels, args.img, args.suffix)
+        print(kernel_markdown(args.kernels))
     for p in made:
         print("plot:", p)
     if not made:
