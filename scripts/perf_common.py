@@ -127,11 +127,20 @@ def image_error(image_path, reference_path):
     return {"rmse": math.sqrt(mse), "psnr": psnr, "relmse": rel}
 
 
+_in_child = False
+
+
 def sphere_scene(n, path, width=1280, height=720, spp=1, depth=4, seed=1):
     """N spheres on a jittered grid over a square field (the layout of random_spheres.py,
     without its quadratic overlap search, so that N = 1e6 takes seconds), a checkered plane,
     two point lights, a camera looking down at the whole field. Written once, then reused."""
     if os.path.exists(path):
+        return path
+    if not _in_child:
+        # Written by a child process: a parent grown by a 1e6-line scene would pass its
+        # resident size on to every streamrt it forks, and wait4's peak RSS would show it.
+        subprocess.run([sys.executable, "-B", os.path.abspath(__file__), "spheres", str(n), path, str(width),
+                        str(height), str(spp), str(depth), str(seed)], check=True)
         return path
     import random
     rng = random.Random(seed)
@@ -194,3 +203,9 @@ def machine_info():
 
 def median(xs):
     return statistics.median(xs)
+
+
+if __name__ == "__main__" and len(sys.argv) == 9 and sys.argv[1] == "spheres":
+    _in_child = True
+    a = sys.argv
+    sphere_scene(int(a[2]), a[3], int(a[4]), int(a[5]), int(a[6]), int(a[7]), int(a[8]))
