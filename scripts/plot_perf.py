@@ -165,6 +165,7 @@ def kernel_markdown(json_path):
 
 def plot_kernels(json_path, img_dir, suffix=""):
     rows, limits, _, _ = kernel_rows(json_path)
+    os.makedirs(img_dir, exist_ok=True)
     fig, ax = plt.subplots(figsize=(6.4, 4.0))
     colors = {"sse2": "tab:gray", "sse4.2": "tab:olive", "avx2": "tab:green", "avx512": "tab:purple"}
     for isa, col in colors.items():
