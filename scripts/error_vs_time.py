@@ -1,0 +1,113 @@
+#!/usr/bin/env python3
+"""Image error against render time, both engines, three sampling patterns
+(docs/performance.md, "Error against run time").
+
+usage: /usr/bin/python3 scripts/error_vs_time.py [--quick] [--scenes a.cfg,b.cfg] [--build DIR]
+
+For each scene, renders spp = 1, 2, 4, ... 64 with the stream and the recursive engine and
+each sampler (grid, stratified, random), and measures each image against a converged
+reference: the recursive (double precision) engine at --ref-spp samples per pixel,
+stratified, made once and cached in BUILD/perf/reference/. Writes
+  BUILD/perf/error_vs_time.csv     scene, engine, sampler, spp, seconds, rmse, psnr, relmse
+  BUILD/perf/precision.csv         scene, sampler, spp, stream-vs-recursive rmse/psnr/relmse at
+                                   equal spp and equal samples: what single precision costs
+(BUILD/perf-quick/ with --quick) and, when matplotlib is there (/usr/bin/python3), one log-log plot per scene into docs/img/
+(scripts/plot_perf.py --errors draws them again from the CSV).
+Seconds are streamrt's render clock (-j as given, default 2), median of --runs.
+"""
+import argparse
+import csv
+import os
+import sys
+import time
+
+sys.dont_write_bytecode = True  # no __pycache__ in scripts/
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import perf_common as pc  # noqa: E402
+
+SAMPLERS = ("grid", "stratified", "random")
+ENGINES = ("stream", "recursive")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="one scene, spp up to 16, 160x90, 128 spp reference: a smoke run")
+    ap.add_argument("--scenes", help="comma-separated scene files (default whitted, shapes, cornell)")
+    ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"))
+    ap.add_argument("--width", type=int, help="default 320 (quick 160)")
+    ap.add_argument("--height", type=int, help="default 180 (quick 90)")
+    ap.add_argument("--max-spp", type=int, help="default 64 (quick 16)")
+    ap.add_argument("--ref-spp", type=int, help="reference spp (default 512, quick 128)")
+    ap.add_argument("-j", "--jobs", type=int, default=2)
+    ap.add_argument("--runs", type=int, default=1, help="timed renders per point (median)")
+    ap.add_argument("--img", default=os.path.join(pc.ROOT, "docs", "img"), help="where the plots go")
+    args = ap.parse_args(argv)
+    w = args.width or (160 if args.quick else 320)
+    h = args.height or (90 if args.quick else 180)
+    args.ref_spp = args.ref_spp or (128 if args.quick else 512)
+    max_spp = args.max_spp or (16 if args.quick else 64)
+    names = args.scenes.split(",") if args.scenes else (
+        ["scenes/whitted.cfg"] if args.quick else ["scenes/whitted.cfg", "scenes/shapes.cfg", "scenes/cornell.cfg"])
+    exe = pc.binary(args.build)
+    out_dir = os.path.join(args.build, "perf-quick" if args.quick else "perf")
+    ref_dir = os.path.join(out_dir, "reference")
+    img_dir = os.path.join(out_dir, "evt-images")
+    for d in (ref_dir, img_dir):
+        os.makedirs(d, exist_ok=True)
+    spps = []
+    s = 1
+    while s <= max_spp:
+        spps.append(s)
+        s *= 2
+    t0 = time.time()
+    rows, prec = [], []
+    for name in names:
+        path = name if os.path.isabs(name) else os.path.join(pc.ROOT, name)
+        base = os.path.splitext(os.path.basename(path))[0]
+        ref = os.path.join(ref_dir, "%s_%dx%d_%dspp.pfm" % (base, w, h, args.ref_spp))
+        if not os.path.exists(ref):
+            print("reference: %s, recursive engine, %d spp, stratified ..." % (base, args.ref_spp), flush=True)
+            tmp = ref + ".tmp.pfm"
+            pc.run_streamrt(exe, path, tmp, engine="recursive", jobs=args.jobs, spp=args.ref_spp, width=w, height=h,
+                            sampler="stratified")
+            os.replace(tmp, ref)
+        pc.run_streamrt(exe, path, os.path.join(img_dir, "warm.pfm"), jobs=args.jobs, spp=1, width=w, height=h)
+        for sampler in SAMPLERS:
+            for spp in spps:
+                imgs = {}
+                for engine in ENGINES:
+                    out = os.path.join(img_dir, "%s_%s.pfm" % (base, engine))
+                    secs = [pc.run_streamrt(exe, path, out, engine=engine, jobs=args.jobs, spp=spp, width=w, height=h,
+                                            sampler=sampler)["seconds"] for _ in range(args.runs)]
+                    e = pc.image_error(out, ref)
+                    imgs[engine] = out
+                    rows.append(dict(scene=base, engine=engine, sampler=sampler, spp=spp, seconds=pc.median(secs), **e))
+                    print("[%5.0fs] %-8s %-9s %-10s spp %-3d %7.3f s  rmse %.5f  psnr %5.2f dB  relmse %.5f" % (
+                        time.time() - t0, base, engine, sampler, spp, rows[-1]["seconds"], e["rmse"], e["psnr"],
+                        e["relmse"]), flush=True)
+                d = pc.image_error(imgs["stream"], imgs["recursive"])
+                prec.append(dict(scene=base, sampler=sampler, spp=spp, **d))
+    fields = ["scene", "engine", "sampler", "spp", "seconds", "rmse", "psnr", "relmse"]
+    csv_path = os.path.join(out_dir, "error_vs_time.csv")
+    with open(csv_path, "w", newline="") as f:
+        wr = csv.DictWriter(f, fieldnames=fields)
+        wr.writeheader()
+        wr.writerows(rows)
+    with open(os.path.join(out_dir, "precision.csv"), "w", newline="") as f:
+        wr = csv.DictWriter(f, fieldnames=["scene", "sampler", "spp", "rmse", "psnr", "relmse"])
+        wr.writeheader()
+        wr.writerows(prec)
+    print("wrote %s and precision.csv (%dx%d, reference %d spp, -j%d) in %.0f s" % (
+        csv_path, w, h, args.ref_spp, args.jobs, time.time() - t0))
+    try:
+        import plot_perf
+    except ImportError as exc:
+        print("no plots (%s): run /usr/bin/python3 scripts/plot_perf.py --errors %s" % (exc, csv_path))
+        return 0
+    for p in plot_perf.plot_errors(csv_path, args.img, suffix="-quick" if args.quick else ""):
+        print("plot:", p)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
