@@ -50,30 +50,40 @@ inline mask_t<V> finite(const V& a) {
 /// fn(b) the other sign. fn(x, f, df) evaluates the function and its derivative. Newton steps
 /// are taken when they stay in the (shrinking) bracket and at least halve the previous step,
 /// otherwise the bracket is bisected. Returns the evaluated point with the smallest |f|.
+///
+/// A lane stops (is frozen, its values no longer updated) once its step falls to a few ulps;
+/// the loop ends when every lane has stopped or after `iters` steps. Freezing rather than
+/// merely exiting makes a lane's answer independent of its neighbours: a ray gets the same
+/// bits alone (V = double) as in any batch.
 template <class V, class Fn>
 inline V bracket_solve(V a, V b, const mask_t<V>& neg_a, Fn&& fn, int iters) {
+    using S = simd::scalar_t<V>;
+    const V tol(S(8) * std::numeric_limits<S>::epsilon());
     V x = (a + b) * V(0.5);
     V step_old = simd::abs(b - a);
     V best = x;
     V best_f = inf_v<V>();
+    mask_t<V> live = x == x || x != x;  // every lane
     for (int i = 0; i < iters; ++i) {
         V f, df;
         fn(x, f, df);
         const V af = simd::abs(f);
-        const auto better = af < best_f;
+        const auto better = live & (af < best_f);
         best = simd::select(better, x, best);
         best_f = simd::select(better, af, best_f);
         // Same sign as at a: the root lies right of x.
-        // mask_xor, not ^ or != on masks (xsimd 8.1 gets both wrong on some levels; lanes.h).
         const auto right = !simd::mask_xor(f < V(0), neg_a);
-        a = simd::select(right, x, a);
-        b = simd::select(right, b, x);
+        a = simd::select(live & right, x, a);
+        b = simd::select(live & !right, x, b);
         const V step = f / df;
         const V xn = x - step;
         const auto newton_ok = (xn >= a) & (xn <= b) & (simd::abs(step) * V(2) <= step_old);
         const V xnew = simd::select(newton_ok, xn, (a + b) * V(0.5));
-        step_old = simd::abs(xnew - x);
-        x = xnew;
+        const V moved = simd::abs(xnew - x);
+        step_old = simd::select(live, moved, step_old);
+        x = simd::select(live, xnew, x);
+        live = live & (moved > tol * simd::abs(x));  // NaN steps stop too
+        if (!simd::any(live)) break;
     }
     V f, df;
     fn(x, f, df);
