@@ -231,16 +231,7 @@ void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object
             }
             push_sorted(stack, sp, hits, nh);
         }
-        if (!xsimd::any(best < start)) continue;
-        alignas(64) float t_out[W], id_out[W];
-        best.store_aligned(t_out);
-        best_id.store_aligned(id_out);
-        for (std::size_t l = 0; l < W && i + l < rays.count; ++l) {
-            if (id_out[l] >= 0.f) {
-                rays.t_max[i + l] = t_out[l];
-                object[i + l] = static_cast<std::int32_t>(id_out[l]);
-            }
-        }
+        if (xsimd::any(best < start)) store_closest(rays, object, i, best, best_id);
     }
 }
 

@@ -45,6 +45,23 @@ inline RayPacket<B> to_canonical(const RayPacket<B>& r, const ObjectXf& ob) {
     return c;
 }
 
+/// Writes a packet's closest hits back: t into t_max and the object id, for the lanes that
+/// found one (id >= 0) among the first `count - i` rays.
+template <class B>
+inline void store_closest(RayView& rays, std::int32_t* object, std::size_t i, const B& best, const B& best_id) {
+    using T = typename B::value_type;
+    constexpr std::size_t W = B::size;
+    alignas(64) T t_out[W], id_out[W];
+    best.store_aligned(t_out);
+    best_id.store_aligned(id_out);
+    for (std::size_t l = 0; l < W && i + l < rays.count; ++l) {
+        if (id_out[l] >= T(0)) {
+            rays.t_max[i + l] = float(t_out[l]);
+            object[i + l] = static_cast<std::int32_t>(id_out[l]);
+        }
+    }
+}
+
 /// Whether any lane of the packet meets the box within (0, best). Slab test with the
 /// NaN-tolerant min/max of the cube (a zero direction component on a slab face gives 0 * inf).
 template <class B, class T>
@@ -92,16 +109,7 @@ void closest_hit_impl(RayView rays, std::int32_t* object, const ObjectXf* objs, 
             best = xsimd::select(closer, t, best);
             best_id = xsimd::select(closer, B(T(objs[k].id)), best_id);
         }
-        if (!xsimd::any(best < start)) continue;
-        alignas(64) T t_out[W], id_out[W];
-        best.store_aligned(t_out);
-        best_id.store_aligned(id_out);
-        for (std::size_t l = 0; l < W && i + l < rays.count; ++l) {
-            if (id_out[l] >= T(0)) {
-                rays.t_max[i + l] = float(t_out[l]);
-                object[i + l] = static_cast<std::int32_t>(id_out[l]);
-            }
-        }
+        if (xsimd::any(best < start)) store_closest(rays, object, i, best, best_id);
     }
 }
 
@@ -163,16 +171,7 @@ void mesh_closest_hit(RayView rays, std::int32_t* object, const ObjectXf* objs, 
                                 rays.bu ? rays.bu + i : nullptr, rays.bv ? rays.bv + i : nullptr);
             best_id = xsimd::select(best < before, B(float(objs[k].id)), best_id);
         }
-        if (!xsimd::any(best < start)) continue;
-        alignas(64) float t_out[W], id_out[W];
-        best.store_aligned(t_out);
-        best_id.store_aligned(id_out);
-        for (std::size_t l = 0; l < W && i + l < rays.count; ++l) {
-            if (id_out[l] >= 0.f) {
-                rays.t_max[i + l] = t_out[l];
-                object[i + l] = static_cast<std::int32_t>(id_out[l]);
-            }
-        }
+        if (xsimd::any(best < start)) store_closest(rays, object, i, best, best_id);
     }
 }
 

@@ -28,9 +28,7 @@ struct ConeMath {
             const V y = os.y + d.y * s;
             best = keep_closest(best, t_shift + s, r.valid && y >= V(-1) && y <= V(1), t_min);
         }
-        const V t = (V(-1) - o.y) / d.y;
-        const V x = o.x + d.x * t, z = o.z + d.z * t;
-        best = keep_closest(best, t, x * x + z * z <= V(1), t_min);
+        best = keep_cap(best, o, d, V(-1), t_min);  // the base
         return miss_if_unchanged(best, t_max);
     }
     /// Gradient of the side, (x, k^2 (1 - y), z); the base cap below; +y at the apex itself.

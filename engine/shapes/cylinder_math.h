@@ -21,12 +21,8 @@ struct CylinderMath {
         V best = t_max;
         best = keep_closest(best, r.t0, r.valid && abs(o.y + d.y * r.t0) <= V(1), t_min);
         best = keep_closest(best, r.t1, r.valid && abs(o.y + d.y * r.t1) <= V(1), t_min);
-        // Caps y = +-1; dy = 0 gives +-inf or NaN, which fail the range test.
-        for (const float cap : {-1.f, 1.f}) {
-            const V t = (V(cap) - o.y) / d.y;
-            const V x = o.x + d.x * t, z = o.z + d.z * t;
-            best = keep_closest(best, t, x * x + z * z <= V(1), t_min);
-        }
+        best = keep_cap(best, o, d, V(-1), t_min);  // caps y = -1 and y = +1
+        best = keep_cap(best, o, d, V(1), t_min);
         return miss_if_unchanged(best, t_max);
     }
     /// Cap or side, whichever the point is closer to being outside of.

@@ -2,6 +2,7 @@
 // Shared root finding for the quadric shapes.
 #include <limits>
 
+#include "core/vec3.h"
 #include "simd/lanes.h"
 
 namespace streamrt {
@@ -36,6 +37,15 @@ template <class V, class M>
 inline V keep_closest(V best, V t, M ok, V t_min) {
     using namespace simd;
     return select(ok && (t > t_min) && (t < best), t, best);
+}
+
+/// The unit disc in the plane y = level (a cylinder's or cone's cap): keeps its crossing
+/// when it lies inside the disc. dy = 0 gives +-inf or NaN, which fail the test.
+template <class V>
+inline V keep_cap(V best, const Vec3T<V>& o, const Vec3T<V>& d, V level, V t_min) {
+    const V t = (level - o.y) / d.y;
+    const V x = o.x + d.x * t, z = o.z + d.z * t;
+    return keep_closest(best, t, x * x + z * z <= V(1), t_min);
 }
 
 /// best started at t_max; lanes that kept it report a miss (+inf).

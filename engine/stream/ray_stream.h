@@ -12,6 +12,19 @@ namespace streamrt {
 
 using simd::AlignedVec;
 
+/// Makes the lanes between count and the next multiple of kMaxLanes inert (t_max < 0, a
+/// finite ray), so full-width kernels can run over the last packet.
+template <class Stream>
+inline void make_tail_inert(Stream& s) {
+    const std::size_t end = simd::round_up_lanes(s.count);
+    for (std::size_t i = s.count; i < end; ++i) {
+        s.ox[i] = s.oy[i] = s.oz[i] = 0.f;
+        s.dx[i] = s.dy[i] = 0.f;
+        s.dz[i] = 1.f;
+        s.t_max[i] = -1.f;
+    }
+}
+
 enum class RayKind : std::uint8_t { Primary, Reflected, Refracted };
 
 /// Rays of one generation of one tile chunk.
@@ -37,15 +50,7 @@ struct RayStream {
     }
     std::size_t capacity() const { return ox.size(); }
     /// Makes the lanes between count and the next multiple of kMaxLanes inert.
-    void pad_tail() {
-        const std::size_t end = simd::round_up_lanes(count);
-        for (std::size_t i = count; i < end; ++i) {
-            ox[i] = oy[i] = oz[i] = 0.f;
-            dx[i] = dy[i] = 0.f;
-            dz[i] = 1.f;
-            t_max[i] = -1.f;
-        }
-    }
+    void pad_tail() { make_tail_inert(*this); }
 };
 
 /// Closest hit per ray: t (t_max where nothing was hit) and the scene object index (-1).
@@ -76,15 +81,7 @@ struct ShadowStream {
         count = 0;
     }
     std::size_t capacity() const { return ox.size(); }
-    void pad_tail() {
-        const std::size_t end = simd::round_up_lanes(count);
-        for (std::size_t i = count; i < end; ++i) {
-            ox[i] = oy[i] = oz[i] = 0.f;
-            dx[i] = dy[i] = 0.f;
-            dz[i] = 1.f;
-            t_max[i] = -1.f;
-        }
-    }
+    void pad_tail() { make_tail_inert(*this); }
 };
 
 /// Rays as the kernels see them: pointers into a RayStream or a ShadowStream.
