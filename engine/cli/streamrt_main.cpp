@@ -186,7 +186,7 @@ int run(int argc, char** argv) {
     check_output_path(s.output, opt.scene_path);
     // Refuse, before allocating anything big, a render that cannot fit in this machine.
     const EngineKind engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
-    const int jobs = opt.jobs > 0 ? opt.jobs : oneapi::tbb::info::default_concurrency();
+    const int jobs = opt.jobs > 0 ? opt.jobs : default_jobs();
     check_render_memory(scene, engine == EngineKind::Stream || opt.compare, jobs);
     if (opt.check_only) {
         if (!opt.quiet)

@@ -1,12 +1,23 @@
 #pragma once
 // The one owner of threads: every parallel loop goes through here, so -j is honoured.
 // The only header that includes TBB.
+#if defined(__SANITIZE_THREAD__)
+// ThreadSanitizer builds run every loop on plain std::threads: Debian's libtbb is not
+// instrumented, so TSan cannot see its synchronisation and reports its hand-offs as races.
+// With std::thread and std::atomic it sees every edge, and checks what matters here: the
+// render code inside the loop bodies. Same tiles, same results.
+#define STREAMRT_STD_THREADS 1
+#include <atomic>
+#include <thread>
+#include <vector>
+#else
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/parallel_invoke.h>
 #include <oneapi/tbb/task_arena.h>
+#endif
 
 #include <algorithm>
 #include <cstddef>
@@ -21,11 +32,89 @@ struct Tile {
     int height() const { return y1 - y0; }
 };
 
+/// The number of threads "all cores" means.
+inline int default_jobs() {
+#if STREAMRT_STD_THREADS
+    return int(std::max(1u, std::thread::hardware_concurrency()));
+#else
+    return oneapi::tbb::info::default_concurrency();
+#endif
+}
+
+#if STREAMRT_STD_THREADS
+namespace parallel_detail {
+/// Runs work() on `threads` threads (the caller is one of them).
+template <class Work>
+void run_on_threads(int threads, Work&& work) {
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back([&] { work(); });
+    work();
+    for (std::thread& t : pool) t.join();
+}
+inline thread_local int invoke_depth = 0;
+}  // namespace parallel_detail
+
+class Parallelism {
+  public:
+    explicit Parallelism(int jobs) : jobs_(jobs > 0 ? jobs : default_jobs()) {}
+    int jobs() const { return jobs_; }
+
+    template <class Body>
+    void for_each_tile(int width, int height, int tile, Body&& body) {
+        const int nx = (width + tile - 1) / tile, ny = (height + tile - 1) / tile;
+        std::atomic<int> next{0};
+        parallel_detail::run_on_threads(std::min(jobs_, std::max(1, nx * ny)), [&] {
+            for (int i = next++; i < nx * ny; i = next++) {
+                const int tx = i % nx, ty = i / nx;
+                body(i, Tile{tx * tile, ty * tile, std::min(width, (tx + 1) * tile), std::min(height, (ty + 1) * tile)});
+            }
+        });
+    }
+
+    template <class Body>
+    void for_each_index(std::size_t n, std::size_t grain, Body&& body) {
+        std::atomic<std::size_t> next{0};
+        const std::size_t step = std::max<std::size_t>(1, grain);
+        parallel_detail::run_on_threads(jobs_, [&] {
+            for (std::size_t b = next.fetch_add(step); b < n; b = next.fetch_add(step))
+                for (std::size_t i = b; i < std::min(n, b + step); ++i) body(i);
+        });
+    }
+
+  private:
+    int jobs_;
+};
+
+template <class A, class B>
+inline void parallel_invoke(A&& a, B&& b) {
+    // Two threads per level for the first levels of a recursive build, then sequential.
+    if (parallel_detail::invoke_depth >= 3) {
+        a();
+        b();
+        return;
+    }
+    std::thread other([&] {
+        parallel_detail::invoke_depth = 4;  // the new thread recurses sequentially
+        a();
+    });
+    ++parallel_detail::invoke_depth;
+    b();
+    --parallel_detail::invoke_depth;
+    other.join();
+}
+
+template <class Body>
+inline void parallel_for_index(std::size_t n, std::size_t grain, Body&& body) {
+    Parallelism(default_jobs()).for_each_index(n, grain, std::forward<Body>(body));
+}
+
+#else
+
 class Parallelism {
   public:
     /// jobs <= 0 means all cores.
     explicit Parallelism(int jobs)
-        : jobs_(jobs > 0 ? jobs : oneapi::tbb::info::default_concurrency()),
+        : jobs_(jobs > 0 ? jobs : default_jobs()),
           limit_(oneapi::tbb::global_control::max_allowed_parallelism, std::size_t(jobs_)),
           arena_(jobs_) {}
 
@@ -83,5 +172,7 @@ inline void parallel_for_index(std::size_t n, std::size_t grain, Body&& body) {
                                   for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
                               });
 }
+
+#endif  // STREAMRT_STD_THREADS
 
 }  // namespace streamrt
