@@ -3,7 +3,9 @@
 #   scripts/sanitize.sh asan [ctest args]   AddressSanitizer + UndefinedBehaviorSanitizer
 #                                            into build-asan/, every test
 #   scripts/sanitize.sh tsan [ctest args]   ThreadSanitizer into build-tsan/, the tests that
-#                                            run threads (renders, the command line)
+#                                            run threads (renders, the command line, the
+#                                            parallel BVH build); loops run on std::thread
+#                                            there (engine/parallel/parallelism.h)
 # Debug-ish flags (-O1 -g) keep the build quick on 2 cores; the perf targets are not built.
 # JOBS (default 1) sets the build parallelism: sanitizer builds need much memory per job.
 set -euo pipefail
@@ -24,7 +26,7 @@ case "$kind" in
     sanitize="thread"
     # Suppressions (each with its reason) live in tests/tsan.supp.
     export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/tsan.supp"
-    filter=(-R "render threads|cli:")
+    filter=(-R "render threads|cli:|bit-identical|BVH")
     ;;
   *) echo "usage: scripts/sanitize.sh asan|tsan [ctest args]" >&2; exit 2 ;;
 esac
