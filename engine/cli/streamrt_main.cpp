@@ -252,9 +252,10 @@ int run(int argc, char** argv) {
     }
     if (!opt.quiet) {
         const double mrays = r.counts.total() / std::max(r.seconds, 1e-9) / 1e6;
-        std::printf("%s: %dx%d, spp %d, degree %d, %s engine, -j%d: %.3f s, %llu rays (%.2f Mrays/s) -> %s\n",
+        std::printf("%s: %dx%d, spp %d, degree %d, %s engine, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s\n",
                     opt.scene_path.c_str(), s.width, s.height, s.spp, s.degree, engine_name(engine), par.jobs(),
-                    r.seconds, static_cast<unsigned long long>(r.counts.total()), mrays, s.output.c_str());
+                    r.seconds, static_cast<unsigned long long>(r.counts.total()), mrays, r.setup_seconds,
+                    s.output.c_str());
     }
     return 0;
 }

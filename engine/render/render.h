@@ -17,7 +17,8 @@ const char* engine_name(EngineKind e);
 struct RenderResult {
     Framebuffer image;
     RayCounts counts;
-    double seconds = 0;
+    double seconds = 0;        ///< rendering
+    double setup_seconds = 0;  ///< building the engine's tables and the object hierarchy
 };
 
 struct EngineOptions {
