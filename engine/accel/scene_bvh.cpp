@@ -46,7 +46,7 @@ bool object_world_bounds(const Object& o, double lo[3], double hi[3]) {
     return true;
 }
 
-std::unique_ptr<SceneBvh> SceneBvh::build(const Scene& scene, const BuildOptions& options) {
+std::unique_ptr<SceneBvh> SceneBvh::build(const Scene& scene, const BuildOptions& options, const glm::dvec3& shift) {
     auto s = std::make_unique<SceneBvh>();
     const std::size_t n = scene.objects.size();
     std::vector<Aabb> boxes(n);
@@ -54,6 +54,7 @@ std::unique_ptr<SceneBvh> SceneBvh::build(const Scene& scene, const BuildOptions
     parallel_for_index(n, 4096, [&](std::size_t i) {
         double lo[3], hi[3];
         ok[i] = object_world_bounds(scene.objects[i], lo, hi);
+        for (int a = 0; a < 3; ++a) lo[a] -= shift[a], hi[a] -= shift[a];
         if (ok[i]) boxes[i] = conservative_box(lo, hi);
     });
     std::vector<Aabb> prim_boxes;
@@ -71,14 +72,15 @@ std::unique_ptr<SceneBvh> SceneBvh::build(const Scene& scene, const BuildOptions
     return s;
 }
 
-std::unique_ptr<SceneBvh> SceneBvh::build_for(const Scene& scene, const AccelConfig& config) {
+std::unique_ptr<SceneBvh> SceneBvh::build_for(const Scene& scene, const AccelConfig& config,
+                                              const glm::dvec3& shift) {
     if (config.mode == AccelMode::Flat) return nullptr;
     if (config.mode == AccelMode::Auto) {
         std::size_t bounded = 0;
         for (const Object& o : scene.objects) bounded += o.kind != ShapeKind::Plane;
         if (bounded < config.min_objects) return nullptr;
     }
-    return build(scene, config.build);
+    return build(scene, config.build, shift);
 }
 
 }  // namespace streamrt::accel

@@ -47,9 +47,13 @@ struct SceneBvh {
     std::vector<std::uint32_t> unbounded;  ///< objects tested separately (planes)
 
     /// nullptr when the configuration says this scene is traced flat.
-    static std::unique_ptr<SceneBvh> build_for(const Scene& scene, const AccelConfig& config = accel_config());
+    /// shift: the hierarchy is built for the scene translated by -shift (the stream engine
+    /// renders relative to the eye, stream/stream_scene.cpp) without copying the scene.
+    static std::unique_ptr<SceneBvh> build_for(const Scene& scene, const AccelConfig& config = accel_config(),
+                                               const glm::dvec3& shift = glm::dvec3(0.0));
     /// The hierarchy regardless of the mode.
-    static std::unique_ptr<SceneBvh> build(const Scene& scene, const BuildOptions& options = {});
+    static std::unique_ptr<SceneBvh> build(const Scene& scene, const BuildOptions& options = {},
+                                           const glm::dvec3& shift = glm::dvec3(0.0));
 };
 
 }  // namespace streamrt::accel

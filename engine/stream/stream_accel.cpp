@@ -9,9 +9,9 @@ void rows3x4(const glm::dmat4& m, float* out) {
     for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 4; ++c) out[r * 4 + c] = float(m[c][r]);  // glm is column-major
 }
-ObjectXf object_xf(const Object& o, std::uint32_t id) {
+ObjectXf object_xf(const Object& o, std::uint32_t id, const glm::dvec3& shift) {
     ObjectXf xf{};
-    rows3x4(o.xf.mi, xf.m);
+    rows3x4(o.xf.mi * translate_matrix(shift), xf.m);  // Mi of the object moved by -shift
     xf.param = float(o.param());
     xf.id = std::int32_t(id);
     xf.mesh = o.mesh ? &o.mesh->view() : nullptr;
@@ -19,21 +19,23 @@ ObjectXf object_xf(const Object& o, std::uint32_t id) {
 }
 }  // namespace
 
-std::shared_ptr<const StreamAccel> StreamAccel::build_for(const Scene& scene) {
-    auto bvh = accel::SceneBvh::build_for(scene);
+std::shared_ptr<const StreamAccel> StreamAccel::build_for(const Scene& scene, const glm::dvec3& shift) {
+    auto bvh = accel::SceneBvh::build_for(scene, accel::accel_config(), shift);
     if (!bvh) return nullptr;
-    return std::make_shared<const StreamAccel>(scene, std::move(bvh));
+    return std::make_shared<const StreamAccel>(scene, std::move(bvh), shift);
 }
 
-StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh) : bvh_(std::move(bvh)) {
+StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh, const glm::dvec3& shift)
+    : bvh_(std::move(bvh)) {
     const accel::AccelConfig& c = accel::accel_config();
     primary_ = c.primary;
     secondary_ = c.secondary;
     shadow_ = c.shadow;
     prims_.reserve(bvh_->bvh.prim_index.size());
     for (std::uint32_t id : bvh_->bvh.prim_index)
-        prims_.push_back({object_xf(scene.objects[id], id), std::uint32_t(scene.objects[id].kind)});
-    for (std::uint32_t id : bvh_->unbounded) unbounded_[int(scene.objects[id].kind)].push_back(object_xf(scene.objects[id], id));
+        prims_.push_back({object_xf(scene.objects[id], id, shift), std::uint32_t(scene.objects[id].kind)});
+    for (std::uint32_t id : bvh_->unbounded)
+        unbounded_[int(scene.objects[id].kind)].push_back(object_xf(scene.objects[id], id, shift));
 }
 
 std::size_t StreamAccel::memory_bytes() const {

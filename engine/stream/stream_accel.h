@@ -17,8 +17,9 @@ namespace streamrt {
 class StreamAccel {
   public:
     /// nullptr when the scene is traced without the hierarchy (accel_config()).
-    static std::shared_ptr<const StreamAccel> build_for(const Scene& scene);
-    explicit StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh);
+    /// For the scene translated by -shift (the stream engine renders relative to the eye).
+    static std::shared_ptr<const StreamAccel> build_for(const Scene& scene, const glm::dvec3& shift = glm::dvec3(0.0));
+    StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh, const glm::dvec3& shift = glm::dvec3(0.0));
 
     /// Closest hit of every ray (see ClosestHitFn); `coherent` picks the configured traversal
     /// for primary rays, otherwise for secondary rays.

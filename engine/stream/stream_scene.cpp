@@ -17,19 +17,15 @@ namespace {
 /// applied in double: Md' = T(-e) Md and Mi' = Mi T(e) (from the exact Mi, not re-inverted).
 /// The checker pattern needs world positions: MaterialT::cell_offset carries e / cell,
 /// reduced modulo the pattern's period of 2 cells (exactly, in double).
-Scene rebased_on_eye(const Scene& scene, glm::dvec3& eye) {
-    Scene r = scene;
+/// The eye, and the camera-only scene (no objects) that places the camera relative to it.
+Scene camera_relative_to_eye(const Scene& scene, glm::dvec3& eye) {
+    Scene r;
+    r.settings = scene.settings;
     const RenderSettings& s = scene.settings;
     const glm::dmat4 cam = scene.camera.world_from_canonical(s.width, s.height);
     eye = transform_point(cam, {0.0, 0.0, 1.0});
-    const glm::dmat4 to_eye = translate_matrix(-eye), from_eye = translate_matrix(eye);
     r.camera.look_at = false;
-    r.camera.md = to_eye * cam;
-    for (Object& o : r.objects) {
-        o.xf.md = to_eye * o.xf.md;
-        o.xf.mi = o.xf.mi * from_eye;
-    }
-    for (Light& l : r.lights) l.pos -= eye;
+    r.camera.md = translate_matrix(-eye) * cam;
     return r;
 }
 
@@ -39,10 +35,14 @@ void rows3x4(const glm::dmat4& m, float* out) {
 }
 }  // namespace
 
-StreamScene::StreamScene(const Scene& original) : settings(original.settings) {
+StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
+    // Each object is moved as it is converted (no copy of the scene: at 1e6 objects that copy
+    // doubled the memory and the set-up time).
     glm::dvec3 eye;
-    const Scene scene = rebased_on_eye(original, eye);
-    camera = CameraRays<float>::from(scene);
+    camera = CameraRays<float>::from(camera_relative_to_eye(scene, eye));
+    const glm::dmat4 to_eye = translate_matrix(-eye), from_eye = translate_matrix(eye);
+    objects.reserve(scene.objects.size());
+    materials.reserve(scene.objects.size());
     const RenderSettings& s = scene.settings;
     background = {float(s.background.x), float(s.background.y), float(s.background.z)};
     bool any_refl = false, any_trans = false;
@@ -57,8 +57,10 @@ StreamScene::StreamScene(const Scene& original) : settings(original.settings) {
             meshes.push_back(o.mesh);
             has_meshes = true;
         }
-        rows3x4(o.xf.mi, so.mi);
-        rows3x4(o.xf.md, so.md);
+        // Md' = T(-e) Md and Mi' = Mi T(e), in double before rounding (Mi from the exact
+        // inverse, not re-inverted); Mn does not see translations.
+        rows3x4(o.xf.mi * from_eye, so.mi);
+        rows3x4(to_eye * o.xf.md, so.md);
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c) so.mn[r * 3 + c] = float(o.xf.mn[c][r]);
         objects.push_back(so);
@@ -79,6 +81,8 @@ StreamScene::StreamScene(const Scene& original) : settings(original.settings) {
         ObjectBounds box{};
         if (accel::object_world_bounds(o, lo, hi)) {
             for (int a = 0; a < 3; ++a) {
+                lo[a] -= eye[a];
+                hi[a] -= eye[a];
                 // Padded outwards by a relative margin and a few float ulps of the coordinates,
                 // so that the float slab test never culls a packet the shape would hit.
                 const double pad = 1e-5 * (hi[a] - lo[a]) + 8.0 * 1.2e-7 * std::max(std::fabs(lo[a]), std::fabs(hi[a]));
@@ -92,13 +96,16 @@ StreamScene::StreamScene(const Scene& original) : settings(original.settings) {
         any_refl |= o.material.refl > 0;
         any_trans |= o.material.trans > 0;
     }
-    for (const Light& l : scene.lights) lights.push_back(LightT<float>::from(l));
+    for (Light l : scene.lights) {
+        l.pos -= eye;
+        lights.push_back(LightT<float>::from(l));
+    }
     features.lighting = s.degree >= 1;
     features.shadows = s.degree >= 5 && !lights.empty();
     features.reflect = s.degree >= 3 && s.depth >= 1 && any_refl;
     features.refract = s.degree >= 4 && s.depth >= 1 && any_trans;
     features.jitter = s.spp > 1;
-    accel = StreamAccel::build_for(scene);
+    accel = StreamAccel::build_for(scene, eye);
 }
 
 }  // namespace streamrt
