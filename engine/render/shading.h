@@ -36,15 +36,20 @@ struct MaterialT {
     ColorT<T> color, checker_color;
     T ambi, diff, spec, shininess, refl, trans, ior, inv_cell;
     bool checker;
+    /// Below this R.V the highlight spec (R.V)^shininess is under 1e-5 (far below 1/255), so
+    /// it is not computed: pow is the costliest call of the shade stage.
+    T spec_cutoff = T(0);
     /// Added to p / cell before the checker parity: the stream engine renders relative to
     /// the eye and puts (eye / cell) mod 2 here; zero for world coordinates.
     Vec3T<T> cell_offset{T(0), T(0), T(0)};
 
     static MaterialT from(const Material& m) {
+        const double cutoff =
+            m.spec > 0 && m.shininess > 0 ? std::min(1.0, std::pow(std::min(1.0, 1e-5 / m.spec), 1.0 / m.shininess)) : 0.0;
         return {{T(m.color.x), T(m.color.y), T(m.color.z)},
                 {T(m.checker_color.x), T(m.checker_color.y), T(m.checker_color.z)},
                 T(m.ambi), T(m.diff), T(m.spec), T(m.shininess), T(m.refl), T(m.trans),
-                T(m.ior), T(1.0 / m.cell), m.checker, {T(0), T(0), T(0)}};
+                T(m.ior), T(1.0 / m.cell), m.checker, T(cutoff), {T(0), T(0), T(0)}};
     }
 };
 
@@ -170,9 +175,11 @@ inline DirectLight<V> direct_light(int degree, const MaterialT<T>& m, const Colo
         using std::pow;
         const Vec3T<V> r = n * (V(2) * ndotw) - s.w;  // w mirrored about n
         const V rv = -dot(r, view);
-        const auto shiny = lit && (rv > zero);
-        const V h = select(shiny, V(m.spec) * pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
-        c = c + ColorT<V>{h, h, h};
+        const auto shiny = lit && (rv > zero) && (rv > V(m.spec_cutoff));
+        if (any(shiny)) {
+            const V h = select(shiny, V(m.spec) * pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
+            c = c + ColorT<V>{h, h, h};
+        }
     }
     return {mul(c, splat<V>(l.color)), lit};
 }
