@@ -21,7 +21,6 @@ namespace streamrt {
 /// Hit rays regrouped by object (a stable counting sort), so that every SIMD packet of the
 /// shade kernel shares one object: its transforms and material are broadcast, not gathered.
 struct SortedHits {
-    std::size_t count = 0;
     AlignedVec<float> ox, oy, oz, dx, dy, dz, t, wr, wg, wb, cone, lr, lg, lb, bu, bv;
     AlignedVec<std::int32_t> pixel, prim;
     std::vector<std::uint32_t> run_start;  ///< per object, then one past the end
@@ -319,7 +318,6 @@ struct PipelineStages {
         }
         for (std::size_t k = 1; k <= n_obj; ++k) h.run_start[k] += h.run_start[k - 1];
         h.reserve(hits);
-        h.count = hits;
         {
             std::vector<std::uint32_t>& next_slot = ws.slot;
             next_slot.assign(h.run_start.begin(), h.run_start.end() - 1);
@@ -425,7 +423,6 @@ struct PipelineStages {
                           Workspace& ws, float* accum, RayCounts& counts, StreamProfile* profile,
                           bool scalar_shade) {
         const auto fig = [&](Stage s) { return profile ? &profile->stages[int(s)] : nullptr; };
-        const int spp = sc.settings.spp;
         const std::size_t lights = sc.lights.size();
         {
             StageTimer timer(fig(Stage::Generate));
@@ -433,7 +430,6 @@ struct PipelineStages {
             counts.primary += ws.current.count;
             if (profile) fig(Stage::Generate)->rays_out += ws.current.count, fig(Stage::Generate)->rays_in += std::uint64_t(n_pixels);
         }
-        (void)spp;
         for (int depth = 0; ws.current.count > 0; ++depth) {
             RayStream& rays = ws.current;
             {

@@ -20,8 +20,6 @@ class StreamRenderer {
     /// Renders the image. With a profile, every stage is timed and counted into it.
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr, StreamProfile* profile = nullptr) const;
 
-    const StreamScene& scene() const { return scene_; }
-    const KernelTable& kernels() const { return kernels_; }
     /// Names of the stages and kernels this scene's pipeline is built from.
     std::vector<std::string> built_stages() const;
 
