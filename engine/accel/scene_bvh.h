@@ -12,8 +12,9 @@
 
 namespace streamrt::accel {
 
-/// World-space bounds of an object in double; false for an unbounded one (the plane).
-bool object_world_bounds(const Object& o, double lo[3], double hi[3]);
+/// World-space bounds of an object in double; false for an unbounded one (the plane, an
+/// empty mesh). `mesh` is the object's mesh (Scene::mesh_of), for Mesh objects.
+bool object_world_bounds(const Object& o, const Mesh* mesh, double lo[3], double hi[3]);
 
 /// How the stream engine walks the hierarchy for one class of rays.
 enum class Traversal : std::uint8_t {

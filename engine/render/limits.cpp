@@ -29,9 +29,9 @@ MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, in
     // Writing: a calibrated float copy, the 8-bit copy and the encoded file (PFM: 12 B/pixel).
     e.output_bytes = pixels * (3 * sizeof(float) + 3 + 3);
     bool reflect = false, both = false;
-    for (const Object& o : scene.objects) {
-        const bool r = s.degree >= 3 && o.material.refl > 0;
-        const bool t = s.degree >= 4 && o.material.trans > 0;
+    for (const Material& m : scene.materials) {
+        const bool r = s.degree >= 3 && m.refl > 0;
+        const bool t = s.degree >= 4 && m.trans > 0;
         reflect = reflect || r || t;
         both = both || (r && t);
     }

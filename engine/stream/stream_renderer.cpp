@@ -26,7 +26,7 @@ std::vector<std::string> StreamRenderer::built_stages() const {
             first = false;
         }
     b.push_back(kernels + "]");
-    const bool sorted = !scalar_shade_ && scene_.objects.size() <= kSortedShadeMaxObjects;
+    const bool sorted = !scalar_shade_ && scene_.object_count <= kSortedShadeMaxObjects;
     b.push_back(std::string(f.lighting ? "shade(lit" : "shade(flat") + (sorted ? ",simd,sorted)" : ",scalar)"));
     if (f.reflect) b.push_back("spawn(reflect)");
     if (f.refract) b.push_back("spawn(refract)");
