@@ -44,7 +44,6 @@ StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bv
         objects_[id] = kernel_object(scene, order_[id], std::int32_t(id), shift);
     });
     for (std::size_t id = n_bounded; id < order_.size(); ++id) unbounded_[objects_[id].kind].push_back(objects_[id].xf);
-    std::vector<std::uint32_t>().swap(bvh_->bounded);
 }
 
 std::size_t StreamAccel::memory_bytes() const {
