@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <type_traits>
 
 #include <xsimd/xsimd.hpp>
 
@@ -28,10 +29,12 @@ namespace {
 /// room for the worst case (2n - 1 nodes) is reserved without being written, so only the
 /// pages of nodes actually made count in memory (about half the worst case at 4 per leaf).
 struct BinNode {
-    Aabb box;
+    float lo[3], hi[3];           ///< bounds (an Aabb's default values would make it non-trivial)
     std::int32_t left, right;     ///< inner: both >= 0; leaf: -1
     std::uint32_t first, count;  ///< leaf
+    float half_area() const { return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}.half_area(); }
 };
+static_assert(std::is_trivially_default_constructible_v<BinNode>);
 
 /// Binary depth past which the builder splits at the object median, so traversal stacks of a
 /// fixed size always suffice (see bvh.h: 64 wide levels).
@@ -121,7 +124,8 @@ struct Builder {
     /// cbox: the bounds of the primitives' doubled centroids (Ref::c).
     void build(std::uint32_t node, std::uint32_t first, std::uint32_t count, const Aabb& box, const Aabb& cbox,
                int depth) {
-        nodes[node].box = box;
+        std::copy_n(box.lo, 3, nodes[node].lo);
+        std::copy_n(box.hi, 3, nodes[node].hi);
         if (count <= 1) return make_leaf(node, first, count);
         std::uint32_t mid = first;
         bool split = false;
@@ -258,8 +262,8 @@ struct Collapser {
                 float best_area = -1.f;
                 for (int k = 0; k < nk; ++k) {
                     const BinNode& c = bin[std::size_t(kids[k])];
-                    if (c.left >= 0 && c.box.half_area() > best_area) {
-                        best_area = c.box.half_area();
+                    if (c.left >= 0 && c.half_area() > best_area) {
+                        best_area = c.half_area();
                         best = k;
                     }
                 }
@@ -278,12 +282,12 @@ struct Collapser {
         }
         for (int j = 0; j < nk; ++j) {
             const BinNode& c = bin[std::size_t(kids[j])];
-            n.lo_x[j] = c.box.lo[0];
-            n.lo_y[j] = c.box.lo[1];
-            n.lo_z[j] = c.box.lo[2];
-            n.hi_x[j] = c.box.hi[0];
-            n.hi_y[j] = c.box.hi[1];
-            n.hi_z[j] = c.box.hi[2];
+            n.lo_x[j] = c.lo[0];
+            n.lo_y[j] = c.lo[1];
+            n.lo_z[j] = c.lo[2];
+            n.hi_x[j] = c.hi[0];
+            n.hi_y[j] = c.hi[1];
+            n.hi_z[j] = c.hi[2];
             if (c.left < 0) {
                 n.child[j] = std::int32_t(c.first);
                 n.count[j] = c.count;
@@ -305,7 +309,7 @@ struct Collapser {
 
 }  // namespace
 
-Bvh Bvh::build(const std::vector<Aabb>& boxes, const BuildOptions& options) {
+Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     Bvh bvh;
     std::vector<Ref> refs;
@@ -314,6 +318,7 @@ Bvh Bvh::build(const std::vector<Aabb>& boxes, const BuildOptions& options) {
         const Aabb& b = boxes[i];
         if (!b.empty()) refs.push_back({{b.lo[0], b.lo[1], b.lo[2]}, 0.f, {b.hi[0], b.hi[1], b.hi[2]}, std::uint32_t(i)});
     }
+    std::vector<Aabb>().swap(boxes);  // the refs hold them now: free the memory before building
     if (refs.empty()) return bvh;
     const std::size_t n = refs.size();
 

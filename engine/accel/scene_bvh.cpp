@@ -62,7 +62,7 @@ std::unique_ptr<SceneBvh> SceneBvh::build(const Scene& scene, const BuildOptions
         if (boxes[i].empty()) s->unbounded.push_back(std::uint32_t(i));
         else ++s->bounded;
     }
-    s->bvh = Bvh::build(boxes, options);
+    s->bvh = Bvh::build(std::move(boxes), options);
     return s;
 }
 
