@@ -64,9 +64,9 @@ TEST_CASE("calibration: clamp, normalize by the maximum, NaN to 0") {
     Framebuffer fb(2, 1);
     fb.rgb = {0.5f, 4.f, -1.f, 2.f, std::nanf(""), 1.f};
     const Framebuffer c = calibrate(fb, Calibration::Clamp);
-    CHECK(c.rgb == std::vector<float>{0.5f, 1.f, 0.f, 1.f, 0.f, 1.f});
+    CHECK(std::vector<float>(c.rgb.begin(), c.rgb.end()) == std::vector<float>{0.5f, 1.f, 0.f, 1.f, 0.f, 1.f});
     const Framebuffer n = calibrate(fb, Calibration::Normalize);
-    CHECK(n.rgb == std::vector<float>{0.125f, 1.f, 0.f, 0.5f, 0.f, 0.25f});
+    CHECK(std::vector<float>(n.rgb.begin(), n.rgb.end()) == std::vector<float>{0.125f, 1.f, 0.f, 0.5f, 0.f, 0.25f});
 }
 
 TEST_CASE("a failed write leaves nothing behind and an existing file untouched") {
