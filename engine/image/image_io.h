@@ -33,7 +33,7 @@ enum class PngFilter : unsigned char { None = 0, Sub = 1, Up = 2 };
 struct PngOptions {
     int level = 1;            ///< zlib level
     int strategy = 3;         ///< zlib strategy (3 = Z_RLE)
-    PngFilter filter = PngFilter::Up;
+    PngFilter filter = PngFilter::Sub;
 };
 
 struct WriteOptions {
