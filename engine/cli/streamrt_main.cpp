@@ -248,7 +248,10 @@ int run(int argc, char** argv) {
     }
 
     const RenderResult r = render_once(engine, true);
-    write_image(s.output, r.image, s.calibration);
+    WriteOptions wo;
+    wo.par = &par;
+    wo.cancel = &g_cancel;
+    if (!write_image(s.output, r.image, s.calibration, wo)) throw Interrupted{};
     if (opt.profile) std::printf("%s", profile.text().c_str());
     if (!opt.profile_json.empty()) {
         std::FILE* f = std::fopen(opt.profile_json.c_str(), "w");

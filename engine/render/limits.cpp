@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "image/image_io.h"
 
 namespace streamrt {
 
@@ -26,8 +27,8 @@ MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, in
     e.threads = std::max(1, threads);
     const double pixels = double(s.width) * double(s.height);
     e.framebuffer_bytes = pixels * 3 * sizeof(float);
-    // Writing: a calibrated float copy, the 8-bit copy and the encoded file (PFM: 12 B/pixel).
-    e.output_bytes = pixels * (3 * sizeof(float) + 3 + 3);
+    // Writing streams bands into the file: a few bands' buffers, never a copy of the image.
+    e.output_bytes = image_write_buffer_bytes(s.width, s.height);
     bool reflect = false, both = false;
     for (const Material& m : scene.materials) {
         const bool r = s.degree >= 3 && m.refl > 0;

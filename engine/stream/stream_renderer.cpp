@@ -76,7 +76,7 @@ StreamRenderer::TileFn StreamRenderer::select_tile_fn() const {
 
 Framebuffer StreamRenderer::render(Parallelism& par, RenderProgress* progress, StreamProfile* profile) const {
     const RenderSettings& s = scene_.settings;
-    Framebuffer fb(s.width, s.height);
+    Framebuffer fb = Framebuffer::uninitialized(s.width, s.height);  // every tile writes its pixels
     std::mutex profile_mutex;
     const auto start = std::chrono::steady_clock::now();
     par.for_each_tile(s.width, s.height, kTileSize, [&](int, Tile tile) {
