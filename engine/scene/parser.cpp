@@ -644,7 +644,7 @@ class Parser {
 
 }  // namespace
 
-Scene load_scene(const std::string& path) {
+Scene load_scene(const std::string& path, int /*jobs*/) {
     std::string text;
     if (!read_whole_file(fs::path(path), text))
         throw SceneError(SourceLoc{path, 0, 0}, "cannot open scene file");

@@ -8,8 +8,9 @@
 
 namespace streamrt {
 
-/// Loads and validates a scene file, following `include` statements.
-Scene load_scene(const std::string& path);
+/// Loads and validates a scene file, following `include` statements. `jobs` threads read a
+/// large file (<= 0: all cores).
+Scene load_scene(const std::string& path, int jobs = 0);
 
 /// Parses scene text held in memory; `name` stands for the file in messages and is the base
 /// for relative includes.
