@@ -5,7 +5,8 @@
 // Reads FILE (default /tmp/reader_s1e6.cfg; written by scripts/perf_common.py with 1e6
 // spheres on a plane when absent) with load_scene at each -j (default 1 and 2), RUNS times
 // each (default 5), every run in a fresh child process so that each reports its own peak
-// resident memory. Prints the median time, the MB/s it gives and the median peak RSS.
+// resident memory. Prints the median wall time, the MB/s it gives, the median CPU time
+// (user + system, whole child) and the median peak RSS.
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -26,6 +27,8 @@ namespace {
 
 struct Run {
     double seconds = 0;
+    double cpu = 0;  // user + system seconds of the whole child (the machine is shared: wall time
+                     // alone says little when other builds hold the cores)
     double peak_mb = 0;
     long objects = 0;
 };
@@ -58,7 +61,8 @@ bool run_child(const std::string& path, int jobs, Run& out) {
     rusage ru{};
     wait4(pid, &status, 0, &ru);
     if (!got || msg[0] < 0) return false;
-    out = {msg[0], double(ru.ru_maxrss) / 1024.0, long(msg[1])};
+    const auto secs = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+    out = {msg[0], secs(ru.ru_utime) + secs(ru.ru_stime), double(ru.ru_maxrss) / 1024.0, long(msg[1])};
     return true;
 }
 
@@ -94,18 +98,19 @@ int main(int argc, char** argv) {
     const double mb = double(st.st_size) / 1e6;
     std::printf("%s: %.1f MB, %d runs per -j, medians\n", path.c_str(), mb, runs);
     for (const int j : jobs) {
-        std::vector<double> secs, peaks;
+        std::vector<double> secs, cpus, peaks;
         long objects = 0;
         for (int r = 0; r < runs; ++r) {
             Run run;
             if (!run_child(path, j, run)) return 1;
             secs.push_back(run.seconds);
+            cpus.push_back(run.cpu);
             peaks.push_back(run.peak_mb);
             objects = run.objects;
         }
         const double t = median(secs);
-        std::printf("-j%d: %.3f s  %.0f MB/s  peak RSS %.0f MB  (%ld objects; runs %.3f .. %.3f s)\n", j, t, mb / t,
-                    median(peaks), objects, *std::min_element(secs.begin(), secs.end()),
+        std::printf("-j%d: %.3f s  %.0f MB/s  cpu %.3f s  peak RSS %.0f MB  (%ld objects; runs %.3f .. %.3f s)\n", j,
+                    t, mb / t, median(cpus), median(peaks), objects, *std::min_element(secs.begin(), secs.end()),
                     *std::max_element(secs.begin(), secs.end()));
     }
     return 0;
