@@ -17,7 +17,6 @@
 #include "parallel/parallelism.h"
 
 #include <algorithm>
-#include <atomic>
 #include <charconv>
 #include <climits>
 #include <cmath>
@@ -593,17 +592,11 @@ class Parser {
             prefault(slots + chunks[i].first_object, slots + chunks[i].first_object + chunks[i].shapes);
         });
         scene.objects.resize(objects);
-        std::atomic<int> first_error_line{other_error_line};
+        // Every chunk is read even after an error: which error comes first is then decided
+        // below in file order, never by which thread got there first.
         par.for_each_index(chunks.size(), 1, [&](std::size_t i) {
-            Chunk& c = chunks[i];
-            if (c.first_line < first_error_line.load(std::memory_order_relaxed)) {
-                read_shapes(text, display, c);
-                if (c.error) {
-                    int seen = first_error_line.load();
-                    while (c.error_line < seen && !first_error_line.compare_exchange_weak(seen, c.error_line)) {}
-                }
-            }
-            if (mapped) release_pages(text.data() + c.begin, text.data() + c.end);
+            read_shapes(text, display, chunks[i]);
+            if (mapped) release_pages(text.data() + chunks[i].begin, text.data() + chunks[i].end);
         });
         for (const Chunk& c : chunks)
             if (c.error && c.error_line < other_error_line) std::rethrow_exception(c.error);
