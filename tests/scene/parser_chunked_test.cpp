@@ -270,6 +270,7 @@ TEST_CASE("chunked reader: odd texts, the fuzz regressions and every scene read 
         "sphere\rcube\r\n",                         // a lone CR is a space
         std::string("cube\0x\nsphere\n", 14),       // NUL byte
         "#\n#\nsphere color=1,1,1#x\ncube",         // comments, no final newline
+        "cube#glued\n  sphere#\n",                 // a comment glued to the word
         "sphere material=m\nmaterial m\n",          // used before its definition
         "material m\nmaterial m\nsphere material=m\n",  // redefined
         "material m color=1,0,0\nsphere material=m\nmaterial n material=m diff=0.5\ncone material=n\n",
