@@ -138,6 +138,16 @@ void same_error(const SceneError& a, const SceneError& b) {
     CHECK(a.where().column == b.where().column);
 }
 
+/// Chunked at -j2, `text` fails at line:column with `message`, exactly as one pass does.
+void expect_error(const std::string& text, int line, int column, const std::string& message) {
+    const SceneError e = error_of([&] { parse_scene(text, "big.cfg", chunked(2)); });
+    CHECK(e.where().file == "big.cfg");
+    CHECK(e.where().line == line);
+    CHECK(e.where().column == column);
+    CHECK(e.message() == message);
+    same_error(e, error_of([&] { parse_scene(text, "big.cfg", one_pass()); }));
+}
+
 /// `text` with line `line` (1-based) replaced.
 std::string with_line(const std::string& text, int line, const std::string& replacement) {
     std::size_t b = 0;
@@ -183,51 +193,31 @@ TEST_CASE("chunked reader: the first error in file order wins over errors in lat
     bad = with_line(bad, 31000, "bogus statement");                               // other statement
     bad = with_line(bad, 32000, "material m0 color=1,1,1");                       // redefinition
     bad = with_line(bad, 2000, "cube color=1,2 translate=0,0,0");                 // the first
-    const SceneError e = error_of([&] { parse_scene(bad, "big.cfg", chunked(2)); });
-    CHECK(e.where().line == 2000);
-    CHECK(e.where().column == 12);
-    CHECK(e.message() == "expected 3 comma-separated numbers x,y,z for 'color', got '1,2'");
-    same_error(e, error_of([&] { parse_scene(bad, "big.cfg", one_pass()); }));
+    expect_error(bad, 2000, 12, "expected 3 comma-separated numbers x,y,z for 'color', got '1,2'");
 
     // The first error is a non-shape statement; shapes after it are broken too.
     std::string other = with_line(text, 35000, "cone translate=a,b,c");
     other = with_line(other, 3000, "light point color=1,1,1");
-    const SceneError o = error_of([&] { parse_scene(other, "big.cfg", chunked(2)); });
-    CHECK(o.where().line == 3000);
-    CHECK(o.where().column == 1);
-    CHECK(o.message() == "light point needs 'pos=x,y,z'");
-    same_error(o, error_of([&] { parse_scene(other, "big.cfg", one_pass()); }));
+    expect_error(other, 3000, 1, "light point needs 'pos=x,y,z'");
 
     // A shape error before a broken non-shape statement of a later chunk.
     std::string shape_first = with_line(text, 36000, "ambient 2");
     shape_first = with_line(shape_first, 4000, "torus minor=-1");
-    const SceneError s = error_of([&] { parse_scene(shape_first, "big.cfg", chunked(2)); });
-    CHECK(s.where().line == 4000);
-    CHECK(s.where().column == 13);
-    same_error(s, error_of([&] { parse_scene(shape_first, "big.cfg", one_pass()); }));
+    expect_error(shape_first, 4000, 13, "'minor' must be > 0, got '-1'");
 }
 
 TEST_CASE("chunked reader: an error in a late chunk has its line and column") {
     const std::string text = big_scene(40000);
     const int last = int(std::count(text.begin(), text.end(), '\n')) + 1;
     const std::string bad = with_line(text, last - 3, "  sphere diff=0.5 translate=1,2,3x");
-    const SceneError e = error_of([&] { parse_scene(bad, "big.cfg", chunked(2)); });
-    CHECK(e.where().file == "big.cfg");
-    CHECK(e.where().line == last - 3);
-    CHECK(e.where().column == 29);
-    CHECK(e.message() == "expected 3 comma-separated numbers x,y,z for 'translate', got '1,2,3x'");
-    same_error(e, error_of([&] { parse_scene(bad, "big.cfg", one_pass()); }));
+    expect_error(bad, last - 3, 29, "expected 3 comma-separated numbers x,y,z for 'translate', got '1,2,3x'");
 }
 
 TEST_CASE("chunked reader: a material defined in a later chunk than its use is refused") {
     std::string text = big_scene(40000);
     text = with_line(text, 20, "sphere material=late  translate=1,1,1");
     text = with_line(text, 38000, "material late color=1,0,0");
-    const SceneError e = error_of([&] { parse_scene(text, "big.cfg", chunked(2)); });
-    CHECK(e.where().line == 20);
-    CHECK(e.where().column == 17);
-    CHECK(e.message() == "unknown material 'late' (a material must be defined before it is used)");
-    same_error(e, error_of([&] { parse_scene(text, "big.cfg", one_pass()); }));
+    expect_error(text, 20, 17, "unknown material 'late' (a material must be defined before it is used)");
     // Used after its definition, in a later chunk, it is found.
     const Scene ok = parse_scene(with_line(with_line(text, 20, "# was here"), 39000, "cube material=late"), "big.cfg",
                                  chunked(2));
