@@ -81,21 +81,28 @@ std::string fmt_num(double v) {
     return buf;
 }
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+/// ' ', '\t', '\v', '\f', '\r' (bytes 9 to 13 but '\n', which never reaches a line).
+bool is_space(char c) { return c == ' ' || (static_cast<unsigned char>(c - '\t') <= 4 && c != '\n'); }
+
+/// a == b, the first byte tested before memcmp: most key comparisons fail on the length or
+/// there, and this runs some twenty times a line.
+bool same(std::string_view a, std::string_view b) {
+    return a.size() == b.size() && (a.empty() || (a[0] == b[0] && std::memcmp(a.data(), b.data(), a.size()) == 0));
+}
 
 /// Splits one line (comment removed) into whitespace-separated tokens with their columns,
 /// into `out` (reused from line to line, so a line allocates nothing).
 void tokenize(std::string_view line, std::vector<Token>& out) {
     out.clear();
     const char* const begin = line.data();
-    const char* end = begin + line.size();
-    if (const void* hash = std::memchr(begin, '#', line.size())) end = static_cast<const char*>(hash);
+    const char* const end = begin + line.size();
     const char* p = begin;
-    while (p < end) {
+    // One scan: '#' ends the last token and the line, as if the line were cut there.
+    while (p < end && *p != '#') {
         while (p < end && is_space(*p)) ++p;
-        if (p >= end) break;
+        if (p >= end || *p == '#') break;
         const char* start = p;
-        while (p < end && !is_space(*p)) ++p;
+        while (p < end && !is_space(*p) && *p != '#') ++p;
         out.push_back({std::string_view(start, std::size_t(p - start)), int(start - begin) + 1});
     }
 }
@@ -183,7 +190,7 @@ class Statement {
                 fail(t.column, "expected key=value, got " + quote(t.text) + " (missing '=')");
             Arg a{t.text.substr(0, eq), t.column, t.text.substr(eq + 1), t.column + int(eq) + 1};
             if (a.key.empty()) fail(t.column, "missing key before '=' in " + quote(t.text));
-            if (std::find(allowed.begin(), allowed.end(), a.key) == allowed.end()) {
+            if (std::none_of(allowed.begin(), allowed.end(), [&](std::string_view k) { return same(k, a.key); })) {
                 std::string msg = "unknown key " + quote(a.key) + " for '" + std::string(word()) +
                                   "' (expected one of:";
                 for (auto k : allowed) msg += " " + std::string(k);
@@ -191,7 +198,7 @@ class Statement {
                 fail(a.key_col, msg);
             }
             for (const Arg& prev : args)
-                if (prev.key == a.key)
+                if (same(prev.key, a.key))
                     fail(a.key_col, "duplicate key " + quote(a.key) + " (first given at column " +
                                         std::to_string(prev.key_col) + ")");
             if (a.value.empty()) fail(a.value_col, "empty value for " + quote(a.key));
@@ -201,7 +208,7 @@ class Statement {
 
     const Arg* find(std::string_view key) const {
         for (const Arg& a : args)
-            if (a.key == key) return &a;
+            if (same(a.key, key)) return &a;
         return nullptr;
     }
 
@@ -332,18 +339,18 @@ bool contains(const std::vector<std::string_view>& v, std::string_view k) {
 /// Applies one material key; false when `a` is not a material key.
 bool apply_material_key(const Statement& st, const Arg& a, Material& m) {
     const auto k = a.key;
-    if (k == "color") m.color = st.color(a);
-    else if (k == "ambi") m.ambi = st.at_least_zero(a);
-    else if (k == "diff") m.diff = st.at_least_zero(a);
-    else if (k == "spec") m.spec = st.at_least_zero(a);
-    else if (k == "shininess") m.shininess = st.at_least_zero(a);
-    else if (k == "refl") m.refl = st.at_least_zero(a);
-    else if (k == "trans") m.trans = st.at_least_zero(a);
-    else if (k == "ior") m.ior = st.positive(a);
-    else if (k == "checker") {
+    if (same(k, "color")) m.color = st.color(a);
+    else if (same(k, "ambi")) m.ambi = st.at_least_zero(a);
+    else if (same(k, "diff")) m.diff = st.at_least_zero(a);
+    else if (same(k, "spec")) m.spec = st.at_least_zero(a);
+    else if (same(k, "shininess")) m.shininess = st.at_least_zero(a);
+    else if (same(k, "refl")) m.refl = st.at_least_zero(a);
+    else if (same(k, "trans")) m.trans = st.at_least_zero(a);
+    else if (same(k, "ior")) m.ior = st.positive(a);
+    else if (same(k, "checker")) {
         m.checker_color = st.color(a);
         m.checker = true;
-    } else if (k == "cell") m.cell = st.positive(a);
+    } else if (same(k, "cell")) m.cell = st.positive(a);
     else return false;
     return true;
 }
@@ -352,23 +359,23 @@ bool apply_material_key(const Statement& st, const Arg& a, Material& m) {
 bool apply_transform_key(const Statement& st, const Arg& a, glm::dmat4& md) {
     const auto k = a.key;
     glm::dmat4 t;
-    if (k == "scale") t = scale_matrix(st.scale(a));
-    else if (k == "rotate_x") t = rotate_x_matrix(st.number(a));
-    else if (k == "rotate_y") t = rotate_y_matrix(st.number(a));
-    else if (k == "rotate_z") t = rotate_z_matrix(st.number(a));
-    else if (k == "translate") t = translate_matrix(st.vec3(a));
+    if (same(k, "scale")) t = scale_matrix(st.scale(a));
+    else if (same(k, "rotate_x")) t = rotate_x_matrix(st.number(a));
+    else if (same(k, "rotate_y")) t = rotate_y_matrix(st.number(a));
+    else if (same(k, "rotate_z")) t = rotate_z_matrix(st.number(a));
+    else if (same(k, "translate")) t = translate_matrix(st.vec3(a));
     else return false;
     md = t * md;
     return true;
 }
 
 std::optional<ShapeKind> shape_from_word(std::string_view w) {
-    if (w == "sphere") return ShapeKind::Sphere;
-    if (w == "cube") return ShapeKind::Cube;
-    if (w == "cylinder") return ShapeKind::Cylinder;
-    if (w == "cone") return ShapeKind::Cone;
-    if (w == "torus") return ShapeKind::Torus;
-    if (w == "plane") return ShapeKind::Plane;
+    if (same(w, "sphere")) return ShapeKind::Sphere;
+    if (same(w, "cube")) return ShapeKind::Cube;
+    if (same(w, "cylinder")) return ShapeKind::Cylinder;
+    if (same(w, "cone")) return ShapeKind::Cone;
+    if (same(w, "torus")) return ShapeKind::Torus;
+    if (same(w, "plane")) return ShapeKind::Plane;
     return std::nullopt;
 }
 
@@ -856,15 +863,15 @@ class Parser {
         f.kind = kind;
         if (const Arg* base = st.find("material")) f.material = lookup_material(st, *base);
         for (const Arg& a : st.args) {
-            if (a.key == "material") continue;
+            if (same(a.key, "material")) continue;
             if (apply_material_key(st, a, f.material)) continue;
             if (apply_transform_key(st, a, f.md)) continue;
-            if (a.key == "minor") f.minor = st.positive(a);
-            else if (a.key == "smooth") {
-                if (a.value == "true") f.smooth = true;
-                else if (a.value == "false") f.smooth = false;
+            if (same(a.key, "minor")) f.minor = st.positive(a);
+            else if (same(a.key, "smooth")) {
+                if (same(a.value, "true")) f.smooth = true;
+                else if (same(a.value, "false")) f.smooth = false;
                 else st.fail(a.value_col, "expected true or false for 'smooth', got " + quote(a.value));
-            } else if (a.key == "file") f.mesh = mesh_file(st, a);
+            } else if (same(a.key, "file")) f.mesh = mesh_file(st, a);
         }
         if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
         if (singular(f.md))
