@@ -395,9 +395,9 @@ fs::path identity_of(const fs::path& p) {
     return id;
 }
 
-/// A scene file's bytes: mapped read-only (the chunked reader gives parsed ranges back with
-/// release()), or read into a string when mapping is not possible (an empty-looking file such
-/// as those of /proc).
+/// A scene file's bytes: mapped read-only (the chunked reader gives parsed ranges back, see
+/// advise_inside), or read into a string when mapping is not possible (an empty-looking file
+/// such as those of /proc).
 class FileText {
   public:
     FileText() = default;
@@ -447,23 +447,17 @@ class FileText {
     std::string owned_;
 };
 
-/// Drops the whole pages of [begin, end) from this process (they are read again from the
-/// page cache if touched): a parsed range of a mapped file does not stay resident.
-void release_pages(const char* begin, const char* end) {
-    const auto page = std::uintptr_t(::sysconf(_SC_PAGESIZE));
-    const std::uintptr_t b = (std::uintptr_t(begin) + page - 1) & ~(page - 1);
-    const std::uintptr_t e = std::uintptr_t(end) & ~(page - 1);
-    if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_DONTNEED);
-}
-
-/// Faults in the whole pages of [begin, end) for writing, from the calling thread. Zeroing
-/// the fresh pages of a million-object array is a large part of reading a big scene: the
-/// chunks prefault their own slices in parallel instead of one thread doing it in resize().
-void prefault(void* begin, void* end) {
-    const auto page = std::uintptr_t(::sysconf(_SC_PAGESIZE));
-    const std::uintptr_t b = (std::uintptr_t(begin) + page - 1) & ~(page - 1);
-    const std::uintptr_t e = std::uintptr_t(end) & ~(page - 1);
-    if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_POPULATE_WRITE);
+/// madvise over the whole `block`-aligned blocks inside [begin, end) (none when there are
+/// none; 0: the page size). Used to give parsed text back (MADV_DONTNEED: read again from the
+/// page cache if touched), to ask for huge pages for the object array (MADV_HUGEPAGE: some
+/// hundreds of faults instead of 100 000s) and to fault its slices in from every thread
+/// (MADV_POPULATE_WRITE: zeroing the fresh pages of a million-object array is a large part of
+/// reading a big scene, left to one thread in resize() otherwise).
+void advise_inside(const void* begin, const void* end, int advice, std::uintptr_t block = 0) {
+    if (block == 0) block = std::uintptr_t(::sysconf(_SC_PAGESIZE));
+    const std::uintptr_t b = (std::uintptr_t(begin) + block - 1) & ~(block - 1);
+    const std::uintptr_t e = std::uintptr_t(end) & ~(block - 1);
+    if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, advice);
 }
 
 /// Per-thread lexing scratch: the token and argument lists of the line being read.
@@ -556,7 +550,7 @@ class Parser {
         Parallelism par(options_.jobs);
         par.for_each_index(chunks.size(), 1, [&](std::size_t i) {
             survey(text, chunks[i]);
-            if (mapped) release_pages(text.data() + chunks[i].begin, text.data() + chunks[i].end);
+            if (mapped) advise_inside(text.data() + chunks[i].begin, text.data() + chunks[i].end, MADV_DONTNEED);
         });
         std::size_t objects = 0;
         int line = 1;
@@ -589,21 +583,17 @@ class Parser {
 
         scene.objects.reserve(objects);
         Object* const slots = scene.objects.data();
-        {
-            const auto b = std::uintptr_t(slots), e = std::uintptr_t(slots + objects);
-            const std::uintptr_t huge = std::uintptr_t(2) << 20;
-            const std::uintptr_t hb = (b + huge - 1) & ~(huge - 1), he = e & ~(huge - 1);
-            if (he > hb) ::madvise(reinterpret_cast<void*>(hb), he - hb, MADV_HUGEPAGE);
-        }
+        advise_inside(slots, slots + objects, MADV_HUGEPAGE, std::uintptr_t(2) << 20);
         par.for_each_index(chunks.size(), 1, [&](std::size_t i) {
-            prefault(slots + chunks[i].first_object, slots + chunks[i].first_object + chunks[i].shapes);
+            advise_inside(slots + chunks[i].first_object, slots + chunks[i].first_object + chunks[i].shapes,
+                          MADV_POPULATE_WRITE);
         });
         scene.objects.resize(objects);
         // Every chunk is read even after an error: which error comes first is then decided
         // below in file order, never by which thread got there first.
         par.for_each_index(chunks.size(), 1, [&](std::size_t i) {
             read_shapes(text, display, chunks[i]);
-            if (mapped) release_pages(text.data() + chunks[i].begin, text.data() + chunks[i].end);
+            if (mapped) advise_inside(text.data() + chunks[i].begin, text.data() + chunks[i].end, MADV_DONTNEED);
         });
         for (const Chunk& c : chunks)
             if (c.error && c.error_line < other_error_line) std::rethrow_exception(c.error);
