@@ -549,7 +549,15 @@ class Parser {
             std::size_t e = std::min(text.size(), b + step);
             if (e < text.size()) {
                 const auto nl = text.find('\n', e - 1);
+                const std::size_t probe = e - 1;
                 e = nl == std::string_view::npos ? text.size() : nl + 1;
+                // One fault may map a whole large folio of the page cache (up to 2 MiB here):
+                // without this, the boundary probes alone left ~90% of a 100 MB file mapped.
+                if (mapped) {
+                    constexpr std::size_t kFolio = std::size_t(2) << 20;
+                    advise_inside(text.data() + (probe > kFolio ? probe - kFolio : 0),
+                                  text.data() + std::min(text.size(), e + kFolio), MADV_DONTNEED);
+                }
             }
             chunks.push_back({});
             chunks.back().begin = b;
