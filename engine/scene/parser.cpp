@@ -82,7 +82,6 @@ std::string fmt_num(double v) {
     return buf;
 }
 
-
 /// Byte classes for the lexer's inner loops: one table load per byte instead of six tests.
 enum : unsigned char { kSpace = 1, kHash = 2 };
 constexpr auto kByteClass = [] {

@@ -158,7 +158,7 @@ std::string with_line(const std::string& text, int line, const std::string& repl
 
 }  // namespace
 
-TEST_CASE("chunked reader: the same scene as one pass, every field, at -j1 and -j2") {
+TEST_CASE("parser: chunked reader: the same scene as one pass, every field, at -j1 and -j2") {
     const std::string text = big_scene(40000);  // ~4.5 MB, ~280 chunks of 16 KiB
     REQUIRE(text.size() > (4u << 20));
     const Scene ref = parse_scene(text, "big.cfg", one_pass());
@@ -176,7 +176,7 @@ TEST_CASE("chunked reader: the same scene as one pass, every field, at -j1 and -
                parse_scene(text.substr(0, 20000), "big.cfg", one_pass()));
 }
 
-TEST_CASE("chunked reader: load_scene (mapped, pages given back) reads the file as parse_scene does") {
+TEST_CASE("parser: chunked reader: load_scene (mapped, pages given back) reads the file as parse_scene does") {
     const fs::path p = fs::temp_directory_path() / ("streamrt_chunked_" + std::to_string(::getpid()) + ".cfg");
     const std::string text = big_scene(20000);
     std::ofstream(p, std::ios::binary) << text;
@@ -186,7 +186,7 @@ TEST_CASE("chunked reader: load_scene (mapped, pages given back) reads the file 
     same_scene(mapped, parse_scene(text, p.string(), one_pass()));
 }
 
-TEST_CASE("chunked reader: the first error in file order wins over errors in later chunks") {
+TEST_CASE("parser: chunked reader: the first error in file order wins over errors in later chunks") {
     const std::string text = big_scene(40000);
     // A shape error in an early chunk, then errors of every kind in later chunks.
     std::string bad = with_line(text, 30000, "sphere scale=0");                   // shape
@@ -206,14 +206,14 @@ TEST_CASE("chunked reader: the first error in file order wins over errors in lat
     expect_error(shape_first, 4000, 13, "'minor' must be > 0, got '-1'");
 }
 
-TEST_CASE("chunked reader: an error in a late chunk has its line and column") {
+TEST_CASE("parser: chunked reader: an error in a late chunk has its line and column") {
     const std::string text = big_scene(40000);
     const int last = int(std::count(text.begin(), text.end(), '\n')) + 1;
     const std::string bad = with_line(text, last - 3, "  sphere diff=0.5 translate=1,2,3x");
     expect_error(bad, last - 3, 29, "expected 3 comma-separated numbers x,y,z for 'translate', got '1,2,3x'");
 }
 
-TEST_CASE("chunked reader: a material defined in a later chunk than its use is refused") {
+TEST_CASE("parser: chunked reader: a material defined in a later chunk than its use is refused") {
     std::string text = big_scene(40000);
     text = with_line(text, 20, "sphere material=late  translate=1,1,1");
     text = with_line(text, 38000, "material late color=1,0,0");
@@ -252,7 +252,7 @@ void same_outcome(const std::string& text, const std::string& name) {
 
 }  // namespace
 
-TEST_CASE("chunked reader: odd texts, the fuzz regressions and every scene read as in one pass") {
+TEST_CASE("parser: chunked reader: odd texts, the fuzz regressions and every scene read as in one pass") {
     const std::string odd[] = {
         "",
         "\n\n\n",
