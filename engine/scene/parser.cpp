@@ -570,12 +570,17 @@ class Parser {
         });
         std::size_t objects = 0;
         int line = 1;
+        bool sequential_only = false;
         for (Chunk& c : chunks) {
-            if (c.sequential_only) return false;
+            sequential_only = sequential_only || c.sequential_only;
             c.first_line = line;
             c.first_object = objects;
             line += c.lines;
             objects += c.shapes;
+        }
+        if (sequential_only) {
+            scene.objects.reserve(objects);  // this file's shapes at least: fewer regrowths
+            return false;
         }
         chunked_ = true;
         ++files_;
