@@ -850,7 +850,7 @@ class Parser {
         ShapeKind kind = ShapeKind::Sphere;
         Material material;
         glm::dmat4 md{1.0};
-        double minor = Object{}.minor;
+        std::optional<double> minor;  // unset: the Object's default
         bool smooth = false;
         std::shared_ptr<const Mesh> mesh;
     };
@@ -861,7 +861,7 @@ class Parser {
         obj.kind = f.kind;
         obj.where = st.where();
         obj.material = f.material;
-        obj.minor = f.minor;
+        if (f.minor) obj.minor = *f.minor;
         obj.smooth = f.smooth;
         obj.mesh = std::move(f.mesh);
         obj.xf = Transform::from_direct(f.md);
