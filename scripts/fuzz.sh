@@ -12,20 +12,21 @@ CXX=${FUZZ_CXX:-clang++-14}
 command -v "$CXX" >/dev/null || CXX=clang++
 out=build-fuzz
 mkdir -p "$out/corpus" "$out/artifacts"
+# The reader needs the mesh loader (mesh statements) and TBB (it reads large texts in parallel).
 sources=(tests/fuzz/scene_fuzz.cpp engine/scene/parser.cpp engine/scene/scene.cpp
-         engine/core/transform.cpp engine/render/limits.cpp)
+         engine/core/transform.cpp engine/render/limits.cpp engine/mesh/mesh.cpp engine/accel/bvh.cpp)
 bin="$out/scene_fuzz"
 # Rebuild when a source is newer than the binary.
 rebuild=0
 [[ -x $bin ]] || rebuild=1
-for s in "${sources[@]}" engine/scene/*.h engine/core/*.h engine/render/limits.h tests/fuzz/*.h; do
+for s in "${sources[@]}" engine/scene/*.h engine/core/*.h engine/render/limits.h engine/parallel/*.h tests/fuzz/*.h; do
   [[ $s -nt $bin ]] && rebuild=1
 done
 if ((rebuild)); then
   echo "fuzz.sh: building $bin with $CXX"
   "$CXX" -std=c++20 -O1 -g -fno-omit-frame-pointer \
     -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-    -Iengine -Itests "${sources[@]}" -o "$bin"
+    -Iengine -Itests "${sources[@]}" -ltbb -ltinyobjloader -o "$bin"
 fi
 # Seed corpus: every example scene plus the regression inputs.
 cp -n scenes/*.cfg scenes/degrees/*.cfg "$out/corpus/" 2>/dev/null || true

@@ -172,7 +172,7 @@ int run(int argc, char** argv) {
     std::signal(SIGINT, on_sigint);
     std::signal(SIGTERM, on_sigint);
 
-    Scene scene = load_scene(opt.scene_path);
+    Scene scene = load_scene(opt.scene_path, opt.jobs);
     RenderSettings& s = scene.settings;
     if (opt.spp) s.spp = *opt.spp;
     if (opt.width) s.width = *opt.width;

@@ -1,24 +1,38 @@
 // The .cfg scene reader (docs/scene-format.md). One statement per line, `#` comments,
 // `key=value` arguments; every mistake becomes a SceneError at the exact line and column of
 // the offending token (the key, the value or the statement word).
+//
+// Speed (docs/architecture.md, "Scene reading"): the file is mapped, lines are cut with
+// memchr and lexed into views kept in scratch vectors reused from line to line; a large file
+// is cut into chunks at line ends, the rare non-shape statements run first in file order and
+// the shapes of all chunks are parsed in parallel into their final slots of scene.objects.
 #include "scene/parser.h"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include "mesh/mesh.h"
+#include "parallel/parallelism.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
+#include <climits>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <exception>
 #include <filesystem>
-#include <fstream>
 #include <initializer_list>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <unordered_map>
 #include <vector>
 
 namespace streamrt {
@@ -69,21 +83,48 @@ std::string fmt_num(double v) {
     return buf;
 }
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+/// Byte classes for the lexer's inner loops: one table load per byte instead of six tests.
+enum : unsigned char { kSpace = 1, kHash = 2 };
+constexpr auto kByteClass = [] {
+    std::array<unsigned char, 256> t{};
+    for (const char c : {' ', '\t', '\r', '\v', '\f'}) t[static_cast<unsigned char>(c)] = kSpace;
+    t[static_cast<unsigned char>('#')] = kHash;
+    return t;
+}();
+unsigned char byte_class(char c) { return kByteClass[static_cast<unsigned char>(c)]; }
 
-/// Splits one line (comment removed) into whitespace-separated tokens with their columns.
-std::vector<Token> tokenize(std::string_view line) {
-    if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    std::vector<Token> out;
-    std::size_t i = 0;
-    while (i < line.size()) {
-        while (i < line.size() && is_space(line[i])) ++i;
-        if (i >= line.size()) break;
-        const std::size_t start = i;
-        while (i < line.size() && !is_space(line[i])) ++i;
-        out.push_back({line.substr(start, i - start), int(start) + 1});
+/// a == b, the first byte tested before memcmp: most key comparisons fail on the length or
+/// there, and this runs some twenty times a line.
+bool same(std::string_view a, std::string_view b) {
+    return a.size() == b.size() && (a.empty() || (a[0] == b[0] && std::memcmp(a.data(), b.data(), a.size()) == 0));
+}
+
+/// Splits one line (comment removed) into whitespace-separated tokens with their columns,
+/// into `out` (reused from line to line, so a line allocates nothing).
+void tokenize(std::string_view line, std::vector<Token>& out) {
+    out.clear();
+    const char* const begin = line.data();
+    const char* const end = begin + line.size();
+    const char* p = begin;
+    // One scan: '#' ends the last token and the line, as if the line were cut there.
+    while (p < end) {
+        while (p < end && byte_class(*p) == kSpace) ++p;
+        if (p >= end || *p == '#') break;
+        const char* start = p;
+        while (p < end && byte_class(*p) == 0) ++p;
+        out.push_back({std::string_view(start, std::size_t(p - start)), int(start - begin) + 1});
     }
-    return out;
+}
+
+/// The first word of a line as tokenize() would find it ("" for a blank or comment line),
+/// without building the token list: the cheap look the chunked first pass takes at a line.
+std::string_view first_word(std::string_view line) {
+    const char* p = line.data();
+    const char* const end = p + line.size();
+    while (p < end && byte_class(*p) == kSpace) ++p;
+    const char* start = p;
+    while (p < end && byte_class(*p) == 0) ++p;
+    return std::string_view(start, std::size_t(p - start));
 }
 
 /// A finite double written entirely in `s` (an optional leading '+' is accepted).
@@ -99,19 +140,18 @@ std::optional<double> to_number(std::string_view s) {
     return v;
 }
 
-/// Splits "a,b,c" into its components; empty components are kept (and rejected later).
-std::vector<std::string_view> split_commas(std::string_view s) {
-    std::vector<std::string_view> parts;
-    std::size_t start = 0;
-    for (;;) {
-        const auto comma = s.find(',', start);
-        if (comma == std::string_view::npos) {
-            parts.push_back(s.substr(start));
-            return parts;
-        }
-        parts.push_back(s.substr(start, comma - start));
-        start = comma + 1;
+/// "x,y,z": exactly three numbers (empty components and a fourth are refused).
+std::optional<glm::dvec3> to_vec3(std::string_view s) {
+    glm::dvec3 out{0.0};
+    for (int i = 0; i < 3; ++i) {
+        const auto comma = s.find(',');
+        if ((comma == std::string_view::npos) != (i == 2)) return std::nullopt;
+        const auto v = to_number(s.substr(0, comma));
+        if (!v) return std::nullopt;
+        out[i] = *v;
+        if (i < 2) s.remove_prefix(comma + 1);
     }
+    return out;
 }
 
 bool all_finite(const glm::dmat4& m) {
@@ -129,20 +169,24 @@ bool singular(const glm::dmat4& m) {
 }
 
 /// One statement being read: its location, its word and (for keyed statements) its arguments.
+/// `args` is the reader's scratch list, cleared here: no allocation per statement.
 class Statement {
   public:
-    Statement(const std::string& file, int line, Token word) : file_(file), line_(line), word_(word) {}
+    Statement(const std::string& file, int line, Token word, std::vector<Arg>& scratch)
+        : args(scratch), file_(&file), line_(line), word_(word) {
+        args.clear();
+    }
 
     [[noreturn]] void fail(int column, std::string_view msg) const {
-        throw SceneError(SourceLoc{file_, line_, column}, msg);
+        throw SceneError(SourceLoc{*file_, line_, column}, msg);
     }
     [[noreturn]] void fail_here(std::string_view msg) const { fail(word_.column, msg); }
-    SourceLoc where() const { return SourceLoc{file_, line_, word_.column}; }
+    SourceLoc where() const { return SourceLoc{*file_, line_, word_.column}; }
     std::string_view word() const { return word_.text; }
-    const std::string& file() const { return file_; }
+    const std::string& file() const { return *file_; }
     int line() const { return line_; }
 
-    std::vector<Arg> args;
+    std::vector<Arg>& args;
 
     /// Reads `key=value` tokens, rejecting missing '=', unknown and duplicate keys, and empty
     /// values, in the order they appear on the line.
@@ -155,7 +199,7 @@ class Statement {
                 fail(t.column, "expected key=value, got " + quote(t.text) + " (missing '=')");
             Arg a{t.text.substr(0, eq), t.column, t.text.substr(eq + 1), t.column + int(eq) + 1};
             if (a.key.empty()) fail(t.column, "missing key before '=' in " + quote(t.text));
-            if (std::find(allowed.begin(), allowed.end(), a.key) == allowed.end()) {
+            if (std::none_of(allowed.begin(), allowed.end(), [&](std::string_view k) { return same(k, a.key); })) {
                 std::string msg = "unknown key " + quote(a.key) + " for '" + std::string(word()) +
                                   "' (expected one of:";
                 for (auto k : allowed) msg += " " + std::string(k);
@@ -163,7 +207,7 @@ class Statement {
                 fail(a.key_col, msg);
             }
             for (const Arg& prev : args)
-                if (prev.key == a.key)
+                if (same(prev.key, a.key))
                     fail(a.key_col, "duplicate key " + quote(a.key) + " (first given at column " +
                                         std::to_string(prev.key_col) + ")");
             if (a.value.empty()) fail(a.value_col, "empty value for " + quote(a.key));
@@ -173,7 +217,7 @@ class Statement {
 
     const Arg* find(std::string_view key) const {
         for (const Arg& a : args)
-            if (a.key == key) return &a;
+            if (same(a.key, key)) return &a;
         return nullptr;
     }
 
@@ -218,18 +262,11 @@ class Statement {
         return int(*v);
     }
     glm::dvec3 vec3(const Arg& a) const {
-        const auto parts = split_commas(a.value);
-        glm::dvec3 out{0.0};
-        bool ok = parts.size() == 3;
-        for (std::size_t i = 0; ok && i < 3; ++i) {
-            const auto v = to_number(parts[i]);
-            if (!v) ok = false;
-            else out[int(i)] = *v;
-        }
-        if (!ok)
+        const auto v = to_vec3(a.value);
+        if (!v)
             fail(a.value_col, "expected 3 comma-separated numbers x,y,z for " + quote(a.key) +
                                   ", got " + quote(a.value));
-        return out;
+        return *v;
     }
     glm::dvec3 color(const Arg& a) const {
         const glm::dvec3 c = vec3(a);
@@ -263,7 +300,7 @@ class Statement {
     }
 
   private:
-    std::string file_;
+    const std::string* file_;  // outlives the statement: the reader's name for the file
     int line_;
     Token word_;
 };
@@ -288,6 +325,22 @@ std::vector<std::string_view> join(std::initializer_list<std::vector<std::string
     return out;
 }
 
+// The joined lists, built once (the order is the one messages list them in).
+const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys});
+const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
+const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys});
+const std::vector<std::string_view> kTorusKeys = join({kShapeKeys, {"minor"}});
+const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth"}});
+const std::vector<std::string_view> kPointLightKeys = {"pos", "color"};
+const std::vector<std::string_view> kSpotLightKeys = {"pos", "dir", "angle", "color"};
+const std::vector<std::string_view> kDirectionalLightKeys = {"dir", "color"};
+
+const std::vector<std::string_view>& shape_keys(ShapeKind kind) {
+    if (kind == ShapeKind::Torus) return kTorusKeys;
+    if (kind == ShapeKind::Mesh) return kMeshKeys;
+    return kShapeKeys;
+}
+
 bool contains(const std::vector<std::string_view>& v, std::string_view k) {
     return std::find(v.begin(), v.end(), k) != v.end();
 }
@@ -303,18 +356,18 @@ struct Appearance {
 bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
     const auto k = a.key;
     Material& m = ap.m;
-    if (k == "color") ap.color = st.color(a);
-    else if (k == "ambi") m.ambi = st.at_least_zero(a);
-    else if (k == "diff") m.diff = st.at_least_zero(a);
-    else if (k == "spec") m.spec = st.at_least_zero(a);
-    else if (k == "shininess") m.shininess = st.at_least_zero(a);
-    else if (k == "refl") m.refl = st.at_least_zero(a);
-    else if (k == "trans") m.trans = st.at_least_zero(a);
-    else if (k == "ior") m.ior = st.positive(a);
-    else if (k == "checker") {
+    if (same(k, "color")) ap.color = st.color(a);
+    else if (same(k, "ambi")) m.ambi = st.at_least_zero(a);
+    else if (same(k, "diff")) m.diff = st.at_least_zero(a);
+    else if (same(k, "spec")) m.spec = st.at_least_zero(a);
+    else if (same(k, "shininess")) m.shininess = st.at_least_zero(a);
+    else if (same(k, "refl")) m.refl = st.at_least_zero(a);
+    else if (same(k, "trans")) m.trans = st.at_least_zero(a);
+    else if (same(k, "ior")) m.ior = st.positive(a);
+    else if (same(k, "checker")) {
         m.checker_color = st.color(a);
         m.checker = true;
-    } else if (k == "cell") m.cell = st.positive(a);
+    } else if (same(k, "cell")) m.cell = st.positive(a);
     else return false;
     return true;
 }
@@ -323,25 +376,29 @@ bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
 bool apply_transform_key(const Statement& st, const Arg& a, glm::dmat4& md) {
     const auto k = a.key;
     glm::dmat4 t;
-    if (k == "scale") t = scale_matrix(st.scale(a));
-    else if (k == "rotate_x") t = rotate_x_matrix(st.number(a));
-    else if (k == "rotate_y") t = rotate_y_matrix(st.number(a));
-    else if (k == "rotate_z") t = rotate_z_matrix(st.number(a));
-    else if (k == "translate") t = translate_matrix(st.vec3(a));
+    if (same(k, "scale")) t = scale_matrix(st.scale(a));
+    else if (same(k, "rotate_x")) t = rotate_x_matrix(st.number(a));
+    else if (same(k, "rotate_y")) t = rotate_y_matrix(st.number(a));
+    else if (same(k, "rotate_z")) t = rotate_z_matrix(st.number(a));
+    else if (same(k, "translate")) t = translate_matrix(st.vec3(a));
     else return false;
     md = t * md;
     return true;
 }
 
 std::optional<ShapeKind> shape_from_word(std::string_view w) {
-    if (w == "sphere") return ShapeKind::Sphere;
-    if (w == "cube") return ShapeKind::Cube;
-    if (w == "cylinder") return ShapeKind::Cylinder;
-    if (w == "cone") return ShapeKind::Cone;
-    if (w == "torus") return ShapeKind::Torus;
-    if (w == "plane") return ShapeKind::Plane;
+    if (same(w, "sphere")) return ShapeKind::Sphere;
+    if (same(w, "cube")) return ShapeKind::Cube;
+    if (same(w, "cylinder")) return ShapeKind::Cylinder;
+    if (same(w, "cone")) return ShapeKind::Cone;
+    if (same(w, "torus")) return ShapeKind::Torus;
+    if (same(w, "plane")) return ShapeKind::Plane;
     return std::nullopt;
 }
+
+/// The statement words the chunked reader parses in parallel (mesh and include fall back to
+/// one sequential pass: they read other files).
+bool is_plain_shape(std::string_view w) { return shape_from_word(w).has_value(); }
 
 /// A path's identity for cycle detection.
 fs::path identity_of(const fs::path& p) {
@@ -355,21 +412,130 @@ fs::path identity_of(const fs::path& p) {
     return id;
 }
 
-bool read_whole_file(const fs::path& p, std::string& out) {
-    std::error_code ec;
-    if (!fs::is_regular_file(p, ec)) return false;
-    std::ifstream in(p, std::ios::binary);
-    if (!in) return false;
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) return false;
-    out = ss.str();
-    return true;
+/// A scene file's bytes: mapped read-only (the chunked reader gives parsed ranges back, see
+/// advise_inside), or read into a string when mapping is not possible (an empty-looking file
+/// such as those of /proc).
+class FileText {
+  public:
+    FileText() = default;
+    FileText(const FileText&) = delete;
+    FileText& operator=(const FileText&) = delete;
+    ~FileText() {
+        if (map_) ::munmap(map_, size_);
+    }
+
+    bool open(const fs::path& p) {
+        std::error_code ec;
+        if (!fs::is_regular_file(p, ec)) return false;
+        const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd < 0) return false;
+        struct stat st{};
+        bool ok = ::fstat(fd, &st) == 0;
+        if (ok && st.st_size > 0) {
+            void* m = ::mmap(nullptr, std::size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
+            if (m != MAP_FAILED) {
+                map_ = m;
+                size_ = std::size_t(st.st_size);
+                ::madvise(map_, size_, MADV_SEQUENTIAL);
+            }
+        }
+        if (ok && !map_) {
+            char buf[1 << 16];
+            for (ssize_t n; (n = ::read(fd, buf, sizeof buf)) != 0;) {
+                if (n < 0) {
+                    ok = false;
+                    break;
+                }
+                owned_.append(buf, std::size_t(n));
+            }
+        }
+        ::close(fd);
+        return ok;
+    }
+
+    std::string_view text() const {
+        return map_ ? std::string_view(static_cast<const char*>(map_), size_) : std::string_view(owned_);
+    }
+    bool mapped() const { return map_ != nullptr; }
+
+  private:
+    void* map_ = nullptr;
+    std::size_t size_ = 0;
+    std::string owned_;
+};
+
+/// madvise over the whole `block`-aligned blocks inside [begin, end) (none when there are
+/// none; 0: the page size). Used to give parsed text back (MADV_DONTNEED: read again from the
+/// page cache if touched), to ask for huge pages for the object array (MADV_HUGEPAGE: some
+/// hundreds of faults instead of 100 000s) and to fault its slices in from every thread
+/// (MADV_POPULATE_WRITE: zeroing the fresh pages of a million-object array is a large part of
+/// reading a big scene, left to one thread in resize() otherwise).
+void advise_inside(const void* begin, const void* end, int advice, std::uintptr_t block = 0) {
+    if (block == 0) block = std::uintptr_t(::sysconf(_SC_PAGESIZE));
+    const std::uintptr_t b = (std::uintptr_t(begin) + block - 1) & ~(block - 1);
+    const std::uintptr_t e = std::uintptr_t(end) & ~(block - 1);
+    if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, advice);
 }
+
+/// Per-thread lexing scratch: the token and argument lists of the line being read.
+struct Scratch {
+    std::vector<Token> toks;
+    std::vector<Arg> args;
+};
+
+/// A material and the first line it may be used from (0 when read in one pass: whatever is
+/// defined is usable, as statements run in order).
+struct MaterialDef {
+    Appearance look;
+    int from_line = 0;
+};
+
+/// Where a pass puts the materials of the objects it reads: the scene's own deduplicated list
+/// (one pass), or a chunk's private list, merged into the scene's in chunk order afterwards
+/// (so the scene's list is the same for every thread count).
+class MaterialList {
+  public:
+    std::uint32_t intern(const Material& m) {
+        if (scene_) return scene_->intern_material(m);
+        const auto [it, added] = index_.try_emplace(m, std::uint32_t(list_.size()));
+        if (added) list_.push_back(m);
+        return it->second;
+    }
+    explicit MaterialList(Scene* scene = nullptr) : scene_(scene) {}
+    const std::vector<Material>& local() const { return list_; }
+
+  private:
+    Scene* scene_;
+    std::unordered_map<Material, std::uint32_t, MaterialHash> index_;
+    std::vector<Material> list_;
+};
+
+/// One chunk of a large text: complete lines [begin, end).
+struct Chunk {
+    std::size_t begin = 0, end = 0;
+    int first_line = 0;                  // line number of `begin`
+    std::size_t first_object = 0;        // its first slot in scene.objects
+    MaterialList materials;              // its objects' materials, indexed by them until merged
+    std::size_t shapes = 0;              // shape statements in it
+    int lines = 0;                       // '\n' in it
+    std::vector<std::pair<std::size_t, int>> others;  // non-shape statements: offset, line in chunk
+    bool sequential_only = false;        // holds include or mesh
+    std::exception_ptr error;            // the first one in the chunk
+    int error_line = INT_MAX;
+};
 
 class Parser {
   public:
     Scene scene;
+
+    explicit Parser(const ReadOptions& options) : options_(options) {}
+
+    /// Reads a top-level text: chunked and in parallel when it is large and plain, else in
+    /// one pass. `mapped`: the text is a private file mapping whose pages may be released.
+    void read_top(std::string_view text, const std::string& display, const fs::path& id, bool mapped) {
+        if (text.size() >= options_.chunked_from && read_chunked(text, display, mapped)) return;
+        read_text(text, display, id, 0);
+    }
 
     /// Reads the text of one file. `display` names it in messages; `id` identifies it for
     /// cycle detection; includes are resolved against `display`'s directory.
@@ -384,23 +550,171 @@ class Parser {
             auto nl = text.find('\n', pos);
             if (nl == std::string_view::npos) nl = text.size();
             ++line_no;
-            statement(text.substr(pos, nl - pos), display, line_no, depth);
+            statement(text.substr(pos, nl - pos), display, line_no, depth, scratch_);
             pos = nl + 1;
         }
         open_.pop_back();
     }
 
   private:
-    std::map<std::string, Appearance, std::less<>> materials_;
+    ReadOptions options_;
+    bool chunked_ = false;  // materials carry the line they are defined at (see MaterialDef)
+    Scratch scratch_;       // the sequential pass's
+    std::map<std::string, MaterialDef, std::less<>> materials_;
     std::vector<fs::path> open_;  // the include chain being read
     std::map<fs::path, std::uint32_t> meshes_;  // by file identity: loaded once, shared (index in scene.meshes)
-    std::uint32_t last_file_ = 0;
+    MaterialList scene_materials_{&scene};  // the one-pass reader's: straight into the scene
     int files_ = 0;
 
-    void statement(std::string_view line, const std::string& file, int line_no, int depth) {
-        const auto toks = tokenize(line);
+    /// The chunked reader. First pass (parallel): cut into chunks at line ends, count lines
+    /// and shape statements, note the other statements. Then the other statements run in
+    /// file order, then the shapes of every chunk are parsed (parallel) into their own slice
+    /// of scene.objects, reserved once. The first error in file order wins. False (nothing
+    /// done) when the text holds include or mesh: those are read in one sequential pass.
+    bool read_chunked(std::string_view text, const std::string& display, bool mapped) {
+        if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 BOM
+        std::vector<Chunk> chunks;
+        const std::size_t step = std::max<std::size_t>(1, options_.chunk_bytes);
+        for (std::size_t b = 0; b < text.size();) {
+            std::size_t e = std::min(text.size(), b + step);
+            if (e < text.size()) {
+                const auto nl = text.find('\n', e - 1);
+                const std::size_t probe = e - 1;
+                e = nl == std::string_view::npos ? text.size() : nl + 1;
+                // One fault may map a whole large folio of the page cache (up to 2 MiB here):
+                // without this, the boundary probes alone left ~90% of a 100 MB file mapped.
+                if (mapped) {
+                    constexpr std::size_t kFolio = std::size_t(2) << 20;
+                    advise_inside(text.data() + (probe > kFolio ? probe - kFolio : 0),
+                                  text.data() + std::min(text.size(), e + kFolio), MADV_DONTNEED);
+                }
+            }
+            chunks.push_back({});
+            chunks.back().begin = b;
+            chunks.back().end = e;
+            b = e;
+        }
+        Parallelism par(options_.jobs);
+        par.for_each_index(chunks.size(), 1, [&](std::size_t i) {
+            survey(text, chunks[i]);
+            if (mapped) advise_inside(text.data() + chunks[i].begin, text.data() + chunks[i].end, MADV_DONTNEED);
+        });
+        std::size_t objects = 0;
+        int line = 1;
+        bool sequential_only = false;
+        for (Chunk& c : chunks) {
+            sequential_only = sequential_only || c.sequential_only;
+            c.first_line = line;
+            c.first_object = objects;
+            line += c.lines;
+            objects += c.shapes;
+        }
+        if (sequential_only) {
+            scene.objects.reserve(objects);  // this file's shapes at least: fewer regrowths
+            return false;
+        }
+        chunked_ = true;
+        ++files_;
+
+        // The other statements, in file order; they stop at their first error.
+        std::exception_ptr other_error;
+        int other_error_line = INT_MAX;
+        for (const Chunk& c : chunks) {
+            for (const auto& [offset, in_chunk] : c.others) {
+                const int at = c.first_line + in_chunk;
+                try {
+                    statement(line_at(text, offset), display, at, 0, scratch_);
+                } catch (...) {
+                    other_error = std::current_exception();
+                    other_error_line = at;
+                    break;
+                }
+            }
+            if (other_error) break;
+        }
+
+        const std::uint32_t file = file_index(display);
+        scene.objects.reserve(objects);
+        Object* const slots = scene.objects.data();
+        advise_inside(slots, slots + objects, MADV_HUGEPAGE, std::uintptr_t(2) << 20);
+        par.for_each_index(chunks.size(), 1, [&](std::size_t i) {
+            advise_inside(slots + chunks[i].first_object, slots + chunks[i].first_object + chunks[i].shapes,
+                          MADV_POPULATE_WRITE);
+        });
+        scene.objects.resize(objects);
+        scene.object_locs.resize(objects);
+        // Every chunk is read even after an error: which error comes first is then decided
+        // below in file order, never by which thread got there first.
+        par.for_each_index(chunks.size(), 1, [&](std::size_t i) {
+            read_shapes(text, display, file, chunks[i]);
+            if (mapped) advise_inside(text.data() + chunks[i].begin, text.data() + chunks[i].end, MADV_DONTNEED);
+        });
+        for (const Chunk& c : chunks)
+            if (c.error && c.error_line < other_error_line) std::rethrow_exception(c.error);
+        if (other_error) std::rethrow_exception(other_error);
+        // The chunks' materials into the scene's list in chunk order, then each object's
+        // chunk-local index replaced by the scene's (skipped where they coincide).
+        std::vector<std::vector<std::uint32_t>> remap(chunks.size());
+        for (std::size_t i = 0; i < chunks.size(); ++i)
+            for (const Material& m : chunks[i].materials.local()) remap[i].push_back(scene.intern_material(m));
+        par.for_each_index(chunks.size(), 1, [&](std::size_t i) {
+            const std::vector<std::uint32_t>& to = remap[i];
+            bool identity = true;
+            for (std::uint32_t k = 0; k < to.size(); ++k) identity = identity && to[k] == k;
+            if (identity) return;
+            for (std::size_t k = chunks[i].first_object; k < chunks[i].first_object + chunks[i].shapes; ++k)
+                scene.objects[k].material = to[scene.objects[k].material];
+        });
+        return true;
+    }
+
+    static std::string_view line_at(std::string_view text, std::size_t offset) {
+        const auto nl = text.find('\n', offset);
+        return text.substr(offset, (nl == std::string_view::npos ? text.size() : nl) - offset);
+    }
+
+    /// First pass over a chunk: lines, shapes, the offsets of the other statements.
+    static void survey(std::string_view text, Chunk& c) {
+        for (std::size_t pos = c.begin; pos < c.end;) {
+            const std::string_view line = line_at(text, pos);
+            const std::string_view w = first_word(line);
+            if (is_plain_shape(w)) ++c.shapes;
+            else if (w == "include" || w == "mesh") c.sequential_only = true;
+            else if (!w.empty()) c.others.emplace_back(pos, c.lines);
+            pos += line.size() + 1;
+            ++c.lines;
+        }
+    }
+
+    /// Second pass over a chunk: its shapes into scene.objects[c.first_object...]; stops at
+    /// the chunk's first error (kept with its line).
+    void read_shapes(std::string_view text, const std::string& display, std::uint32_t file, Chunk& c) {
+        Scratch scratch;
+        std::size_t slot = c.first_object;
+        int line_no = c.first_line;
+        try {
+            for (std::size_t pos = c.begin; pos < c.end; ++line_no) {
+                const std::string_view line = line_at(text, pos);
+                pos += line.size() + 1;
+                tokenize(line, scratch.toks);
+                if (scratch.toks.empty()) continue;
+                const auto kind = shape_from_word(scratch.toks[0].text);
+                if (!kind) continue;  // already read, in file order
+                Statement st(display, line_no, scratch.toks[0], scratch.args);
+                shape(st, scratch.toks, *kind, file, c.materials, scene.objects[slot], scene.object_locs[slot]);
+                ++slot;
+            }
+        } catch (...) {
+            c.error = std::current_exception();
+            c.error_line = line_no;
+        }
+    }
+
+    void statement(std::string_view line, const std::string& file, int line_no, int depth, Scratch& scratch) {
+        tokenize(line, scratch.toks);
+        const std::vector<Token>& toks = scratch.toks;
         if (toks.empty()) return;
-        Statement st(file, line_no, toks[0]);
+        Statement st(file, line_no, toks[0], scratch.args);
         const auto w = toks[0].text;
         if (w == "image") image(st, toks);
         else if (w == "ambient") ambient(st, toks);
@@ -409,8 +723,8 @@ class Parser {
         else if (w == "light") light(st, toks);
         else if (w == "material") material(st, toks);
         else if (w == "include") include(st, toks, depth);
-        else if (w == "mesh") shape(st, toks, ShapeKind::Mesh);
-        else if (auto kind = shape_from_word(w)) shape(st, toks, *kind);
+        else if (w == "mesh") one_pass_shape(st, toks, ShapeKind::Mesh);
+        else if (auto kind = shape_from_word(w)) one_pass_shape(st, toks, *kind);
         else
             st.fail_here("unknown statement " + quote(w) +
                          " (expected image, ambient, background, camera, light, material, "
@@ -469,7 +783,7 @@ class Parser {
     }
 
     void camera(Statement& st, const std::vector<Token>& toks) {
-        st.read_args(toks, 1, join({kLookAtKeys, kExplicitCameraKeys}));
+        st.read_args(toks, 1, kCameraKeys);
         Camera cam;
         if (!st.args.empty()) {
             const Arg& first = st.args.front();
@@ -525,21 +839,21 @@ class Parser {
             st.fail_here("expected a light kind (point, spot or directional) after 'light'");
         const Token& kt = toks[1];
         Light l;
-        std::vector<std::string_view> keys;
+        const std::vector<std::string_view>* keys = nullptr;
         if (kt.text == "point") {
             l.kind = LightKind::Point;
-            keys = {"pos", "color"};
+            keys = &kPointLightKeys;
         } else if (kt.text == "spot") {
             l.kind = LightKind::Spot;
-            keys = {"pos", "dir", "angle", "color"};
+            keys = &kSpotLightKeys;
         } else if (kt.text == "directional") {
             l.kind = LightKind::Directional;
-            keys = {"dir", "color"};
+            keys = &kDirectionalLightKeys;
         } else {
             st.fail(kt.column,
                     "expected a light kind (point, spot or directional), got " + quote(kt.text));
         }
-        st.read_args(toks, 2, keys);
+        st.read_args(toks, 2, *keys);
         for (const Arg& a : st.args) {
             if (a.key == "pos") l.pos = st.vec3(a);
             else if (a.key == "dir") l.dir = st.direction(a);
@@ -554,12 +868,14 @@ class Parser {
         scene.lights.push_back(l);
     }
 
+    /// The material named by `a`, as defined at this statement: the chunked reader has read
+    /// every material statement first, so one defined on a later line is refused here.
     const Appearance& lookup_material(const Statement& st, const Arg& a) const {
         const auto it = materials_.find(a.value);
-        if (it == materials_.end())
+        if (it == materials_.end() || it->second.from_line > st.line())
             st.fail(a.value_col, "unknown material " + quote(a.value) +
                                      " (a material must be defined before it is used)");
-        return it->second;
+        return it->second.look;
     }
 
     void material(Statement& st, const std::vector<Token>& toks) {
@@ -569,68 +885,80 @@ class Parser {
         const Token& name = toks[1];
         if (const auto it = materials_.find(name.text); it != materials_.end())
             st.fail(name.column, "material " + quote(name.text) + " is already defined");
-        std::vector<std::string_view> keys = kMaterialKeys;
-        keys.push_back("material");  // a base material to start from
-        st.read_args(toks, 2, keys);
+        st.read_args(toks, 2, kMaterialStatementKeys);  // "material": a base to start from
         Appearance m;
         if (const Arg* base = st.find("material")) m = lookup_material(st, *base);
         for (const Arg& a : st.args) apply_material_key(st, a, m);
-        materials_.emplace(std::string(name.text), m);
+        materials_.emplace(std::string(name.text), MaterialDef{m, chunked_ ? st.line() : 0});
     }
 
-    void shape(Statement& st, const std::vector<Token>& toks, ShapeKind kind) {
-        std::vector<std::string_view> keys = join({{"material"}, kMaterialKeys, kTransformKeys});
-        if (kind == ShapeKind::Torus) keys.push_back("minor");
-        if (kind == ShapeKind::Mesh) keys.insert(keys.end(), {"file", "smooth"});
-        st.read_args(toks, 1, keys);
+    /// What a shape statement says, before it becomes an Object (make_object).
+    struct ShapeFields {
+        ShapeKind kind = ShapeKind::Sphere;
         Appearance look;
-        if (const Arg* base = st.find("material")) look = lookup_material(st, *base);
-        glm::dmat4 md(1.0);
-        double minor = 0.25;
+        glm::dmat4 md{1.0};
+        double minor = 0.25;  // the torus's default
         bool smooth = false;
-        std::uint32_t mesh = 0;
-        bool has_mesh = false;
-        for (const Arg& a : st.args) {
-            if (a.key == "material") continue;
-            if (apply_material_key(st, a, look)) continue;
-            if (apply_transform_key(st, a, md)) continue;
-            if (a.key == "minor") minor = st.positive(a);
-            else if (a.key == "smooth") {
-                if (a.value == "true") smooth = true;
-                else if (a.value == "false") smooth = false;
-                else st.fail(a.value_col, "expected true or false for 'smooth', got " + quote(a.value));
-            } else if (a.key == "file") {
-                mesh = mesh_file(st, a);
-                has_mesh = true;
-            }
-        }
-        if (kind == ShapeKind::Mesh && !has_mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
-        if (singular(md))
-            st.fail_here(std::string(st.word()) +
-                         ": the composed transform is singular (or not finite)");
-        add_object(st, kind, md, look, kind == ShapeKind::Torus ? minor : kind == ShapeKind::Mesh ? (smooth ? 1.0 : 0.0) : 0.0,
-                   mesh);
+        std::optional<std::uint32_t> mesh;  // index in scene.meshes
+    };
+
+    /// The one place an Object is built from a checked shape statement, in place: `obj` and
+    /// `loc` are its slots in scene.objects and scene.object_locs.
+    static void make_object(const Statement& st, const ShapeFields& f, std::uint32_t file, MaterialList& materials,
+                            Object& obj, ObjectLoc& loc) {
+        obj.kind = f.kind;
+        obj.md = glm::dmat4x3(f.md);
+        obj.param = f.kind == ShapeKind::Torus ? f.minor : f.kind == ShapeKind::Mesh ? (f.smooth ? 1.0 : 0.0) : 0.0;
+        obj.color = glm::vec3(f.look.color);
+        obj.material = materials.intern(f.look.m);
+        obj.mesh = f.mesh.value_or(0);
+        loc = ObjectLoc{file, st.line(), st.where().column};
     }
 
-    /// Stores one object of the scene (the only place objects are made).
-    void add_object(const Statement& st, ShapeKind kind, const glm::dmat4& md, const Appearance& look, double param,
-                    std::uint32_t mesh) {
+    /// A shape statement of the one-pass reader, appended to the scene.
+    void one_pass_shape(Statement& st, const std::vector<Token>& toks, ShapeKind kind) {
+        const std::uint32_t file = file_index(st.file());
         Object obj;
-        obj.kind = kind;
-        obj.md = glm::dmat4x3(md);
-        obj.param = param;
-        obj.color = glm::vec3(look.color);
-        obj.mesh = mesh;
-        scene.add_object(obj, look.m, ObjectLoc{file_index(st.file()), st.line(), st.where().column});
+        ObjectLoc loc;
+        shape(st, toks, kind, file, scene_materials_, obj, loc);
+        scene.objects.push_back(obj);
+        scene.object_locs.push_back(loc);
     }
 
-    /// The index of a file name in Scene::files.
+    /// The index of a file name in Scene::files (one-pass reader and set-up only: not
+    /// thread-safe).
     std::uint32_t file_index(const std::string& file) {
         if (!scene.files.empty() && scene.files[last_file_] == file) return last_file_;
         for (std::uint32_t i = 0; i < scene.files.size(); ++i)
             if (scene.files[i] == file) return last_file_ = i;
         scene.files.push_back(file);
         return last_file_ = std::uint32_t(scene.files.size() - 1);
+    }
+    std::uint32_t last_file_ = 0;
+
+    /// Reads a shape statement into `out` and `loc`.
+    void shape(Statement& st, const std::vector<Token>& toks, ShapeKind kind, std::uint32_t file,
+               MaterialList& materials, Object& out, ObjectLoc& loc) {
+        st.read_args(toks, 1, shape_keys(kind));
+        ShapeFields f;
+        f.kind = kind;
+        if (const Arg* base = st.find("material")) f.look = lookup_material(st, *base);
+        for (const Arg& a : st.args) {
+            if (same(a.key, "material")) continue;
+            if (apply_material_key(st, a, f.look)) continue;
+            if (apply_transform_key(st, a, f.md)) continue;
+            if (same(a.key, "minor")) f.minor = st.positive(a);
+            else if (same(a.key, "smooth")) {
+                if (same(a.value, "true")) f.smooth = true;
+                else if (same(a.value, "false")) f.smooth = false;
+                else st.fail(a.value_col, "expected true or false for 'smooth', got " + quote(a.value));
+            } else if (same(a.key, "file")) f.mesh = mesh_file(st, a);
+        }
+        if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
+        if (singular(f.md))
+            st.fail_here(std::string(st.word()) +
+                         ": the composed transform is singular (or not finite)");
+        make_object(st, f, file, materials, out, loc);
     }
 
     /// The mesh of an OBJ file named relative to the statement's file, read once per file:
@@ -673,30 +1001,36 @@ class Parser {
         const fs::path id = identity_of(target);
         if (std::find(open_.begin(), open_.end(), id) != open_.end())
             st.fail(t.column, "include cycle: " + quote(shown) + " is already being read");
-        std::string text;
-        if (!read_whole_file(target, text))
-            st.fail(t.column, "cannot open included file " + quote(shown));
-        read_text(text, shown, id, depth + 1);
+        FileText text;
+        if (!text.open(target)) st.fail(t.column, "cannot open included file " + quote(shown));
+        read_text(text.text(), shown, id, depth + 1);
     }
 };
 
 }  // namespace
 
-Scene load_scene(const std::string& path) {
-    std::string text;
-    if (!read_whole_file(fs::path(path), text))
-        throw SceneError(SourceLoc{path, 0, 0}, "cannot open scene file");
-    Parser p;
+Scene load_scene(const std::string& path, const ReadOptions& options) {
+    FileText text;
+    if (!text.open(fs::path(path))) throw SceneError(SourceLoc{path, 0, 0}, "cannot open scene file");
+    Parser p(options);
     p.scene.path = path;
-    p.read_text(text, path, identity_of(path), 0);
+    p.read_top(text.text(), path, identity_of(path), text.mapped());
     return std::move(p.scene);
 }
 
-Scene parse_scene(std::string_view text, const std::string& name) {
-    Parser p;
+Scene load_scene(const std::string& path, int jobs) {
+    ReadOptions options;
+    options.jobs = jobs;
+    return load_scene(path, options);
+}
+
+Scene parse_scene(std::string_view text, const std::string& name, const ReadOptions& options) {
+    Parser p(options);
     p.scene.path = name;
-    p.read_text(text, name, identity_of(name.empty() ? fs::path("<memory>") : fs::path(name)), 0);
+    p.read_top(text, name, identity_of(name.empty() ? fs::path("<memory>") : fs::path(name)), false);
     return std::move(p.scene);
 }
+
+Scene parse_scene(std::string_view text, const std::string& name) { return parse_scene(text, name, ReadOptions{}); }
 
 }  // namespace streamrt

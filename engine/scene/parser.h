@@ -1,6 +1,7 @@
 #pragma once
 // Reads the line-oriented .cfg scene format (docs/scene-format.md). Every mistake throws a
 // SceneError carrying file:line:col; a returned Scene is fully validated.
+#include <cstddef>
 #include <string>
 #include <string_view>
 
@@ -8,11 +9,23 @@
 
 namespace streamrt {
 
-/// Loads and validates a scene file, following `include` statements.
-Scene load_scene(const std::string& path);
+/// How a large text is read: cut into chunks at line ends, shapes of the chunks parsed in
+/// parallel (docs/architecture.md, "Scene reading"). The Scene and the error are the same
+/// for every setting.
+struct ReadOptions {
+    int jobs = 0;                          ///< threads; <= 0: all cores
+    std::size_t chunk_bytes = 1u << 20;    ///< a chunk's size, extended to the next line end
+    std::size_t chunked_from = 1u << 20;   ///< smaller texts are read in one sequential pass
+};
+
+/// Loads and validates a scene file, following `include` statements. `jobs` threads read a
+/// large file (<= 0: all cores).
+Scene load_scene(const std::string& path, int jobs = 0);
+Scene load_scene(const std::string& path, const ReadOptions& options);
 
 /// Parses scene text held in memory; `name` stands for the file in messages and is the base
 /// for relative includes.
 Scene parse_scene(std::string_view text, const std::string& name);
+Scene parse_scene(std::string_view text, const std::string& name, const ReadOptions& options);
 
 }  // namespace streamrt

@@ -47,7 +47,7 @@ glm::dmat4 Camera::world_from_canonical(int width, int height) const {
 
 namespace streamrt {
 
-std::size_t Scene::MaterialHash::operator()(const Material& m) const {
+std::size_t MaterialHash::operator()(const Material& m) const {
     // Equal materials have equal fields; fields are hashed by value (+0 and -0 compare equal
     // and are both possible only for checker colours, which then hash alike through +0.0).
     std::size_t h = 0;
@@ -58,10 +58,14 @@ std::size_t Scene::MaterialHash::operator()(const Material& m) const {
     return h ^ std::size_t(m.checker);
 }
 
-void Scene::add_object(Object o, const Material& m, const ObjectLoc& loc) {
+std::uint32_t Scene::intern_material(const Material& m) {
     const auto [it, added] = material_index_.try_emplace(m, std::uint32_t(materials.size()));
     if (added) materials.push_back(m);
-    o.material = it->second;
+    return it->second;
+}
+
+void Scene::add_object(Object o, const Material& m, const ObjectLoc& loc) {
+    o.material = intern_material(m);
     objects.push_back(o);
     object_locs.push_back(loc);
 }

@@ -50,6 +50,11 @@ struct Material {
     bool operator==(const Material&) const = default;
 };
 
+/// Hash of a material's fields, for deduplication (equal materials hash alike).
+struct MaterialHash {
+    std::size_t operator()(const Material& m) const;
+};
+
 /// One object, compact (128 bytes; a scene may hold millions): the canonical shape, Md, the
 /// object's colour and the index of its (deduplicated) material. Mi and Mn are not stored:
 /// each engine derives what it needs from Md once, in the precision it works in. Where the
@@ -140,11 +145,10 @@ struct Scene {
     }
     /// Adds an object; its material is deduplicated against those already here.
     void add_object(Object o, const Material& m = {}, const ObjectLoc& loc = {});
+    /// The index of material m in `materials`, added if no equal one is there.
+    std::uint32_t intern_material(const Material& m);
 
   private:
-    struct MaterialHash {
-        std::size_t operator()(const Material& m) const;
-    };
     std::unordered_map<Material, std::uint32_t, MaterialHash> material_index_;
 };
 

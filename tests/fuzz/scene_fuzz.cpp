@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +16,7 @@
 
 #include "fuzz/include_tree.h"
 #include "fuzz/scene_contract.h"
+#include "scene/parser.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -42,6 +44,20 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
     return 0;
 }
 
+/// What a read gives, in short: the error's text, or the objects' kinds and lines.
+std::string outcome(std::string_view text, const streamrt::ReadOptions& options) {
+    try {
+        const streamrt::Scene sc = streamrt::parse_scene(text, g_name, options);
+        std::string out = "ok";
+        for (std::size_t i = 0; i < sc.objects.size(); ++i)
+            out += " " + std::to_string(int(sc.objects[i].kind)) + "@" + std::to_string(sc.where(i).line) + "m" +
+                   std::to_string(sc.objects[i].material);
+        return out;
+    } catch (const streamrt::SceneError& e) {
+        return e.what();
+    }
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const std::string_view text(reinterpret_cast<const char*>(data), size);
     try {
@@ -50,5 +66,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } catch (const streamrt::SceneError& e) {
         require(streamrt_fuzz::check_error(e));
     }
+    // The chunked reader (tiny chunks, one thread) must say exactly what one pass says.
+    streamrt::ReadOptions one_pass, chunked;
+    one_pass.chunked_from = SIZE_MAX;
+    chunked.jobs = 1;
+    chunked.chunk_bytes = 5;
+    chunked.chunked_from = 0;
+    const std::string a = outcome(text, one_pass), b = outcome(text, chunked);
+    if (a != b) require("chunked read differs: '" + b + "' instead of '" + a + "'");
     return 0;
 }
