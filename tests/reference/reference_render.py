@@ -467,7 +467,11 @@ def trace(scene, o, d, level, width0, spread):
     deg = scene.image["degree"]
     colour = np.tile(scene.background, (n, 1)).astype(float)
     unsure = np.zeros(n, bool)
+    if n == 0:
+        return colour, unsure
     t, k, p, nout = closest_hit(scene, o, d)
+    # Secondary rays of every object are traced together, one batch per bounce level.
+    sec = dict(o=[], d=[], w=[], parent=[], width=[])
     for idx, obj in enumerate(scene.objects):
         sel = np.nonzero(k == idx)[0]
         if len(sel) == 0:
@@ -518,9 +522,7 @@ def trace(scene, o, d, level, width0, spread):
         if deg >= 3 and level < scene.image["depth"]:
             refl_dir = D - 2 * _dot(D, N)[:, None] * N
             if mat["refl"] > 0:
-                c2, u2 = trace(scene, off, refl_dir, level + 1, width, spread)
-                col = col + mat["refl"] * c2
-                uns |= u2
+                _queue(sec, off, refl_dir, mat["refl"], sel, width)
             if deg >= 4 and mat["trans"] > 0:
                 entering = cos_i < 0
                 eta = np.where(entering, 1 / mat["ior"], mat["ior"])
@@ -531,12 +533,23 @@ def trace(scene, o, d, level, width0, spread):
                 T /= np.linalg.norm(T, axis=1, keepdims=True)
                 tdir = np.where(tir[:, None], refl_dir, T)
                 torg = np.where(tir[:, None], off, P - eps[:, None] * N)
-                c2, u2 = trace(scene, torg, tdir, level + 1, width, spread)
-                col = col + mat["trans"] * c2
-                uns |= u2
+                _queue(sec, torg, tdir, mat["trans"], sel, width)
         colour[sel] = col
         unsure[sel] = uns
+    if sec["o"]:
+        cat = {key: np.concatenate(val) for key, val in sec.items()}
+        c2, u2 = trace(scene, cat["o"], cat["d"], level + 1, cat["width"], spread)
+        np.add.at(colour, cat["parent"], cat["w"][:, None] * c2)
+        unsure[cat["parent"][u2]] = True
     return colour, unsure
+
+
+def _queue(sec, o, d, weight, parent, width):
+    sec["o"].append(o)
+    sec["d"].append(d)
+    sec["w"].append(np.full(len(o), weight))
+    sec["parent"].append(parent)
+    sec["width"].append(width)
 
 
 def render(scene):
