@@ -3,7 +3,8 @@
 # Does nothing when everything is already there.
 set -euo pipefail
 packages=(g++ cmake ninja-build pkg-config libxsimd-dev xtl-dev libtbb-dev libglm-dev libstb-dev
-          doctest-dev libcli11-dev libbenchmark-dev libtinyobjloader-dev python3-matplotlib)
+          doctest-dev libcli11-dev libbenchmark-dev libtinyobjloader-dev python3-matplotlib
+          python3-numpy)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -244,9 +244,14 @@ def _pick(cands, tmin):
 
 def hit_sphere(o, d, tmin, obj):
     a = np.einsum("ij,ij->i", d, d)
-    b = np.einsum("ij,ij->i", o, d)
-    c = np.einsum("ij,ij->i", o, o) - 1
+    # Solve from the ray's point nearest the centre: c is then free of the cancellation that
+    # loses the root for far origins or very flat spheres (scale 1e-6 along one axis).
+    t0 = -np.einsum("ij,ij->i", o, d) / a
+    q = o + t0[:, None] * d
+    b = np.einsum("ij,ij->i", q, d)
+    c = np.einsum("ij,ij->i", q, q) - 1
     t1, t2 = _quadratic(a, b, c)
+    t1, t2 = t1 + t0, t2 + t0
     t, _ = _pick([(t1, ~np.isnan(t1)), (t2, ~np.isnan(t2))], tmin)
     return t, o + np.where(np.isfinite(t), t, 0)[:, None] * d
 
@@ -287,9 +292,13 @@ def _caps(o, d, ys, radius2):
 
 def hit_cylinder(o, d, tmin, obj):
     a = d[:, 0] ** 2 + d[:, 2] ** 2
-    b = o[:, 0] * d[:, 0] + o[:, 2] * d[:, 2]
-    c = o[:, 0] ** 2 + o[:, 2] ** 2 - 1
+    with np.errstate(divide="ignore", invalid="ignore"):  # same shift as the sphere, in xz
+        t0 = np.where(a > 0, -(o[:, 0] * d[:, 0] + o[:, 2] * d[:, 2]) / a, 0)
+    qx, qz = o[:, 0] + t0 * d[:, 0], o[:, 2] + t0 * d[:, 2]
+    b = qx * d[:, 0] + qz * d[:, 2]
+    c = qx ** 2 + qz ** 2 - 1
     t1, t2 = _quadratic(a, b, c)
+    t1, t2 = t1 + t0, t2 + t0
     cands = []
     for t in (t1, t2):
         y = o[:, 1] + t * d[:, 1]
