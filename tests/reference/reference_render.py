@@ -336,6 +336,9 @@ def normal_cone(p, obj):
     side = np.stack([2 * p[:, 0], (1 - p[:, 1]) / 2, 2 * p[:, 2]], axis=1)
     cap = np.tile([0.0, -1.0, 0.0], (len(p), 1))
     on_cap = np.abs(p[:, 1] + 1) < np.abs(np.hypot(p[:, 0], p[:, 2]) - (1 - p[:, 1]) / 2)
+    # The apex has no gradient; docs/scene-format.md gives it the normal +y.
+    apex = ~np.any(side, axis=1)
+    side[apex] = [0.0, 1.0, 0.0]
     return np.where(on_cap[:, None], cap, side)
 
 
