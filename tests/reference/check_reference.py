@@ -62,7 +62,8 @@ GROUPS = {
     "stress": [(_stress(s), None, None) for s in (
         "anisotropic", "cube_edges", "diamond", "inside_glass_cube", "inside_torus",
         "light_in_glass", "mirrors_depth50", "nested_glass", "plane_edge_on", "silhouettes",
-        "tir_critical", "torus_edge_on", "torus_fat", "torus_hole", "ior_1.0001")],
+        "tir_critical", "torus_edge_on", "torus_fat", "torus_hole", "ior_1.0001",
+        "cylinder_axis", "quadrics_far", "torus_spindle", "torus_thin", "scale_unit")],
     # Disagreements found by the reference (docs/testing.md); not in ctest.
     "known": [(_stress(s), None, None) for s in ("disk_sphere", "torus_far")],
 }

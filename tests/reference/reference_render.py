@@ -397,6 +397,13 @@ def normal_torus(p, obj):
     g = 4 * s[:, None] * p
     g[:, 0] -= 8 * p[:, 0]
     g[:, 2] -= 8 * p[:, 2]
+    # F is the product of the near-tube and far-tube factors; on the spindle's inner lemon
+    # (the far factor vanishes) the gradient points into the lemon, while the documented
+    # outward normal points away from the far tube's centre circle: flip it there.
+    rho = np.hypot(p[:, 0], p[:, 2])
+    near = (rho - 1) ** 2 + p[:, 1] ** 2 - r * r
+    far = (rho + 1) ** 2 + p[:, 1] ** 2 - r * r
+    g[np.abs(far) < np.abs(near)] *= -1
     return g
 
 
