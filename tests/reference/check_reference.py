@@ -6,11 +6,11 @@ Each case renders one scene (spp 1, pixel centres) with `streamrt --engine strea
 
 Tolerances (derived, not fitted):
 - TOL_ABS = 2e-3 per channel: half an 8-bit output step (1/255/2), so a pass means the
-  engines' PNGs match the reference to the rounding. The engines compute in float32
-  (relative error ~6e-8 per operation); through the few dozen operations of a hit and
-  its shading, and a Phong exponent of up to ~150 amplifying the error of R.V, that
-  stays below ~1e-4: 2e-3 leaves a 20x margin, yet a wrong normal, a dropped term or a
-  wrong refraction ratio changes colours by 1e-2 to 1.
+  engines' PNGs match the reference to the rounding. Rounding alone stays far below it: the
+  recursive engine (double) agrees to ~5e-5 and the stream engine (float32, relative error
+  ~6e-8 per operation, amplified by Phong exponents up to ~150 and by refraction) to
+  ~3e-4 on all but a handful of pixels, so a change at the 1e-7 level cannot fail, while a
+  wrong normal, a dropped term or a wrong refraction ratio changes colours by 1e-2 to 1.
 - MAX_SHARE = 0.5 % of pixels may exceed TOL_ABS: pixels whose sample lies within float32
   error of a silhouette, a shadow or spot edge, or a total-internal-reflection boundary
   legitimately take the other branch (about 1 in 200 pixels in the stiffest scenes here).
