@@ -13,7 +13,7 @@ Tolerances (derived, not fitted):
   wrong normal, a dropped term or a wrong refraction ratio changes colours by 1e-2 to 1.
 - MAX_SHARE = 0.5 % of pixels may exceed TOL_ABS: pixels whose sample lies within float32
   error of a silhouette, a shadow or spot edge, or a total-internal-reflection boundary
-  legitimately take the other branch (about 1 in 200 pixels in the stiffest scenes here).
+  legitimately take the other branch (at most 1 in 2000 pixels seen in the scenes here).
 - Checker pixels whose footprint reaches a cell boundary (see reference_render.py) are
   left out: the engines filter the pattern there and the reference samples it sharply.
 
