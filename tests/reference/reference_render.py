@@ -10,6 +10,7 @@ Usage: reference_render.py SCENE.cfg -o OUT.pfm [--width W --height H --degree D
 import argparse
 import math
 import os
+import re
 import sys
 
 import numpy as np
@@ -593,20 +594,12 @@ def write_pfm(path, img):
 def read_pfm(path):
     with open(path, "rb") as f:
         data = f.read()
-    parts = []
-    pos = 0
-    while len(parts) < 4:  # magic, width, height, scale: whitespace-separated tokens
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        end = pos
-        while not data[end:end + 1].isspace():
-            end += 1
-        parts.append(data[pos:end].decode())
-        pos = end
-    pos += 1
-    if parts[0] != "PF":
+    # Header: "PF", width, height, scale (negative: little-endian), one whitespace each.
+    m = re.match(rb"PF\s+(\d+)\s+(\d+)\s+(\S+)\s", data)
+    if not m:
         raise ValueError(f"{path}: not a colour PFM")
-    w, h, scale = int(parts[1]), int(parts[2]), float(parts[3])
+    w, h, scale = int(m.group(1)), int(m.group(2)), float(m.group(3))
+    pos = m.end()
     dtype = "<f4" if scale < 0 else ">f4"
     img = np.frombuffer(data, dtype=dtype, count=w * h * 3, offset=pos).reshape(h, w, 3)
     return img[::-1].astype(np.float64)
