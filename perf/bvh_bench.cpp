@@ -55,21 +55,23 @@ Scene random_spheres(std::size_t n, std::vector<SphereRec>* out = nullptr, std::
     s.lights.push_back({LightKind::Point, {0.6 * side, 0.7 * side + 3, 0.2 * side}, {0, -1, 0}, {0.45, 0.45, 0.5}, 30});
     Object plane;
     plane.kind = ShapeKind::Plane;
-    plane.material.checker = true;
-    plane.material.checker_color = {0.25, 0.25, 0.25};
-    plane.material.cell = cell / 2;
-    s.objects.push_back(plane);
+    Material floor;
+    floor.checker = true;
+    floor.checker_color = {0.25, 0.25, 0.25};
+    floor.cell = cell / 2;
+    s.add_object(plane, floor, {});
+    Material matte;
+    matte.diff = 0.85;
+    matte.spec = 0.3;
     for (std::size_t i = 0; i < n; ++i) {
         const double r = cell * (0.2 + 0.25 * u(rng));
         const double x = -side / 2 + cell * (double(i % g) + 0.5) + (cell / 2 - r) * (2 * u(rng) - 1);
         const double z = -side / 2 + cell * (double(i / g) + 0.5) + (cell / 2 - r) * (2 * u(rng) - 1);
         Object o;
         o.kind = ShapeKind::Sphere;
-        o.material.color = {0.1 + 0.9 * u(rng), 0.1 + 0.9 * u(rng), 0.1 + 0.9 * u(rng)};
-        o.material.diff = 0.85;
-        o.material.spec = 0.3;
-        o.xf = Transform::from_direct(translate_matrix({x, r, z}) * scale_matrix({r, r, r}));
-        s.objects.push_back(o);
+        o.color = {0.1 + 0.9 * u(rng), 0.1 + 0.9 * u(rng), 0.1 + 0.9 * u(rng)};
+        o.md = glm::dmat4x3(translate_matrix({x, r, z}) * scale_matrix({r, r, r}));
+        s.add_object(o, matte, {});
         if (out) out->push_back({x, r, z, r});
     }
     return s;
@@ -214,7 +216,7 @@ int cmd_traversal(std::size_t n) {
         shad.push_back(sh);
     }
     const auto time_closest = [&](std::vector<RayStream>& set, BvhClosestFn fn, const accel::SceneBvh& sb,
-                                  const std::vector<AccelObject>& prims) {
+                                  const std::vector<KernelObject>& prims) {
         const AccelView view{sb.bvh.nodes.data(), prims.data()};
         double best = 1e30;
         std::size_t rays = 0;
@@ -234,7 +236,7 @@ int cmd_traversal(std::size_t n) {
         return double(rays) / best / 1e6;
     };
     const auto time_any = [&](std::vector<ShadowStream>& set, BvhAnyFn fn, const accel::SceneBvh& sb,
-                              const std::vector<AccelObject>& prims) {
+                              const std::vector<KernelObject>& prims) {
         const AccelView view{sb.bvh.nodes.data(), prims.data()};
         double best = 1e30;
         std::size_t rays = 0;
@@ -252,19 +254,11 @@ int cmd_traversal(std::size_t n) {
         }
         return double(rays) / best / 1e6;
     };
-    // The kernels need the leaf objects; rebuild them as StreamAccel does.
+    // The kernels need the leaf objects, laid out as StreamAccel does.
     auto sb = accel::SceneBvh::build(s);
-    std::vector<AccelObject> prims;
-    for (std::uint32_t id : sb->bvh.prim_index) {
-        const Object& o = s.objects[id];
-        AccelObject a{};
-        for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 4; ++c) a.xf.m[r * 4 + c] = float(o.xf.mi[c][r]);
-        a.xf.param = float(o.minor);
-        a.xf.id = std::int32_t(id);
-        a.kind = std::uint32_t(o.kind);
-        prims.push_back(a);
-    }
+    std::vector<KernelObject> prims;
+    for (std::uint32_t k = 0; k < sb->bvh.prim_index.size(); ++k)
+        prims.push_back(kernel_object(s, sb->bvh.prim_index[k], std::int32_t(k), glm::dvec3(0.0)));
     std::printf("traversal, N=%zu spheres, isa %s, one thread, Mrays/s (hierarchy only, plane excluded):\n", n,
                 isa_name(isa));
     std::printf("  primary   packet %7.2f   single %7.2f\n", time_closest(prim, at.closest_packet, *sb, prims),

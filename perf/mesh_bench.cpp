@@ -22,8 +22,9 @@ namespace {
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
-Scene view_of(const Object& o, int degree, int width, int height) {
+Scene view_of(const Object& o, const std::shared_ptr<const Mesh>& mesh, int degree, int width, int height) {
     Scene s;
+    if (mesh) s.meshes.push_back(mesh);  // Object::mesh 0
     s.settings.width = width;
     s.settings.height = height;
     s.settings.spp = 1;
@@ -37,9 +38,9 @@ Scene view_of(const Object& o, int degree, int width, int height) {
     s.lights.push_back({LightKind::Point, {3, 5, 4}, {0, -1, 0}, {1, 1, 1}, 30});
     Object plane;
     plane.kind = ShapeKind::Plane;
-    plane.xf = Transform::from_direct(translate_matrix({0, -1, 0}));
-    s.objects.push_back(plane);
-    s.objects.push_back(o);
+    plane.md = glm::dmat4x3(translate_matrix({0, -1, 0}));
+    s.add_object(plane, Material{}, {});
+    s.add_object(o, Material{}, {});
     return s;
 }
 
@@ -76,8 +77,7 @@ int main(int argc, char** argv) {
     sphere.kind = ShapeKind::Sphere;
     Object m;
     m.kind = ShapeKind::Mesh;
-    m.mesh = mesh;
-    m.smooth = true;
+    m.param = 1.0;  // smooth
     Parallelism par(jobs);
     std::printf("\nrender 1280x720, 1 spp, -j %d, best of 3 (recursive engine at 640x360)\n", jobs);
     std::printf("%-8s %-7s %-10s %10s %12s %16s\n", "object", "degree", "engine", "seconds", "Mrays/s", "primary Mrays/s");
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
         for (const Object* o : {&sphere, &m})
             for (EngineKind e : {EngineKind::Stream, EngineKind::Recursive}) {
                 const bool rec = e == EngineKind::Recursive;
-                const Scene s = view_of(*o, degree, rec ? 640 : 1280, rec ? 360 : 720);
+                const Scene s = view_of(*o, o == &m ? mesh : nullptr, degree, rec ? 640 : 1280, rec ? 360 : 720);
                 double best = 1e30;
                 RenderResult r;
                 for (int k = 0; k < 3; ++k) {

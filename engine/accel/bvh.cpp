@@ -4,6 +4,10 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <type_traits>
+
+#include <xsimd/xsimd.hpp>
 
 #include "parallel/parallelism.h"
 
@@ -21,36 +25,97 @@ Aabb conservative_box(const double lo[3], const double hi[3]) {
 
 namespace {
 
-/// Binary nodes of the SAH build; collapsed into WideNodes afterwards.
+/// Binary nodes of the SAH build; collapsed into WideNodes afterwards. Trivial on purpose:
+/// room for the worst case (2n - 1 nodes) is reserved without being written, so only the
+/// pages of nodes actually made count in memory (about half the worst case at 4 per leaf).
 struct BinNode {
-    Aabb box;
-    std::int32_t left = -1, right = -1;  ///< inner: both >= 0
-    std::uint32_t first = 0, count = 0;  ///< leaf
+    float lo[3], hi[3];           ///< bounds (an Aabb's default values would make it non-trivial)
+    std::int32_t left, right;     ///< inner: both >= 0; leaf: -1
+    std::uint32_t first, count;  ///< leaf
+    float half_area() const { return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}.half_area(); }
 };
+static_assert(std::is_trivially_default_constructible_v<BinNode>);
 
 /// Binary depth past which the builder splits at the object median, so traversal stacks of a
 /// fixed size always suffice (see bvh.h: 64 wide levels).
 constexpr int kMedianDepth = 40;
 
 /// A primitive as the builder moves it: its box and number, 32 bytes, partitioned in place so
-/// that every pass over a node's primitives reads memory in order.
+/// that every pass over a node's primitives reads memory in order. Laid out so that lo and hi
+/// each load as one 4-lane batch: lo's fourth lane is 0, hi's is the id (masked off).
 struct Ref {
-    Aabb box;
+    float lo[3];
+    float zero = 0.f;
+    float hi[3];
     std::uint32_t id;
-    float pad;
-    float c(int a) const { return box.lo[a] + box.hi[a]; }  ///< twice the centroid
+    float c(int a) const { return lo[a] + hi[a]; }  ///< twice the centroid
+    Aabb box() const { return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
 };
+static_assert(sizeof(Ref) == 32);
+
+/// 4-lane SSE2 batches (x, y, z, unused): the binning pass grows three boxes per primitive,
+/// two instructions each this way instead of six.
+using B4 = xsimd::batch<float, xsimd::sse2>;
+using I4 = xsimd::batch<std::int32_t, xsimd::sse2>;
+
+/// Trivially constructible, so a node's bin arrays cost nothing until reset (empty()).
+struct Box4 {
+    B4 lo, hi;
+    static Box4 empty() {
+        return {B4(std::numeric_limits<float>::infinity()), B4(-std::numeric_limits<float>::infinity())};
+    }
+    void grow(const B4& l, const B4& h) {
+        lo = xsimd::min(lo, l);
+        hi = xsimd::max(hi, h);
+    }
+    void grow(const Box4& b) { grow(b.lo, b.hi); }
+    Aabb aabb() const {
+        alignas(16) float l[4], h[4];
+        lo.store_aligned(l);
+        hi.store_aligned(h);
+        return Aabb{{l[0], l[1], l[2]}, {h[0], h[1], h[2]}};
+    }
+};
+
+inline B4 ref_lo(const Ref& r) { return B4::load_unaligned(r.lo); }
+inline B4 ref_hi(const Ref& r) {
+    alignas(16) static constexpr std::int32_t kXyz[4] = {-1, -1, -1, 0};
+    return B4::load_unaligned(r.hi) & xsimd::bitwise_cast<B4>(I4::load_aligned(kXyz));  // the id's bits out
+}
 
 struct Builder {
     std::vector<Ref>& refs;
-    std::vector<BinNode> nodes;
+    std::unique_ptr<BinNode[]> nodes;
     std::atomic<std::uint32_t> n_nodes{0};
     BuildOptions opt;
 
 
     std::uint32_t alloc() { return n_nodes.fetch_add(1, std::memory_order_relaxed); }
 
+    /// The bin of each axis for a doubled centroid c: trunc((c - lo) * scale) clamped to
+    /// [0, last]. One rule for binning and partitioning, so both agree on every primitive.
+    struct BinOf {
+        B4 lo, scale;
+        float last;
+        I4 operator()(const B4& c) const {
+            return xsimd::to_int(xsimd::min(xsimd::max((c - lo) * scale, B4(0.f)), B4(last)));
+        }
+    };
+
+    /// Bounds and doubled-centroid bounds of refs[begin, end).
+    void bounds_of(std::uint32_t begin, std::uint32_t end, Aabb& box, Aabb& cbox) const {
+        Box4 b = Box4::empty(), c = Box4::empty();
+        for (std::uint32_t k = begin; k < end; ++k) {
+            const B4 lo = ref_lo(refs[k]), hi = ref_hi(refs[k]), cen = lo + hi;
+            b.grow(lo, hi);
+            c.grow(cen, cen);
+        }
+        box = b.aabb();
+        cbox = c.aabb();
+    }
+
     void make_leaf(std::uint32_t node, std::uint32_t first, std::uint32_t count) {
+        nodes[node].left = nodes[node].right = -1;
         nodes[node].first = first;
         nodes[node].count = count;
     }
@@ -59,10 +124,12 @@ struct Builder {
     /// cbox: the bounds of the primitives' doubled centroids (Ref::c).
     void build(std::uint32_t node, std::uint32_t first, std::uint32_t count, const Aabb& box, const Aabb& cbox,
                int depth) {
-        nodes[node].box = box;
+        std::copy_n(box.lo, 3, nodes[node].lo);
+        std::copy_n(box.hi, 3, nodes[node].hi);
         if (count <= 1) return make_leaf(node, first, count);
         std::uint32_t mid = first;
         bool split = false;
+        Aabb lb, rb, lc, rc;  // the children's bounds and centroid bounds
         if (depth < kMedianDepth) {
             // Binned SAH over the three axes, one pass over the primitives; small nodes use
             // fewer bins (as many as primitives), so the bottom of the tree stays cheap.
@@ -70,45 +137,49 @@ struct Builder {
             const int nb = std::clamp(std::min(opt.bins, int(count)), 2, kMaxBins);
             float best_cost = std::numeric_limits<float>::infinity();
             int best_axis = -1, best_bin = 0;
-            Aabb bb[3][kMaxBins];
+            // Per axis and bin: the primitives' boxes, their doubled centroids, their count.
+            Box4 bb[3][kMaxBins], cb[3][kMaxBins];
             std::uint32_t bc[3][kMaxBins];
-            float scale[3];
+            alignas(16) float scale[4] = {0.f, 0.f, 0.f, 0.f};
             for (int a = 0; a < 3; ++a) {
                 const float ext = cbox.hi[a] - cbox.lo[a];
                 scale[a] = ext > 0.f ? float(nb) / ext * 0.99999f : 0.f;
                 for (int b = 0; b < nb; ++b) {
-                    bb[a][b] = Aabb{};
+                    bb[a][b] = cb[a][b] = Box4::empty();
                     bc[a][b] = 0;
                 }
             }
+            alignas(16) const float origin[4] = {cbox.lo[0], cbox.lo[1], cbox.lo[2], 0.f};
+            const BinOf bin_of{B4::load_aligned(origin), B4::load_aligned(scale), float(nb - 1)};
             for (std::uint32_t k = first; k < first + count; ++k) {
-                const Aabb& box_i = refs[k].box;
-                const float c[3] = {refs[k].c(0), refs[k].c(1), refs[k].c(2)};
+                const B4 lo = ref_lo(refs[k]), hi = ref_hi(refs[k]), c = lo + hi;
+                alignas(16) std::int32_t b[4];
+                bin_of(c).store_aligned(b);
                 for (int a = 0; a < 3; ++a) {
-                    const int b = std::clamp(int((c[a] - cbox.lo[a]) * scale[a]), 0, nb - 1);
-                    bb[a][b].grow(box_i);
-                    ++bc[a][b];
+                    bb[a][b[a]].grow(lo, hi);
+                    cb[a][b[a]].grow(c, c);
+                    ++bc[a][b[a]];
                 }
             }
             for (int a = 0; a < 3; ++a) {
                 if (!(scale[a] > 0.f)) continue;
                 float right_area[kMaxBins];
                 std::uint32_t right_count[kMaxBins];
-                Aabb acc;
+                Box4 acc = Box4::empty();
                 std::uint32_t cnt = 0;
                 for (int b = nb - 1; b > 0; --b) {
                     acc.grow(bb[a][b]);
                     cnt += bc[a][b];
-                    right_area[b] = acc.half_area();
+                    right_area[b] = acc.aabb().half_area();
                     right_count[b] = cnt;
                 }
-                acc = Aabb{};
+                acc = Box4::empty();
                 cnt = 0;
                 for (int b = 0; b < nb - 1; ++b) {
                     acc.grow(bb[a][b]);
                     cnt += bc[a][b];
                     if (cnt == 0 || right_count[b + 1] == 0) continue;
-                    const float cost = acc.half_area() * float(cnt) + right_area[b + 1] * float(right_count[b + 1]);
+                    const float cost = acc.aabb().half_area() * float(cnt) + right_area[b + 1] * float(right_count[b + 1]);
                     if (cost < best_cost) {
                         best_cost = cost;
                         best_axis = a;
@@ -122,16 +193,27 @@ struct Builder {
                 if (count <= std::uint32_t(opt.max_leaf) && leaf_cost <= split_cost)
                     return make_leaf(node, first, count);
                 const int a = best_axis;
-                const float sc = scale[a];
+                // The same bin rule as the binning pass, so the sides are exactly the bins'.
                 const auto it = std::partition(refs.begin() + first, refs.begin() + first + count, [&](const Ref& r) {
-                    return std::clamp(int((r.c(a) - cbox.lo[a]) * sc), 0, nb - 1) <= best_bin;
+                    alignas(16) std::int32_t b[4];
+                    bin_of(ref_lo(r) + ref_hi(r)).store_aligned(b);
+                    return b[a] <= best_bin;
                 });
                 mid = std::uint32_t(it - refs.begin());
                 split = mid > first && mid < first + count;
+                // The children's bounds are the unions of their bins (the partition used the
+                // same bin rule), exactly what a pass over their primitives would give.
+                Box4 sides[2] = {Box4::empty(), Box4::empty()}, csides[2] = {Box4::empty(), Box4::empty()};
+                for (int b = 0; b < nb; ++b) {
+                    sides[b > best_bin].grow(bb[a][b]);
+                    csides[b > best_bin].grow(cb[a][b]);
+                }
+                lb = sides[0].aabb(), rb = sides[1].aabb(), lc = csides[0].aabb(), rc = csides[1].aabb();
             }
         }
         if (!split) {
             if (count <= std::uint32_t(opt.max_leaf)) return make_leaf(node, first, count);
+            lb = rb = lc = rc = Aabb{};
             // Object median along the widest centroid axis (all centroids equal: any halves).
             int a = 0;
             for (int k = 1; k < 3; ++k)
@@ -139,19 +221,11 @@ struct Builder {
             mid = first + count / 2;
             std::nth_element(refs.begin() + first, refs.begin() + mid, refs.begin() + first + count,
                              [&](const Ref& x, const Ref& y) { return x.c(a) < y.c(a); });
-        }
-        Aabb lb, rb, lc, rc;
-        for (std::uint32_t k = first; k < mid; ++k) {
-            lb.grow(refs[k].box);
-            const float c[3] = {refs[k].c(0), refs[k].c(1), refs[k].c(2)};
-            lc.grow(c);
-        }
-        for (std::uint32_t k = mid; k < first + count; ++k) {
-            rb.grow(refs[k].box);
-            const float c[3] = {refs[k].c(0), refs[k].c(1), refs[k].c(2)};
-            rc.grow(c);
+            bounds_of(first, mid, lb, lc);
+            bounds_of(mid, first + count, rb, rc);
         }
         const std::uint32_t l = alloc(), r = alloc();
+        nodes[node].first = nodes[node].count = 0;
         nodes[node].left = std::int32_t(l);
         nodes[node].right = std::int32_t(r);
         const std::uint32_t nl = mid - first, nr = first + count - mid;
@@ -168,7 +242,7 @@ struct Builder {
 /// Collapses the binary tree into 8-wide nodes: a wide node takes its binary node's two
 /// children, then repeatedly opens the inner child of largest area until it has 8.
 struct Collapser {
-    const std::vector<BinNode>& bin;
+    const BinNode* bin;
     simd::AlignedVec<WideNode>& out;
     std::size_t leaves = 0;
 
@@ -188,8 +262,8 @@ struct Collapser {
                 float best_area = -1.f;
                 for (int k = 0; k < nk; ++k) {
                     const BinNode& c = bin[std::size_t(kids[k])];
-                    if (c.left >= 0 && c.box.half_area() > best_area) {
-                        best_area = c.box.half_area();
+                    if (c.left >= 0 && c.half_area() > best_area) {
+                        best_area = c.half_area();
                         best = k;
                     }
                 }
@@ -208,12 +282,12 @@ struct Collapser {
         }
         for (int j = 0; j < nk; ++j) {
             const BinNode& c = bin[std::size_t(kids[j])];
-            n.lo_x[j] = c.box.lo[0];
-            n.lo_y[j] = c.box.lo[1];
-            n.lo_z[j] = c.box.lo[2];
-            n.hi_x[j] = c.box.hi[0];
-            n.hi_y[j] = c.box.hi[1];
-            n.hi_z[j] = c.box.hi[2];
+            n.lo_x[j] = c.lo[0];
+            n.lo_y[j] = c.lo[1];
+            n.lo_z[j] = c.lo[2];
+            n.hi_x[j] = c.hi[0];
+            n.hi_y[j] = c.hi[1];
+            n.hi_z[j] = c.hi[2];
             if (c.left < 0) {
                 n.child[j] = std::int32_t(c.first);
                 n.count[j] = c.count;
@@ -235,35 +309,34 @@ struct Collapser {
 
 }  // namespace
 
-Bvh Bvh::build(const std::vector<Aabb>& boxes, const BuildOptions& options) {
+Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     Bvh bvh;
     std::vector<Ref> refs;
     refs.reserve(boxes.size());
-    for (std::size_t i = 0; i < boxes.size(); ++i)
-        if (!boxes[i].empty()) refs.push_back({boxes[i], std::uint32_t(i), 0.f});
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        const Aabb& b = boxes[i];
+        if (!b.empty()) refs.push_back({{b.lo[0], b.lo[1], b.lo[2]}, 0.f, {b.hi[0], b.hi[1], b.hi[2]}, std::uint32_t(i)});
+    }
+    std::vector<Aabb>().swap(boxes);  // the refs hold them now: free the memory before building
     if (refs.empty()) return bvh;
     const std::size_t n = refs.size();
 
-    Builder b{refs, {}, {}, options};
+    // Worst case 2n - 1 nodes, left unwritten (see BinNode).
+    Builder b{refs, std::make_unique_for_overwrite<BinNode[]>(2 * n), {}, options};
     Aabb all, call;
-    for (const Ref& r : refs) {
-        all.grow(r.box);
-        const float c[3] = {r.c(0), r.c(1), r.c(2)};
-        call.grow(c);
-    }
-    b.nodes.resize(2 * n);
+    b.bounds_of(0, std::uint32_t(n), all, call);
     const std::uint32_t root = b.alloc();
     b.build(root, 0, std::uint32_t(n), all, call, 0);
-    b.nodes.resize(b.n_nodes.load());
+    const std::size_t n_binary = b.n_nodes.load();
 
-    Collapser c{b.nodes, bvh.nodes};
-    bvh.nodes.reserve(b.nodes.size() / 4 + 1);
+    Collapser c{b.nodes.get(), bvh.nodes};
+    bvh.nodes.reserve(n_binary / 4 + 1);
     c.emit(0);
     bvh.prim_index.resize(n);
     parallel_for_index(n, 65536, [&](std::size_t k) { bvh.prim_index[k] = refs[k].id; });
     bvh.bounds = all;
-    bvh.stats.binary_nodes = b.nodes.size();
+    bvh.stats.binary_nodes = n_binary;
     bvh.stats.wide_nodes = bvh.nodes.size();
     bvh.stats.leaves = c.leaves;
     bvh.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

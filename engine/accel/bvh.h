@@ -87,8 +87,9 @@ struct Bvh {
     std::size_t memory_bytes() const {
         return nodes.size() * sizeof(WideNode) + prim_index.size() * sizeof(std::uint32_t);
     }
-    /// Builds over boxes (empty boxes are left out).
-    static Bvh build(const std::vector<Aabb>& boxes, const BuildOptions& options = {});
+    /// Builds over boxes (empty boxes are left out). Taken by value: pass them with std::move
+    /// and their memory is given back before the build proper starts.
+    static Bvh build(std::vector<Aabb> boxes, const BuildOptions& options = {});
 };
 
 /// Scalar slab test of one ray against child j of a node, t in [0, t_max]. inv is 1/d per

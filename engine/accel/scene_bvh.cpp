@@ -13,8 +13,8 @@ AccelConfig& accel_config() {
     return config;
 }
 
-bool object_world_bounds(const Object& o, double lo[3], double hi[3]) {
-    const glm::dmat4& m = o.xf.md;
+bool object_world_bounds(const Object& o, const Mesh* mesh, double lo[3], double hi[3]) {
+    const glm::dmat4x3& m = o.md;
     switch (o.kind) {
         case ShapeKind::Plane: return false;
         case ShapeKind::Sphere:
@@ -29,10 +29,10 @@ bool object_world_bounds(const Object& o, double lo[3], double hi[3]) {
     }
     // The canonical box through Md: centre +- |M| half-extent (the box of the 8 corners).
     double c[3] = {0, 0, 0}, e[3] = {1, 1, 1};
-    if (o.kind == ShapeKind::Torus) e[0] = e[2] = 1 + o.minor, e[1] = o.minor;
+    if (o.kind == ShapeKind::Torus) e[0] = e[2] = 1 + o.param, e[1] = o.param;
     if (o.kind == ShapeKind::Mesh) {
-        if (!o.mesh || o.mesh->triangle_count() == 0) return false;
-        for (int a = 0; a < 3; ++a) c[a] = 0.5 * (o.mesh->lo[a] + o.mesh->hi[a]), e[a] = 0.5 * (o.mesh->hi[a] - o.mesh->lo[a]);
+        if (!mesh || mesh->triangle_count() == 0) return false;
+        for (int a = 0; a < 3; ++a) c[a] = 0.5 * (mesh->lo[a] + mesh->hi[a]), e[a] = 0.5 * (mesh->hi[a] - mesh->lo[a]);
     }
     for (int a = 0; a < 3; ++a) {
         double mid = m[3][a], ext = 0;
@@ -49,26 +49,20 @@ bool object_world_bounds(const Object& o, double lo[3], double hi[3]) {
 std::unique_ptr<SceneBvh> SceneBvh::build(const Scene& scene, const BuildOptions& options, const glm::dvec3& shift) {
     auto s = std::make_unique<SceneBvh>();
     const std::size_t n = scene.objects.size();
+    // Unbounded objects keep an empty box, which the build leaves out; its prim_index then
+    // names scene objects directly.
     std::vector<Aabb> boxes(n);
-    std::vector<char> ok(n);
     parallel_for_index(n, 4096, [&](std::size_t i) {
         double lo[3], hi[3];
-        ok[i] = object_world_bounds(scene.objects[i], lo, hi);
+        if (!object_world_bounds(scene.objects[i], scene.mesh_of(scene.objects[i]), lo, hi)) return;
         for (int a = 0; a < 3; ++a) lo[a] -= shift[a], hi[a] -= shift[a];
-        if (ok[i]) boxes[i] = conservative_box(lo, hi);
+        boxes[i] = conservative_box(lo, hi);
     });
-    std::vector<Aabb> prim_boxes;
-    prim_boxes.reserve(n);
     for (std::size_t i = 0; i < n; ++i) {
-        if (ok[i]) {
-            s->bounded.push_back(std::uint32_t(i));
-            prim_boxes.push_back(boxes[i]);
-        } else {
-            s->unbounded.push_back(std::uint32_t(i));
-        }
+        if (boxes[i].empty()) s->unbounded.push_back(std::uint32_t(i));
+        else ++s->bounded;
     }
-    s->bvh = Bvh::build(prim_boxes, options);
-    for (std::uint32_t& k : s->bvh.prim_index) k = s->bounded[k];  // leaf order -> object index
+    s->bvh = Bvh::build(std::move(boxes), options);
     return s;
 }
 

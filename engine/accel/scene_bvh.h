@@ -12,8 +12,9 @@
 
 namespace streamrt::accel {
 
-/// World-space bounds of an object in double; false for an unbounded one (the plane).
-bool object_world_bounds(const Object& o, double lo[3], double hi[3]);
+/// World-space bounds of an object in double; false for an unbounded one (the plane, an
+/// empty mesh). `mesh` is the object's mesh (Scene::mesh_of), for Mesh objects.
+bool object_world_bounds(const Object& o, const Mesh* mesh, double lo[3], double hi[3]);
 
 /// How the stream engine walks the hierarchy for one class of rays.
 enum class Traversal : std::uint8_t {
@@ -43,7 +44,7 @@ AccelConfig& accel_config();
 /// The hierarchy over the bounded objects of a scene plus the list of the others.
 struct SceneBvh {
     Bvh bvh;                               ///< prim_index holds object indices
-    std::vector<std::uint32_t> bounded;    ///< objects in the hierarchy
+    std::size_t bounded = 0;               ///< how many objects are in the hierarchy
     std::vector<std::uint32_t> unbounded;  ///< objects tested separately (planes)
 
     /// nullptr when the configuration says this scene is traced flat.

@@ -10,16 +10,22 @@ namespace streamrt {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
-inline Vec3d apply_point(const glm::dmat4& m, const Vec3d& p) { return to_vec(transform_point(m, to_glm(p))); }
-inline Vec3d apply_vector(const glm::dmat4& m, const Vec3d& v) { return to_vec(transform_vector(m, to_glm(v))); }
+inline Vec3d apply_point(const glm::dmat4x3& m, const Vec3d& p) { return to_vec(m * glm::dvec4(to_glm(p), 1.0)); }
+inline Vec3d apply_vector(const glm::dmat4x3& m, const Vec3d& v) { return to_vec(m * glm::dvec4(to_glm(v), 0.0)); }
+/// Mn n, with Mn = (Mi's linear part) transposed: n times that part as a row vector.
+inline Vec3d apply_normal(const glm::dmat4x3& mi, const Vec3d& n) {
+    return normalize(to_vec(to_glm(n) * glm::dmat3(mi)));
+}
 }  // namespace
 
 RecursiveRenderer::RecursiveRenderer(const Scene& scene)
     : scene_(scene), bvh_(accel::SceneBvh::build_for(scene)), camera_(CameraRays<double>::from(scene)) {
-    for (const Object& o : scene.objects) {
-        objects_.push_back({o.kind, o.param(), o.xf.mi, o.xf.md, o.xf.mn, o.mesh.get()});
-        materials_.push_back(MaterialT<double>::from(o.material));
-    }
+    objects_.resize(scene.objects.size());
+    parallel_for_index(scene.objects.size(), 4096, [&](std::size_t i) {
+        const Object& o = scene.objects[i];
+        objects_[i] = {affine_inverse(o.md), o.param, o.kind, scene.mesh_of(o)};
+    });
+    for (const Material& m : scene.materials) materials_.push_back(MaterialT<double>::from(m));
     for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(l));
 }
 
@@ -78,8 +84,8 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
                          : visit_shape(ob.kind, [&](auto shape) { return shape.template normal<double>(pc, ob.param); });
     hit.object = best;
     hit.t = best_t;
-    hit.point = apply_point(ob.md, pc);
-    hit.normal = to_vec(transform_normal(ob.mn, to_glm(nc)));
+    hit.point = apply_point(scene_.objects[std::size_t(best)].md, pc);
+    hit.normal = apply_normal(ob.mi, nc);
     return true;
 }
 
@@ -115,11 +121,13 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     HitD hit;
     if (!closest_hit(ray, 0.0, kInf, hit)) return {s.background.x, s.background.y, s.background.z};
 
-    const MaterialT<double>& m = materials_[std::size_t(hit.object)];
+    const Object& object = scene_.objects[std::size_t(hit.object)];
+    const MaterialT<double>& m = materials_[object.material];
+    const ColorT<double> object_color{object.color.x, object.color.y, object.color.z};
     const Vec3d n_out = hit.normal;
     const double cone = ray.cone + camera_.spread * hit.t;
-    const ColorT<double> base =
-        surface_color(m, hit.point, n_out, footprint_width(ray.cone, camera_.spread, hit.t, dot(ray.dir, n_out)));
+    const ColorT<double> base = surface_color(m, object_color, hit.point, n_out,
+                                              footprint_width(ray.cone, camera_.spread, hit.t, dot(ray.dir, n_out)));
     if (s.degree == 0) return base;
 
     // Light on the side the ray arrives from (a camera inside a room or a sphere sees the
@@ -171,7 +179,7 @@ ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) 
 
 Framebuffer RecursiveRenderer::render(Parallelism& par, RenderProgress* progress) const {
     const RenderSettings& s = scene_.settings;
-    Framebuffer fb(s.width, s.height);
+    Framebuffer fb = Framebuffer::uninitialized(s.width, s.height);  // every tile writes its pixels
     constexpr int kTile = 16;
     par.for_each_tile(s.width, s.height, kTile, [&](int, Tile tile) {
         if (progress && progress->cancelled()) return;

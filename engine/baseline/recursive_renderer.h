@@ -51,11 +51,12 @@ class RecursiveRenderer {
     ColorT<double> render_pixel(int x, int y, RayCounts& counts) const;
 
   private:
+    /// What the loop over objects reads: Mi (world -> canonical, top three rows) computed
+    /// once from the scene's Md; Mn is Mi's linear part transposed, applied on the fly.
     struct PreparedObject {
-        ShapeKind kind;
+        glm::dmat4x3 mi;
         double param;
-        glm::dmat4 mi, md;
-        glm::dmat3 mn;
+        ShapeKind kind;
         const Mesh* mesh;  ///< Mesh only
     };
     /// What a closer hit leaves behind: the canonical ray, and for a mesh the triangle and
@@ -71,7 +72,7 @@ class RecursiveRenderer {
     std::unique_ptr<accel::SceneBvh> bvh_;  ///< null: the handout's loop over all objects
     CameraRays<double> camera_;
     std::vector<PreparedObject> objects_;
-    std::vector<MaterialT<double>> materials_;
+    std::vector<MaterialT<double>> materials_;  ///< per scene material
     std::vector<LightT<double>> lights_;
 };
 

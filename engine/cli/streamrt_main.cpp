@@ -215,8 +215,15 @@ int run(int argc, char** argv) {
         RenderProgress progress;
         progress.cancel = &g_cancel;
         progress.tiles_total = ((s.width + 15) / 16) * ((s.height + 15) / 16);
+        const auto prepared = prepare_render(scene, which, eo);
+        // An engine rendering from its own tables no longer needs the scene's object
+        // records (128 bytes each; 128 MB at 1e6 objects): give them back before rendering.
+        if (!prepared->reads_scene_objects() && !opt.compare) {
+            std::vector<Object>().swap(scene.objects);
+            std::vector<ObjectLoc>().swap(scene.object_locs);
+        }
         ProgressDisplay display(progress, show_progress && !opt.quiet && ::isatty(2));
-        RenderResult r = render_scene(scene, which, par, &progress, eo);
+        RenderResult r = render_prepared(*prepared, par, &progress);
         display.stop();
         if (g_cancel.load()) throw Interrupted{};
         return r;
@@ -241,7 +248,10 @@ int run(int argc, char** argv) {
     }
 
     const RenderResult r = render_once(engine, true);
-    write_image(s.output, r.image, s.calibration);
+    WriteOptions wo;
+    wo.par = &par;
+    wo.cancel = &g_cancel;
+    if (!write_image(s.output, r.image, s.calibration, wo)) throw Interrupted{};
     if (opt.profile) std::printf("%s", profile.text().c_str());
     if (!opt.profile_json.empty()) {
         std::FILE* f = std::fopen(opt.profile_json.c_str(), "w");

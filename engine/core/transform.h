@@ -36,6 +36,13 @@ inline glm::dvec3 transform_normal(const glm::dmat3& mn, const glm::dvec3& n) {
     return glm::normalize(mn * n);
 }
 
+/// The inverse of an affine map stored as its top three rows (glm: 4 columns of 3): the
+/// linear part inverted (cofactors, double), the translation taken back through it.
+inline glm::dmat4x3 affine_inverse(const glm::dmat4x3& m) {
+    const glm::dmat3 a = glm::inverse(glm::dmat3(m));
+    return glm::dmat4x3(a[0], a[1], a[2], -(a * m[3]));
+}
+
 /// Elementary transforms (angles in degrees), the vocabulary of the scene file.
 glm::dmat4 scale_matrix(const glm::dvec3& s);
 glm::dmat4 translate_matrix(const glm::dvec3& t);

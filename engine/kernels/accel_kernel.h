@@ -201,7 +201,7 @@ void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object
             if (e.t > best_max) continue;
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count; ++k) {
-                    const AccelObject& ob = bvh.prims[k];
+                    const KernelObject& ob = bvh.prims[k];
                     if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
                         const B before = best;
                         mesh_leaf_closest<Arch>(rays, i, ob.xf, best);
@@ -255,7 +255,7 @@ void bvh_any_packet(const AccelView& bvh, RayView rays) {
             const StackEntry e = stack[--sp];
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count && xsimd::any(open); ++k) {
-                    const AccelObject& ob = bvh.prims[k];
+                    const KernelObject& ob = bvh.prims[k];
                     if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
                         const RayPacket<B> r{{B::load_aligned(rays.ox + i), B::load_aligned(rays.oy + i),
                                               B::load_aligned(rays.oz + i)},
@@ -330,7 +330,7 @@ void bvh_closest_single(const AccelView& bvh, RayView rays, std::int32_t* object
             if (e.t > best) continue;
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count; ++k) {
-                    const AccelObject& ob = bvh.prims[k];
+                    const KernelObject& ob = bvh.prims[k];
                     if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
                         const float t = mesh_single_closest<Arch>(rays, i, o, d, ob.xf, best);
                         if (t < best) {
@@ -377,7 +377,7 @@ void bvh_any_single(const AccelView& bvh, RayView rays) {
             const StackEntry e = stack[--sp];
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count && !blocked; ++k) {
-                    const AccelObject& ob = bvh.prims[k];
+                    const KernelObject& ob = bvh.prims[k];
                     if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
                         blocked = mesh_single_any<Arch>(o, d, ob.xf, t_max);
                         continue;

@@ -10,16 +10,10 @@
 
 namespace streamrt {
 
-/// One object in a leaf, in leaf order: what the shape kernels need, plus its kind.
-struct AccelObject {
-    ObjectXf xf;  ///< Mi rows, shape parameter, scene object index
-    std::uint32_t kind;  ///< ShapeKind
-};
-
 /// What the traversal kernels read: the wide nodes and the leaf-ordered objects.
 struct AccelView {
     const accel::WideNode* nodes;
-    const AccelObject* prims;
+    const KernelObject* prims;  ///< leaf order: the leaves index it
 };
 
 /// Closest hit through the hierarchy: as ClosestHitFn (shrinks t_max, writes the object id of

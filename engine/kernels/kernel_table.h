@@ -7,28 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "kernels/kernel_object.h"
 #include "kernels/shade_job.h"
 #include "mesh/mesh_view.h"
 #include "scene/scene.h"
 #include "stream/ray_stream.h"
 
 namespace streamrt {
-
-/// One object as the kernels see it: Mi's top three rows (world -> canonical), broadcast
-/// into every lane, the shape parameter (torus minor radius; 1 for a smooth mesh), the scene
-/// object index, and for a mesh its triangles and hierarchy.
-struct ObjectXf {
-    float m[12];  ///< row-major 3x4
-    float param;
-    std::int32_t id;
-    const MeshView* mesh = nullptr;  ///< ShapeKind::Mesh only
-};
-
-/// An object's world-space bounding box, padded outwards; the flat kernels skip an object
-/// for a whole packet when no ray of it meets the box before its current closest hit.
-struct ObjectBounds {
-    float lo[3], hi[3];
-};
 
 /// Closest hit: for each ray, shrinks t_max to the nearest hit among objs and writes that
 /// object's id into object[]. Rays that hit nothing keep t_max and object untouched. Mesh

@@ -5,21 +5,12 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "kernels/kernel_object.h"
 #include "mesh/mesh_view.h"
 #include "render/shading.h"
 #include "scene/scene.h"
 
 namespace streamrt {
-
-/// What shading needs of one object, beside the kernels' ObjectXf.
-struct ShadeObject {
-    ShapeKind kind;
-    float param;  ///< torus minor radius; mesh: 1 smooth, 0 flat
-    float mi[12];  ///< world -> canonical, row-major 3x4 (to rebuild the canonical hit point)
-    float md[12];  ///< canonical -> world
-    float mn[9];   ///< normals, row-major 3x3
-    const MeshView* mesh = nullptr;  ///< ShapeKind::Mesh only
-};
 
 
 /// Append-only view of a RayStream (reflected and refracted rays).
@@ -42,8 +33,9 @@ struct ShadeJob {
     const float *ox, *oy, *oz, *dx, *dy, *dz, *t, *wr, *wg, *wb, *cone;
     const std::int32_t* pixel;
     std::size_t begin, end;
-    // The object they all hit.
-    const ShadeObject* object;
+    // The object they all hit: its record (Mi, kind, parameter, mesh), colour and material.
+    const KernelObject* object;
+    ColorT<float> color;
     const MaterialT<float>* material;
     const LightT<float>* lights;
     std::size_t n_lights;

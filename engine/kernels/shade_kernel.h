@@ -27,11 +27,12 @@ inline Vec3T<B> apply_vector(const float* m, const Vec3T<B>& v) {
             xsimd::fma(B(m[4]), v.x, xsimd::fma(B(m[5]), v.y, B(m[6]) * v.z)),
             xsimd::fma(B(m[8]), v.x, xsimd::fma(B(m[9]), v.y, B(m[10]) * v.z))};
 }
+/// Mn n with Mn = (Mi's linear part) transposed, read from Mi's row-major 3x4 rows.
 template <class B>
-inline Vec3T<B> apply_normal(const float* m, const Vec3T<B>& n) {
-    return normalize(Vec3T<B>{xsimd::fma(B(m[0]), n.x, xsimd::fma(B(m[1]), n.y, B(m[2]) * n.z)),
-                              xsimd::fma(B(m[3]), n.x, xsimd::fma(B(m[4]), n.y, B(m[5]) * n.z)),
-                              xsimd::fma(B(m[6]), n.x, xsimd::fma(B(m[7]), n.y, B(m[8]) * n.z))});
+inline Vec3T<B> apply_normal(const float* mi, const Vec3T<B>& n) {
+    return normalize(Vec3T<B>{xsimd::fma(B(mi[0]), n.x, xsimd::fma(B(mi[4]), n.y, B(mi[8]) * n.z)),
+                              xsimd::fma(B(mi[1]), n.x, xsimd::fma(B(mi[5]), n.y, B(mi[9]) * n.z)),
+                              xsimd::fma(B(mi[2]), n.x, xsimd::fma(B(mi[6]), n.y, B(mi[10]) * n.z))});
 }
 
 template <class B>
@@ -55,8 +56,8 @@ inline Vec3T<B> canonical_normal(ShapeKind kind, const Vec3T<B>& p, const B& par
 template <class B>
 inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
     constexpr std::size_t W = B::size;
-    const MeshView& m = *job.object->mesh;
-    const bool smooth = job.object->param != 0.f;
+    const MeshView& m = *job.object->xf.mesh;
+    const bool smooth = job.object->xf.param != 0.f;
     alignas(64) float nx[W], ny[W], nz[W];
     for (std::size_t l = 0; l < W; ++l) {
         nx[l] = ny[l] = 0.f;
@@ -114,7 +115,8 @@ void shade_run(const ShadeJob& job) {
     using B = xsimd::batch<float, Arch>;
     constexpr std::size_t W = B::size;
     const simd::FlushDenormals ftz;  // see simd/lanes.h
-    const ShadeObject& ob = *job.object;
+    const ObjectXf& ob = job.object->xf;
+    const ShapeKind kind = ShapeKind(job.object->kind);
     const MaterialT<float>& m = *job.material;
     const bool reflect_here = kReflect && job.spawn && m.refl > 0.f;
     const bool refract_here = kRefract && job.spawn && m.trans > 0.f;
@@ -131,18 +133,20 @@ void shade_run(const ShadeJob& job) {
         const B t = B::load_unaligned(job.t + i);
         const ColorT<B> w{B::load_unaligned(job.wr + i), B::load_unaligned(job.wg + i), B::load_unaligned(job.wb + i)};
 
-        // Rebuild the canonical hit point, then world point and normal through Md and Mn.
-        const Vec3T<B> pc = apply_point(ob.mi, o) + apply_vector(ob.mi, d) * t;
-        const Vec3T<B> p = apply_point(ob.md, pc);
+        // The canonical hit point gives the normal, brought back with Mn; the world point
+        // is the ray's own.
+        const Vec3T<B> pc = apply_point(ob.m, o) + apply_vector(ob.m, d) * t;
+        const Vec3T<B> p = o + d * t;
         const B cone_in = B::load_unaligned(job.cone + i);
         const B cone = cone_in + B(job.spread) * t;
         ColorT<B> base;
         Vec3T<B> n_out;
         if (kLit || m.checker)
-            n_out = apply_normal(ob.mn, ob.kind == ShapeKind::Mesh ? mesh_normals<B>(job, i)
-                                                                    : canonical_normal(ob.kind, pc, B(ob.param)));
-        if (m.checker) base = surface_color(m, p, n_out, footprint_width(cone_in, B(job.spread), t, dot(d, n_out)));
-        else base = splat<B>(m.color);
+            n_out = apply_normal(ob.m, kind == ShapeKind::Mesh ? mesh_normals<B>(job, i)
+                                                                : canonical_normal(kind, pc, B(ob.param)));
+        if (m.checker)
+            base = surface_color(m, job.color, p, n_out, footprint_width(cone_in, B(job.spread), t, dot(d, n_out)));
+        else base = splat<B>(job.color);
         ColorT<B> local;
         if constexpr (!kLit) {
             local = mul(w, base);

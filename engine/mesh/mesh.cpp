@@ -81,7 +81,7 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
         }
         boxes[k] = accel::conservative_box(lo, hi);
     });
-    m->bvh = accel::Bvh::build(boxes, options);
+    m->bvh = accel::Bvh::build(std::move(boxes), options);
 
     // Store the triangles in leaf order, so leaves address them directly.
     m->tri.resize(9 * n_tris);

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "image/image_io.h"
 
 namespace streamrt {
 
@@ -26,12 +27,12 @@ MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, in
     e.threads = std::max(1, threads);
     const double pixels = double(s.width) * double(s.height);
     e.framebuffer_bytes = pixels * 3 * sizeof(float);
-    // Writing: a calibrated float copy, the 8-bit copy and the encoded file (PFM: 12 B/pixel).
-    e.output_bytes = pixels * (3 * sizeof(float) + 3 + 3);
+    // Writing streams bands into the file: a few bands' buffers, never a copy of the image.
+    e.output_bytes = image_write_buffer_bytes(s.width, s.height);
     bool reflect = false, both = false;
-    for (const Object& o : scene.objects) {
-        const bool r = s.degree >= 3 && o.material.refl > 0;
-        const bool t = s.degree >= 4 && o.material.trans > 0;
+    for (const Material& m : scene.materials) {
+        const bool r = s.degree >= 3 && m.refl > 0;
+        const bool t = s.degree >= 4 && m.trans > 0;
         reflect = reflect || r || t;
         both = both || (r && t);
     }

@@ -11,7 +11,7 @@ namespace streamrt {
 /// Worst-case bytes a render needs, by part (doubles: the worst case can exceed 2^64).
 struct MemoryEstimate {
     double framebuffer_bytes = 0;  ///< width*height*3 floats
-    double output_bytes = 0;       ///< calibrated copy, 8-bit copy and encoded file while writing
+    double output_bytes = 0;       ///< the image writer's band buffers (image_write_buffer_bytes)
     double per_thread_bytes = 0;   ///< ray streams of one worker (stream engine) or its stack
     int threads = 1;
     double total_bytes = 0;        ///< framebuffer + output + threads * per_thread

@@ -1,5 +1,6 @@
 #pragma once
 // One entry point for both engines, used by the command line, the tests and perf/.
+#include <memory>
 #include <string>
 
 #include "image/framebuffer.h"
@@ -26,6 +27,23 @@ struct EngineOptions {
     StreamProfile* profile = nullptr;   ///< stream engine: per-stage figures, when wanted
     bool scalar_shade = false;          ///< stream engine: scalar shade stage (for measurement)
 };
+
+/// An engine with its set-up done (tables, hierarchy), ready to render.
+class PreparedRender {
+  public:
+    virtual ~PreparedRender() = default;
+    virtual Framebuffer render(Parallelism& par, RenderProgress* progress) = 0;
+    /// False when the engine rendering no longer reads the scene's objects (the stream engine
+    /// renders from its own tables): the caller may then release them before rendering.
+    virtual bool reads_scene_objects() const = 0;
+    double setup_seconds = 0;
+};
+
+/// The set-up of an engine for `scene`, which must outlive it.
+std::unique_ptr<PreparedRender> prepare_render(const Scene& scene, EngineKind engine, const EngineOptions& options = {});
+
+/// Set-up then rendering, the two timed apart.
+RenderResult render_prepared(PreparedRender& prepared, Parallelism& par, RenderProgress* progress = nullptr);
 
 RenderResult render_scene(const Scene& scene, EngineKind engine, Parallelism& par,
                           RenderProgress* progress = nullptr, const EngineOptions& options = {});

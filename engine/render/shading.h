@@ -31,9 +31,11 @@ inline Vec3T<V> splat(const Vec3T<T>& a) {
     return {V(a.x), V(a.y), V(a.z)};
 }
 
+/// A material in the engine's precision. The object's own colour (Object::color) is passed
+/// beside it wherever a surface colour is needed.
 template <class T>
 struct MaterialT {
-    ColorT<T> color, checker_color;
+    ColorT<T> checker_color;
     T ambi, diff, spec, shininess, refl, trans, ior, inv_cell;
     bool checker;
     /// Below this R.V the highlight spec (R.V)^shininess is under 1e-5 (far below 1/255), so
@@ -46,8 +48,7 @@ struct MaterialT {
     static MaterialT from(const Material& m) {
         const double cutoff =
             m.spec > 0 && m.shininess > 0 ? std::min(1.0, std::pow(std::min(1.0, 1e-5 / m.spec), 1.0 / m.shininess)) : 0.0;
-        return {{T(m.color.x), T(m.color.y), T(m.color.z)},
-                {T(m.checker_color.x), T(m.checker_color.y), T(m.checker_color.z)},
+        return {{T(m.checker_color.x), T(m.checker_color.y), T(m.checker_color.z)},
                 T(m.ambi), T(m.diff), T(m.spec), T(m.shininess), T(m.refl), T(m.trans),
                 T(m.ior), T(1.0 / m.cell), m.checker, T(cutoff), {T(0), T(0), T(0)}};
     }
@@ -101,9 +102,10 @@ inline V odd_share(const V& c, const V& half) {
 /// covers many cells, this converges to the average colour instead of aliasing, and the
 /// float and double engines agree there.
 template <class V, class T>
-inline ColorT<V> surface_color(const MaterialT<T>& m, const Vec3T<V>& p, const Vec3T<V>& n, const V& footprint) {
+inline ColorT<V> surface_color(const MaterialT<T>& m, const ColorT<T>& color, const Vec3T<V>& p, const Vec3T<V>& n,
+                               const V& footprint) {
     using namespace simd;
-    if (!m.checker) return splat<V>(m.color);
+    if (!m.checker) return splat<V>(color);
     const V k(m.inv_cell), half_cell(0.5);
     const V h = half_cell * footprint * k;
     const auto extent = [&](const V& nc) { return h * sqrt(max(V(1) - nc * nc, V(0))); };
@@ -112,7 +114,7 @@ inline ColorT<V> surface_color(const MaterialT<T>& m, const Vec3T<V>& p, const V
     const V fz = detail::odd_share(p.z * k + (half_cell + V(m.cell_offset.z)), extent(n.z));
     const V fxy = fx + fy - V(2) * fx * fy;
     const V odd = fxy + fz - V(2) * fxy * fz;
-    return splat<V>(m.color) + (splat<V>(m.checker_color) - splat<V>(m.color)) * odd;
+    return splat<V>(color) + (splat<V>(m.checker_color) - splat<V>(color)) * odd;
 }
 
 /// Width of a ray's footprint where it meets a surface: the cone it carries (width at its

@@ -292,10 +292,18 @@ bool contains(const std::vector<std::string_view>& v, std::string_view k) {
     return std::find(v.begin(), v.end(), k) != v.end();
 }
 
+/// What a `material` statement names and a shape's material keys set: the optical
+/// parameters and the colour (stored apart in the scene: Object::color, Scene::materials).
+struct Appearance {
+    Material m;
+    glm::dvec3 color{1.0, 1.0, 1.0};
+};
+
 /// Applies one material key; false when `a` is not a material key.
-bool apply_material_key(const Statement& st, const Arg& a, Material& m) {
+bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
     const auto k = a.key;
-    if (k == "color") m.color = st.color(a);
+    Material& m = ap.m;
+    if (k == "color") ap.color = st.color(a);
     else if (k == "ambi") m.ambi = st.at_least_zero(a);
     else if (k == "diff") m.diff = st.at_least_zero(a);
     else if (k == "spec") m.spec = st.at_least_zero(a);
@@ -383,9 +391,10 @@ class Parser {
     }
 
   private:
-    std::map<std::string, Material, std::less<>> materials_;
+    std::map<std::string, Appearance, std::less<>> materials_;
     std::vector<fs::path> open_;  // the include chain being read
-    std::map<fs::path, std::shared_ptr<const Mesh>> meshes_;  // by file identity: loaded once, shared
+    std::map<fs::path, std::uint32_t> meshes_;  // by file identity: loaded once, shared (index in scene.meshes)
+    std::uint32_t last_file_ = 0;
     int files_ = 0;
 
     void statement(std::string_view line, const std::string& file, int line_no, int depth) {
@@ -545,7 +554,7 @@ class Parser {
         scene.lights.push_back(l);
     }
 
-    const Material& lookup_material(const Statement& st, const Arg& a) const {
+    const Appearance& lookup_material(const Statement& st, const Arg& a) const {
         const auto it = materials_.find(a.value);
         if (it == materials_.end())
             st.fail(a.value_col, "unknown material " + quote(a.value) +
@@ -563,7 +572,7 @@ class Parser {
         std::vector<std::string_view> keys = kMaterialKeys;
         keys.push_back("material");  // a base material to start from
         st.read_args(toks, 2, keys);
-        Material m;
+        Appearance m;
         if (const Arg* base = st.find("material")) m = lookup_material(st, *base);
         for (const Arg& a : st.args) apply_material_key(st, a, m);
         materials_.emplace(std::string(name.text), m);
@@ -574,32 +583,59 @@ class Parser {
         if (kind == ShapeKind::Torus) keys.push_back("minor");
         if (kind == ShapeKind::Mesh) keys.insert(keys.end(), {"file", "smooth"});
         st.read_args(toks, 1, keys);
-        Object obj;
-        obj.kind = kind;
-        obj.where = st.where();
-        if (const Arg* base = st.find("material")) obj.material = lookup_material(st, *base);
+        Appearance look;
+        if (const Arg* base = st.find("material")) look = lookup_material(st, *base);
         glm::dmat4 md(1.0);
+        double minor = 0.25;
+        bool smooth = false;
+        std::uint32_t mesh = 0;
+        bool has_mesh = false;
         for (const Arg& a : st.args) {
             if (a.key == "material") continue;
-            if (apply_material_key(st, a, obj.material)) continue;
+            if (apply_material_key(st, a, look)) continue;
             if (apply_transform_key(st, a, md)) continue;
-            if (a.key == "minor") obj.minor = st.positive(a);
+            if (a.key == "minor") minor = st.positive(a);
             else if (a.key == "smooth") {
-                if (a.value == "true") obj.smooth = true;
-                else if (a.value == "false") obj.smooth = false;
+                if (a.value == "true") smooth = true;
+                else if (a.value == "false") smooth = false;
                 else st.fail(a.value_col, "expected true or false for 'smooth', got " + quote(a.value));
-            } else if (a.key == "file") obj.mesh = mesh_file(st, a);
+            } else if (a.key == "file") {
+                mesh = mesh_file(st, a);
+                has_mesh = true;
+            }
         }
-        if (kind == ShapeKind::Mesh && !obj.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
+        if (kind == ShapeKind::Mesh && !has_mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
         if (singular(md))
             st.fail_here(std::string(st.word()) +
                          ": the composed transform is singular (or not finite)");
-        obj.xf = Transform::from_direct(md);
-        scene.objects.push_back(obj);
+        add_object(st, kind, md, look, kind == ShapeKind::Torus ? minor : kind == ShapeKind::Mesh ? (smooth ? 1.0 : 0.0) : 0.0,
+                   mesh);
     }
 
-    /// The mesh of an OBJ file named relative to the statement's file, read once per file.
-    std::shared_ptr<const Mesh> mesh_file(const Statement& st, const Arg& a) {
+    /// Stores one object of the scene (the only place objects are made).
+    void add_object(const Statement& st, ShapeKind kind, const glm::dmat4& md, const Appearance& look, double param,
+                    std::uint32_t mesh) {
+        Object obj;
+        obj.kind = kind;
+        obj.md = glm::dmat4x3(md);
+        obj.param = param;
+        obj.color = glm::vec3(look.color);
+        obj.mesh = mesh;
+        scene.add_object(obj, look.m, ObjectLoc{file_index(st.file()), st.line(), st.where().column});
+    }
+
+    /// The index of a file name in Scene::files.
+    std::uint32_t file_index(const std::string& file) {
+        if (!scene.files.empty() && scene.files[last_file_] == file) return last_file_;
+        for (std::uint32_t i = 0; i < scene.files.size(); ++i)
+            if (scene.files[i] == file) return last_file_ = i;
+        scene.files.push_back(file);
+        return last_file_ = std::uint32_t(scene.files.size() - 1);
+    }
+
+    /// The mesh of an OBJ file named relative to the statement's file, read once per file:
+    /// its index in Scene::meshes.
+    std::uint32_t mesh_file(const Statement& st, const Arg& a) {
         const fs::path base = fs::path(st.file()).parent_path();
         const fs::path target = (base / fs::path(std::string(a.value))).lexically_normal();
         const fs::path id = identity_of(target);
@@ -609,8 +645,10 @@ class Parser {
             st.fail(a.value_col, "cannot open mesh file " + quote(target.string()));
         try {
             auto mesh = load_obj_mesh(target.string());
-            meshes_.emplace(id, mesh);
-            return mesh;
+            const auto index = std::uint32_t(scene.meshes.size());
+            scene.meshes.push_back(std::move(mesh));
+            meshes_.emplace(id, index);
+            return index;
         } catch (const std::exception& e) {
             st.fail(a.value_col, quote(target.string()) + ": " + e.what());
         }

@@ -18,6 +18,8 @@ const char* shape_kind_name(ShapeKind k) {
 }  // namespace streamrt
 
 #include <cmath>
+#include <cstring>
+#include <functional>
 #include <numbers>
 
 namespace streamrt {
@@ -39,6 +41,29 @@ glm::dmat4 Camera::world_from_canonical(int width, int height) const {
     const double df = 1.0;
     const glm::dmat4 m = translate_matrix(eye - df * (-forward)) * rot * scale_matrix({rx, ry, df});
     return m;
+}
+
+}  // namespace streamrt
+
+namespace streamrt {
+
+std::size_t Scene::MaterialHash::operator()(const Material& m) const {
+    // Equal materials have equal fields; fields are hashed by value (+0 and -0 compare equal
+    // and are both possible only for checker colours, which then hash alike through +0.0).
+    std::size_t h = 0;
+    const auto mix = [&h](double v) { h = h * 0x9E3779B97F4A7C15ull ^ std::hash<double>{}(v + 0.0); };
+    for (double v : {m.ambi, m.diff, m.spec, m.shininess, m.refl, m.trans, m.ior, m.cell, m.checker_color.x,
+                     m.checker_color.y, m.checker_color.z})
+        mix(v);
+    return h ^ std::size_t(m.checker);
+}
+
+void Scene::add_object(Object o, const Material& m, const ObjectLoc& loc) {
+    const auto [it, added] = material_index_.try_emplace(m, std::uint32_t(materials.size()));
+    if (added) materials.push_back(m);
+    o.material = it->second;
+    objects.push_back(o);
+    object_locs.push_back(loc);
 }
 
 }  // namespace streamrt

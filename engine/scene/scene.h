@@ -1,13 +1,15 @@
 #pragma once
 // The scene model of the handout: lights, shapes (canonical shape + Md/Mn/Mi + material),
-// a camera placed by Md, and the render settings. Everything here is in double; the stream
-// engine converts to its own float tables when it builds its pipeline.
+// a camera placed by Md, and the render settings. Geometry is in double (Md, lights, camera);
+// objects are compact records with an index into deduplicated materials (a scene may hold
+// millions). Each engine converts to its own tables when it builds its pipeline.
 #include <glm/glm.hpp>
 
 #include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "core/error.h"
@@ -30,8 +32,10 @@ enum class ShapeKind : std::uint8_t {
 inline constexpr int kShapeKindCount = 7;
 const char* shape_kind_name(ShapeKind k);
 
+/// A material's optical parameters (the handout's ambi, diff, refl, trans and their
+/// companions). The colour is not here: it is the object's own (Object::color), so that
+/// scenes whose objects differ only by colour share one material record.
 struct Material {
-    glm::dvec3 color{1.0, 1.0, 1.0};
     double ambi = 1.0;   ///< weight of the ambient term (degree 2)
     double diff = 1.0;   ///< weight of the Lambert term (degree 2)
     double spec = 0.0;   ///< Phong highlight weight (degree 2, optional)
@@ -42,20 +46,35 @@ struct Material {
     bool checker = false;
     glm::dvec3 checker_color{0.0, 0.0, 0.0};
     double cell = 1.0;  ///< checker cell side, world units
+
+    bool operator==(const Material&) const = default;
 };
 
+/// One object, compact (128 bytes; a scene may hold millions): the canonical shape, Md, the
+/// object's colour and the index of its (deduplicated) material. Mi and Mn are not stored:
+/// each engine derives what it needs from Md once, in the precision it works in. Where the
+/// statement came from is kept apart (Scene::where), since only messages need it.
 struct Object {
-    ShapeKind kind = ShapeKind::Sphere;
-    double minor = 0.25;  ///< torus minor radius (canonical units); unused by other shapes
-    std::shared_ptr<const Mesh> mesh;  ///< Mesh only: the triangles, shared by every object using the file
-    bool smooth = false;  ///< Mesh only: interpolated vertex normals instead of the flat face normal
-    Material material;
-    Transform xf;  ///< Md, Mi, Mn
-    SourceLoc where;  ///< the statement that made it, for messages
-
+    /// Md's top three rows (glm: 4 columns of 3); the fourth row of an affine map is 0 0 0 1.
+    glm::dmat4x3 md{1.0};
     /// The per-object shape parameter the kernels and shading receive: the torus minor
-    /// radius, 1 for a smooth mesh, 0 for a flat one.
-    double param() const { return kind == ShapeKind::Mesh ? (smooth ? 1.0 : 0.0) : minor; }
+    /// radius (canonical units), 1 for a smooth mesh, 0 for a flat one, 0 otherwise.
+    double param = 0.0;
+    /// The handout's Col of the object. Single precision: scene colours carry a few decimals
+    /// and end as 8-bit or float pixels.
+    glm::vec3 color{1.f, 1.f, 1.f};
+    std::uint32_t material = 0;  ///< index into Scene::materials
+    std::uint32_t mesh = 0;      ///< Mesh only: index into Scene::meshes
+    ShapeKind kind = ShapeKind::Sphere;
+
+    glm::dmat4 direct() const { return glm::dmat4(md); }
+};
+static_assert(sizeof(Object) == 128, "Object is meant to stay two cache lines");
+
+/// Where an object's statement is, for messages: an index into Scene::files, line, column.
+struct ObjectLoc {
+    std::uint32_t file = 0;
+    std::int32_t line = 0, column = 0;
 };
 
 enum class LightKind : std::uint8_t { Point, Spot, Directional };
@@ -103,6 +122,30 @@ struct Scene {
     Camera camera;
     std::vector<Light> lights;
     std::vector<Object> objects;
+    std::vector<Material> materials;  ///< deduplicated; Object::material indexes it
+    std::vector<std::shared_ptr<const Mesh>> meshes;  ///< one per OBJ file; Object::mesh indexes it
+    /// Cold data, for messages only: the statement of each object (same indexing as objects).
+    std::vector<ObjectLoc> object_locs;
+    std::vector<std::string> files;  ///< the files objects came from (ObjectLoc::file)
+
+    const Material& material_of(const Object& o) const { return materials[o.material]; }
+    /// The object's mesh (Mesh objects only; nullptr otherwise).
+    const Mesh* mesh_of(const Object& o) const {
+        return o.kind == ShapeKind::Mesh && o.mesh < meshes.size() ? meshes[o.mesh].get() : nullptr;
+    }
+    /// The statement that made object i.
+    SourceLoc where(std::size_t i) const {
+        const ObjectLoc& l = object_locs[i];
+        return SourceLoc{files[l.file], l.line, l.column};
+    }
+    /// Adds an object; its material is deduplicated against those already here.
+    void add_object(Object o, const Material& m = {}, const ObjectLoc& loc = {});
+
+  private:
+    struct MaterialHash {
+        std::size_t operator()(const Material& m) const;
+    };
+    std::unordered_map<Material, std::uint32_t, MaterialHash> material_index_;
 };
 
 }  // namespace streamrt

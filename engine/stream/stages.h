@@ -89,9 +89,10 @@ inline Vec3f apply_vector(const float* m, const Vec3f& v) {
     return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
             m[8] * v.x + m[9] * v.y + m[10] * v.z};
 }
-inline Vec3f apply_normal(const float* m, const Vec3f& n) {
-    return normalize(Vec3f{m[0] * n.x + m[1] * n.y + m[2] * n.z, m[3] * n.x + m[4] * n.y + m[5] * n.z,
-                           m[6] * n.x + m[7] * n.y + m[8] * n.z});
+/// Mn n with Mn = (Mi's linear part) transposed, read from Mi's row-major 3x4 rows.
+inline Vec3f apply_normal(const float* mi, const Vec3f& n) {
+    return normalize(Vec3f{mi[0] * n.x + mi[4] * n.y + mi[8] * n.z, mi[1] * n.x + mi[5] * n.y + mi[9] * n.z,
+                           mi[2] * n.x + mi[6] * n.y + mi[10] * n.z});
 }
 inline void add(float* accum, std::int32_t pixel, const ColorT<float>& c) {
     accum[pixel * 3 + 0] += c.x;
@@ -207,15 +208,16 @@ struct PipelineStages {
         using namespace stage_detail;
         const RenderSettings& s = sc.settings;
         const bool may_spawn = kSecondary && depth < s.depth;
-        // This path serves scenes with many objects, where each hit's object and material
-        // records are likely cache misses: fetch them a few rays ahead.
+        // This path serves scenes with many objects, where each hit's records are likely
+        // cache misses: fetch them a few rays ahead (in leaf order, neighbouring rays mostly
+        // hit objects close in memory).
         constexpr std::size_t kPrefetchDistance = 8;
         for (std::size_t i = 0; i < rays.count; ++i) {
             if (i + kPrefetchDistance < rays.count && object[i + kPrefetchDistance] >= 0) {
                 const std::size_t ahead = std::size_t(object[i + kPrefetchDistance]);
                 __builtin_prefetch(&sc.objects[ahead]);
                 __builtin_prefetch(reinterpret_cast<const char*>(&sc.objects[ahead]) + 64);
-                __builtin_prefetch(&sc.materials[ahead]);
+                __builtin_prefetch(&sc.surfaces[ahead]);
             }
             const ColorT<float> w{rays.wr[i], rays.wg[i], rays.wb[i]};
             const std::int32_t px = rays.pixel[i];
@@ -224,23 +226,25 @@ struct PipelineStages {
                 add(accum, px, mul(w, sc.background));
                 continue;
             }
-            const ShadeObject& ob = sc.objects[std::size_t(id)];
-            const MaterialT<float>& m = sc.materials[std::size_t(id)];
+            const KernelObject& ob = sc.objects[std::size_t(id)];
+            const SurfaceRecord& sf = sc.surfaces[std::size_t(id)];
+            const MaterialT<float>& m = sc.materials[sf.material];
+            const ShapeKind kind = ShapeKind(ob.kind);
             const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
             const float t = rays.t_max[i];
-            // Rebuild the canonical hit point (the kernels keep only t and the object) and
-            // bring point and normal back with Md and Mn, as the baseline does.
-            const Vec3f pc = apply_point(ob.mi, o) + apply_vector(ob.mi, d) * t;
-            const Vec3f p = apply_point(ob.md, pc);
+            // The canonical hit point (the kernels keep only t and the object) gives the
+            // normal, brought back with Mn; the world point is the ray's own.
+            const Vec3f pc = apply_point(ob.xf.m, o) + apply_vector(ob.xf.m, d) * t;
+            const Vec3f p = o + d * t;
             const Vec3f nc =
-                ob.kind == ShapeKind::Mesh
-                    ? mesh_normal<float>(*ob.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i], mesh_hits.v[i],
-                                         ob.param != 0.f)
-                    : visit_shape(ob.kind, [&](auto shape) { return shape.template normal<float>(pc, ob.param); });
-            const Vec3f n_out = apply_normal(ob.mn, nc);
+                kind == ShapeKind::Mesh
+                    ? mesh_normal<float>(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i], mesh_hits.v[i],
+                                         ob.xf.param != 0.f)
+                    : visit_shape(kind, [&](auto shape) { return shape.template normal<float>(pc, ob.xf.param); });
+            const Vec3f n_out = apply_normal(ob.xf.m, nc);
             const float cone = rays.cone[i] + sc.camera.spread * t;
-            const ColorT<float> base =
-                surface_color(m, p, n_out, footprint_width(rays.cone[i], sc.camera.spread, t, dot(d, n_out)));
+            const ColorT<float> base = surface_color(m, ColorT<float>{sf.color[0], sf.color[1], sf.color[2]}, p, n_out,
+                                                     footprint_width(rays.cone[i], sc.camera.spread, t, dot(d, n_out)));
             if constexpr (!kLighting) {
                 add(accum, px, mul(w, base));
                 continue;
@@ -304,7 +308,7 @@ struct PipelineStages {
                              RayCounts& counts) {
         using namespace stage_detail;
         SortedHits& h = ws.sorted;
-        const std::size_t n_obj = sc.objects.size();
+        const std::size_t n_obj = sc.object_count;
         h.run_start.assign(n_obj + 1, 0);
         std::size_t hits = 0;
         for (std::size_t i = 0; i < rays.count; ++i) {
@@ -348,7 +352,7 @@ struct PipelineStages {
         RayStream& nx = ws.next;
         ShadowStream& sh = ws.shadows;
         ShadeJob job{h.ox.data(), h.oy.data(), h.oz.data(), h.dx.data(), h.dy.data(), h.dz.data(), h.t.data(),
-                     h.wr.data(), h.wg.data(), h.wb.data(), h.cone.data(), h.pixel.data(), 0, 0, nullptr, nullptr,
+                     h.wr.data(), h.wg.data(), h.wb.data(), h.cone.data(), h.pixel.data(), 0, 0, nullptr, {}, nullptr,
                      sc.lights.data(), sc.lights.size(), sc.settings.degree, float(sc.settings.ambient),
                      kSecondary && depth < sc.settings.depth, sc.camera.spread, h.lr.data(), h.lg.data(), h.lb.data(),
                      {nx.ox.data(), nx.oy.data(), nx.oz.data(), nx.dx.data(), nx.dy.data(), nx.dz.data(),
@@ -364,8 +368,10 @@ struct PipelineStages {
             if (h.run_start[k] == h.run_start[k + 1]) continue;
             job.begin = h.run_start[k];
             job.end = h.run_start[k + 1];
+            const SurfaceRecord& sf = sc.surfaces[k];
             job.object = &sc.objects[k];
-            job.material = &sc.materials[k];
+            job.color = {sf.color[0], sf.color[1], sf.color[2]};
+            job.material = &sc.materials[sf.material];
             fn(job);
         }
         for (std::size_t j = 0; j < hits; ++j) add(accum, h.pixel[j], {h.lr[j], h.lg[j], h.lb[j]});
@@ -442,7 +448,7 @@ struct PipelineStages {
                 // Room for every ray spawning both children and a shadow ray per light.
                 ws.next.reserve(kSecondary ? rays.count * 2 : 0);
                 if constexpr (kShadows) ws.shadows.reserve(rays.count * lights);
-                if (scalar_shade || sc.objects.size() > kSortedShadeMaxObjects)
+                if (scalar_shade || sc.object_count > kSortedShadeMaxObjects)
                     shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, accum, counts);
                 else
                     shade_sorted(sc, kt, rays, ws.object, depth, ws, accum, counts);

@@ -1,23 +1,25 @@
 #include "stream/stream_accel.h"
 
 #include "mesh/mesh.h"
+#include "parallel/parallelism.h"
 
 namespace streamrt {
 
-namespace {
-void rows3x4(const glm::dmat4& m, float* out) {
+KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t id, const glm::dvec3& shift) {
+    const Object& o = scene.objects[index];
+    // Mi of the object moved by -shift: Mi T(shift), composed in double before rounding.
+    glm::dmat4x3 mi = affine_inverse(o.md);
+    mi[3] += glm::dmat3(mi) * shift;
+    KernelObject k{};
     for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c) out[r * 4 + c] = float(m[c][r]);  // glm is column-major
+        for (int c = 0; c < 4; ++c) k.xf.m[r * 4 + c] = float(mi[c][r]);  // glm is column-major
+    k.xf.param = float(o.param);
+    k.xf.id = id;
+    const Mesh* mesh = scene.mesh_of(o);
+    k.xf.mesh = mesh ? &mesh->view() : nullptr;
+    k.kind = std::uint32_t(o.kind);
+    return k;
 }
-ObjectXf object_xf(const Object& o, std::uint32_t id, const glm::dvec3& shift) {
-    ObjectXf xf{};
-    rows3x4(o.xf.mi * translate_matrix(shift), xf.m);  // Mi of the object moved by -shift
-    xf.param = float(o.param());
-    xf.id = std::int32_t(id);
-    xf.mesh = o.mesh ? &o.mesh->view() : nullptr;
-    return xf;
-}
-}  // namespace
 
 std::shared_ptr<const StreamAccel> StreamAccel::build_for(const Scene& scene, const glm::dvec3& shift) {
     auto bvh = accel::SceneBvh::build_for(scene, accel::accel_config(), shift);
@@ -31,15 +33,21 @@ StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bv
     primary_ = c.primary;
     secondary_ = c.secondary;
     shadow_ = c.shadow;
-    prims_.reserve(bvh_->bvh.prim_index.size());
-    for (std::uint32_t id : bvh_->bvh.prim_index)
-        prims_.push_back({object_xf(scene.objects[id], id, shift), std::uint32_t(scene.objects[id].kind)});
-    for (std::uint32_t id : bvh_->unbounded)
-        unbounded_[int(scene.objects[id].kind)].push_back(object_xf(scene.objects[id], id, shift));
+    // Leaf order: the leaves' ranges [child, child + count) index objects_ directly, so the
+    // hierarchy's own map to scene indices moves here (id -> scene index).
+    order_ = std::move(bvh_->bvh.prim_index);
+    bvh_->bvh.prim_index.clear();
+    const std::size_t n_bounded = order_.size();
+    order_.insert(order_.end(), bvh_->unbounded.begin(), bvh_->unbounded.end());
+    objects_.resize(order_.size());
+    parallel_for_index(order_.size(), 4096, [&](std::size_t id) {
+        objects_[id] = kernel_object(scene, order_[id], std::int32_t(id), shift);
+    });
+    for (std::size_t id = n_bounded; id < order_.size(); ++id) unbounded_[objects_[id].kind].push_back(objects_[id].xf);
 }
 
 std::size_t StreamAccel::memory_bytes() const {
-    return bvh_->bvh.memory_bytes() + prims_.size() * sizeof(AccelObject);
+    return bvh_->bvh.memory_bytes() + objects_.size() * sizeof(KernelObject) + order_.size() * sizeof(std::uint32_t);
 }
 
 void StreamAccel::closest(const KernelTable& kt, RayView rays, std::int32_t* object, bool coherent) const {
@@ -47,7 +55,7 @@ void StreamAccel::closest(const KernelTable& kt, RayView rays, std::int32_t* obj
         if (!unbounded_[k].empty()) kt.closest[k](rays, object, unbounded_[k].data(), unbounded_[k].size());
     if (bvh_->bvh.empty()) return;
     const AccelKernelTable& at = accel_kernel_table(kt.isa);
-    const AccelView view{bvh_->bvh.nodes.data(), prims_.data()};
+    const AccelView view{bvh_->bvh.nodes.data(), objects_.data()};
     const accel::Traversal tr = coherent ? primary_ : secondary_;
     (tr == accel::Traversal::Packet ? at.closest_packet : at.closest_single)(view, rays, object);
 }
@@ -57,7 +65,7 @@ void StreamAccel::any(const KernelTable& kt, RayView rays) const {
         if (!unbounded_[k].empty()) kt.any[k](rays, unbounded_[k].data(), unbounded_[k].size());
     if (bvh_->bvh.empty()) return;
     const AccelKernelTable& at = accel_kernel_table(kt.isa);
-    const AccelView view{bvh_->bvh.nodes.data(), prims_.data()};
+    const AccelView view{bvh_->bvh.nodes.data(), objects_.data()};
     (shadow_ == accel::Traversal::Packet ? at.any_packet : at.any_single)(view, rays);
 }
 

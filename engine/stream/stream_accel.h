@@ -1,8 +1,10 @@
 #pragma once
 // The stream engine's side of the object hierarchy (engine/accel): the scene's SceneBvh with
-// its leaf objects laid out for the traversal kernels, the unbounded objects (planes) kept
-// for the flat per-kind kernels, and the choice of traversal per ray class. The intersect and
-// occlusion stages call closest()/any() instead of their per-kind loops when a scene has one.
+// every object laid out as the kernels and the shade stage read it, in leaf order (objects
+// close in space are close in memory, which is what the shade stage needs at 1e6 objects),
+// the unbounded objects (planes) after them and also kept per kind for the flat kernels, and
+// the choice of traversal per ray class. The intersect and occlusion stages call
+// closest()/any() instead of their per-kind loops when a scene has one.
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -14,6 +16,10 @@
 
 namespace streamrt {
 
+/// The stream engine's record of scene object `index`, moved by -shift (the engine renders
+/// relative to the eye), with id `id` in the engine's tables.
+KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t id, const glm::dvec3& shift);
+
 class StreamAccel {
   public:
     /// nullptr when the scene is traced without the hierarchy (accel_config()).
@@ -22,17 +28,24 @@ class StreamAccel {
     StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh, const glm::dvec3& shift = glm::dvec3(0.0));
 
     /// Closest hit of every ray (see ClosestHitFn); `coherent` picks the configured traversal
-    /// for primary rays, otherwise for secondary rays.
+    /// for primary rays, otherwise for secondary rays. Ids index objects().
     void closest(const KernelTable& kt, RayView rays, std::int32_t* object, bool coherent) const;
     /// Any hit for shadow rays (see AnyHitFn).
     void any(const KernelTable& kt, RayView rays) const;
+
+    /// Every object, bounded ones in leaf order then the unbounded ones; ids index it.
+    const std::vector<KernelObject>& objects() const { return objects_; }
+    /// The scene index of the object with id `id`.
+    std::uint32_t scene_index(std::int32_t id) const { return order_[std::size_t(id)]; }
+    const std::vector<std::uint32_t>& scene_order() const { return order_; }
 
     const accel::SceneBvh& scene_bvh() const { return *bvh_; }
     std::size_t memory_bytes() const;
 
   private:
     std::unique_ptr<accel::SceneBvh> bvh_;
-    std::vector<AccelObject> prims_;                ///< leaf order
+    std::vector<KernelObject> objects_;                 ///< by id: leaf order, then unbounded
+    std::vector<std::uint32_t> order_;                  ///< id -> scene index
     std::vector<ObjectXf> unbounded_[kShapeKindCount];  ///< per kind, outside the hierarchy
     accel::Traversal primary_, secondary_, shadow_;
 };

@@ -26,7 +26,7 @@ std::vector<std::string> StreamRenderer::built_stages() const {
             first = false;
         }
     b.push_back(kernels + "]");
-    const bool sorted = !scalar_shade_ && scene_.objects.size() <= kSortedShadeMaxObjects;
+    const bool sorted = !scalar_shade_ && scene_.object_count <= kSortedShadeMaxObjects;
     b.push_back(std::string(f.lighting ? "shade(lit" : "shade(flat") + (sorted ? ",simd,sorted)" : ",scalar)"));
     if (f.reflect) b.push_back("spawn(reflect)");
     if (f.refract) b.push_back("spawn(refract)");
@@ -76,7 +76,7 @@ StreamRenderer::TileFn StreamRenderer::select_tile_fn() const {
 
 Framebuffer StreamRenderer::render(Parallelism& par, RenderProgress* progress, StreamProfile* profile) const {
     const RenderSettings& s = scene_.settings;
-    Framebuffer fb(s.width, s.height);
+    Framebuffer fb = Framebuffer::uninitialized(s.width, s.height);  // every tile writes its pixels
     std::mutex profile_mutex;
     const auto start = std::chrono::steady_clock::now();
     par.for_each_tile(s.width, s.height, kTileSize, [&](int, Tile tile) {

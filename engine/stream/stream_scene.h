@@ -28,11 +28,15 @@ struct StreamScene {
     RenderSettings settings;
     StreamFeatures features;
     CameraRays<float> camera;  ///< everything below is relative to the eye (stream_scene.cpp)
-    std::vector<ShadeObject> objects;
-    std::vector<MaterialT<float>> materials;  ///< per object
+    /// Every object as the kernels and the shade stage read it, by id (the ids the intersect
+    /// stage writes): the hierarchy's leaf order when there is one, scene order otherwise.
+    const KernelObject* objects = nullptr;
+    std::size_t object_count = 0;
+    std::vector<SurfaceRecord> surfaces;      ///< by id: colour and material index
+    std::vector<MaterialT<float>> materials;  ///< by scene material index
     std::vector<LightT<float>> lights;
-    /// Per shape kind (indexed by ShapeKind), the objects of that kind; empty kinds get no
-    /// kernel call at all.
+    /// Without a hierarchy: per shape kind (indexed by ShapeKind), the objects of that kind;
+    /// empty kinds get no kernel call at all.
     std::vector<ObjectXf> groups[kShapeKindCount];
     /// World bounds per object of each group, for the per-packet culling of the flat kernels;
     /// a kind with an unbounded member (the plane) is tested without culling.
@@ -40,13 +44,18 @@ struct StreamScene {
     bool group_bounded[kShapeKindCount];  ///< set in the constructor
     ColorT<float> background;
     /// The object hierarchy, when the scene is traced with one (stream/stream_accel.h); the
-    /// intersect and occlusion stages then use it instead of `groups`.
+    /// intersect and occlusion stages then use it instead of `groups`, and it owns `objects`.
     std::shared_ptr<const StreamAccel> accel;
-    /// The meshes the objects use (kept alive here: ShadeObject and ObjectXf point into them).
+    /// The meshes the objects use (kept alive here: the objects' records point into them).
     std::vector<std::shared_ptr<const Mesh>> meshes;
     bool has_meshes = false;
 
     explicit StreamScene(const Scene& scene);
+    StreamScene(const StreamScene&) = delete;  // `objects` may point into flat_objects_
+    StreamScene& operator=(const StreamScene&) = delete;
+
+  private:
+    std::vector<KernelObject> flat_objects_;  ///< `objects` without a hierarchy
 };
 
 }  // namespace streamrt

@@ -24,18 +24,18 @@ Scene random_scene(std::size_t n, std::uint32_t seed) {
         Object o;
         const int k = int(rng() % 5);  // sphere, cube, cylinder, cone, torus
         o.kind = ShapeKind(k);
-        o.minor = 0.3;
+        o.param = k == int(ShapeKind::Torus) ? 0.3 : 0.0;
         const glm::dmat4 md = translate_matrix({side * u(rng), side * u(rng), side * u(rng)}) *
                               rotate_y_matrix(180 * u(rng)) * rotate_x_matrix(180 * u(rng)) *
                               scale_matrix({0.3 + std::abs(u(rng)), 0.3 + std::abs(u(rng)), 0.3 + std::abs(u(rng))});
-        o.xf = Transform::from_direct(md);
-        s.objects.push_back(o);
+        o.md = glm::dmat4x3(md);
+        s.add_object(o);
     }
     if (seed % 2) {  // a plane, which stays outside the hierarchy
         Object p;
         p.kind = ShapeKind::Plane;
-        p.xf = Transform::from_direct(translate_matrix({0, -side, 0}));
-        s.objects.push_back(p);
+        p.md = glm::dmat4x3(translate_matrix({0, -side, 0}));
+        s.add_object(p);
     }
     return s;
 }
@@ -45,10 +45,11 @@ double brute_t(const Scene& s, const Vec3d& o, const Vec3d& d, double t_max, int
     *id = -1;
     for (std::size_t i = 0; i < s.objects.size(); ++i) {
         const Object& ob = s.objects[i];
-        const Vec3d oc = to_vec(transform_point(ob.xf.mi, to_glm(o)));
-        const Vec3d dc = to_vec(transform_vector(ob.xf.mi, to_glm(d)));
+        const glm::dmat4 mi(affine_inverse(ob.md));
+        const Vec3d oc = to_vec(transform_point(mi, to_glm(o)));
+        const Vec3d dc = to_vec(transform_vector(mi, to_glm(d)));
         const double t =
-            visit_shape(ob.kind, [&](auto shape) { return shape.template hit_t<double>(oc, dc, ob.minor, 0.0, best); });
+            visit_shape(ob.kind, [&](auto shape) { return shape.template hit_t<double>(oc, dc, ob.param, 0.0, best); });
         if (t < best) {
             best = t;
             *id = int(i);
@@ -62,10 +63,11 @@ double bvh_t(const Scene& s, const accel::SceneBvh& b, const Vec3d& o, const Vec
     *id = -1;
     const auto test = [&](std::uint32_t i, double& tm) {
         const Object& ob = s.objects[i];
-        const Vec3d oc = to_vec(transform_point(ob.xf.mi, to_glm(o)));
-        const Vec3d dc = to_vec(transform_vector(ob.xf.mi, to_glm(d)));
+        const glm::dmat4 mi(affine_inverse(ob.md));
+        const Vec3d oc = to_vec(transform_point(mi, to_glm(o)));
+        const Vec3d dc = to_vec(transform_vector(mi, to_glm(d)));
         const double t =
-            visit_shape(ob.kind, [&](auto shape) { return shape.template hit_t<double>(oc, dc, ob.minor, 0.0, tm); });
+            visit_shape(ob.kind, [&](auto shape) { return shape.template hit_t<double>(oc, dc, ob.param, 0.0, tm); });
         if (t < tm) {
             tm = t;
             *id = int(i);
@@ -143,15 +145,8 @@ TEST_CASE("BVH: SIMD packet and single-ray kernels agree with the flat kernels, 
             const KernelTable& kt = kernel_table(isa);
             // Flat reference: every object in its kind's kernel.
             std::vector<ObjectXf> groups[kShapeKindCount];
-            for (std::size_t i = 0; i < s.objects.size(); ++i) {
-                const Object& o = s.objects[i];
-                ObjectXf xf{};
-                for (int a = 0; a < 3; ++a)
-                    for (int c = 0; c < 4; ++c) xf.m[a * 4 + c] = float(o.xf.mi[c][a]);
-                xf.param = float(o.minor);
-                xf.id = std::int32_t(i);
-                groups[int(o.kind)].push_back(xf);
-            }
+            for (std::size_t i = 0; i < s.objects.size(); ++i)
+                groups[int(s.objects[i].kind)].push_back(kernel_object(s, i, std::int32_t(i), glm::dvec3(0.0)).xf);
             const auto make = [&](RayStream& rs, float t_max) {
                 rs.reserve(r.o.size());
                 for (std::size_t i = 0; i < r.o.size(); ++i) {
@@ -175,7 +170,8 @@ TEST_CASE("BVH: SIMD packet and single-ray kernels agree with the flat kernels, 
                 AlignedVec<std::int32_t> id(rs.capacity(), -1);
                 sa2.closest(kt, view_of(rs), id.data(), true);
                 for (std::size_t i = 0; i < rs.count; ++i) {
-                    CHECK(id[i] == flat_id[i]);
+                    // The hierarchy's ids index its leaf-ordered records; map them back.
+                    CHECK((id[i] < 0 ? -1 : std::int32_t(sa2.scene_index(id[i]))) == flat_id[i]);
                     CHECK(rs.t_max[i] == flat.t_max[i]);
                 }
                 // any hit: segments just short of / beyond the closest hit

@@ -230,6 +230,33 @@ TEST_CASE("cli: a render writes the image and leaves no temporary file") {
     CHECK(d.files().size() == 4);  // the scene and the three images, nothing else
 }
 
+TEST_CASE("cli: the PNG file's bytes are the same at -j1 and -j2") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kSmallScene);
+    // 400 wide: 110-row PNG bands, so 300 rows are three bands encoded in parallel at -j2.
+    std::string bytes[2];
+    for (int j = 1; j <= 2; ++j) {
+        const fs::path out = d.path / ("j" + std::to_string(j) + ".png");
+        const Run r = streamrt("-q -j" + std::to_string(j) + " --width 400 --height 300 " + q(scene) + " -o " + q(out));
+        REQUIRE(r.code == 0);
+        bytes[j - 1] = slurp(out);
+    }
+    CHECK(bytes[0].size() > 1000);
+    CHECK(bytes[0] == bytes[1]);
+}
+
+TEST_CASE("cli: a 32768x32768 render fits a 24 GiB machine: --check says ok") {
+    // 12 GiB of float framebuffer plus the writer's bands (about 13 MiB), not 18 GiB of copies.
+    const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGE_SIZE));
+    if (memory < 20.0 * (1ull << 30)) return;  // a smaller machine rightly refuses it
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kSmallScene);
+    const Run r = streamrt("--check -j2 --width 32768 --height 32768 " + q(scene) + " -o " + q(d.path / "big.png"));
+    INFO(r.err);
+    CHECK(r.code == 0);
+    CHECK(r.out.find("ok") != std::string::npos);
+}
+
 namespace {
 
 /// Starts streamrt with argv in a child (stdout and stderr to `log`), returns its pid.

@@ -50,13 +50,16 @@ inline std::string check_scene(const Scene& sc) {
         return "spp, depth or degree out of range";
     if (!(s.ambient >= 0 && s.ambient <= 1) || !finite(s.background) || s.output.empty())
         return "ambient, background or output invalid";
-    for (const Object& o : sc.objects) {
-        if (!finite(o.xf.md) || !finite(o.xf.mi) || !finite(o.xf.mn))
-            return "object transform not finite: " + o.where.str();
-        if (!(o.minor > 0) || !std::isfinite(o.minor)) return "torus minor invalid: " + o.where.str();
-        const Material& m = o.material;
-        if (!finite(m.color) || !(m.ior > 0) || !(m.cell > 0) || !std::isfinite(m.cell))
-            return "material invalid: " + o.where.str();
+    for (std::size_t i = 0; i < sc.objects.size(); ++i) {
+        const Object& o = sc.objects[i];
+        if (!finite(o.direct()) || !finite(glm::dmat4(affine_inverse(o.md))))
+            return "object transform not finite: " + sc.where(i).str();
+        if (o.kind == ShapeKind::Torus && (!(o.param > 0) || !std::isfinite(o.param)))
+            return "torus minor invalid: " + sc.where(i).str();
+        if (o.material >= sc.materials.size()) return "material index out of range: " + sc.where(i).str();
+        const Material& m = sc.material_of(o);
+        if (!finite(glm::dvec3(o.color)) || !(m.ior > 0) || !(m.cell > 0) || !std::isfinite(m.cell))
+            return "material invalid: " + sc.where(i).str();
     }
     for (const Light& l : sc.lights) {
         if (!finite(l.pos) || !finite(l.color)) return "light not finite";

@@ -38,12 +38,14 @@ struct Rays {
     }
 };
 
-Object mesh_object(const std::shared_ptr<const Mesh>& m, const glm::dmat4& md = glm::dmat4(1.0)) {
+/// Adds mesh m to scene s as an object placed by md.
+void add_mesh_object(Scene& s, const std::shared_ptr<const Mesh>& m, const glm::dmat4& md = glm::dmat4(1.0)) {
     Object o;
     o.kind = ShapeKind::Mesh;
-    o.mesh = m;
-    o.xf = Transform::from_direct(md);
-    return o;
+    o.mesh = std::uint32_t(s.meshes.size());
+    o.md = glm::dmat4x3(md);
+    s.meshes.push_back(m);
+    s.add_object(o);
 }
 
 void fill(RayStream& rs, const Rays& r, float t_max) {
@@ -76,7 +78,7 @@ void check_all_hit(const std::shared_ptr<const Mesh>& mesh, const Rays& r, float
     CHECK(miss_f == 0);
 
     Scene s;
-    s.objects.push_back(mesh_object(mesh));
+    add_mesh_object(s, mesh);
     ObjectXf xf{};
     xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
     xf.id = 0;
@@ -224,7 +226,7 @@ TEST_CASE("meshes: rays aimed exactly at shared edges and vertices of a tessella
 
 TEST_CASE("meshes: tessellated spheres against the analytic sphere, silhouettes agree within the tessellation error") {
     constexpr int kSize = 64;
-    const auto scene_with = [](const Object& o) {
+    const auto scene_with = [](const Object& o, const std::shared_ptr<const Mesh>& mesh) {
         Scene s;
         s.settings.width = s.settings.height = kSize;
         s.settings.spp = 1;
@@ -232,12 +234,13 @@ TEST_CASE("meshes: tessellated spheres against the analytic sphere, silhouettes 
         s.camera.look_at = true;
         s.camera.eye = {0.3, 0.5, 3.5};
         s.camera.fov = 40;
-        s.objects.push_back(o);
+        if (mesh) add_mesh_object(s, mesh);
+        else s.add_object(o);
         return s;
     };
     Object sphere;
     sphere.kind = ShapeKind::Sphere;
-    const Scene analytic = scene_with(sphere);
+    const Scene analytic = scene_with(sphere, nullptr);
     const CameraRays<double> cam = CameraRays<double>::from(analytic);
     Parallelism par(2);
     std::size_t previous = std::size_t(-1);
@@ -252,7 +255,7 @@ TEST_CASE("meshes: tessellated spheres against the analytic sphere, silhouettes 
         }
         CAPTURE(m->triangle_count());
         CAPTURE(r_in);
-        const Scene tess = scene_with(mesh_object(m));
+        const Scene tess = scene_with(Object{}, m);
         std::size_t outside_band = 0, extra = 0, differ = 0;
         for (EngineKind e : {EngineKind::Recursive, EngineKind::Stream}) {
             const Framebuffer a = render_scene(analytic, e, par).image;
@@ -302,11 +305,12 @@ TEST_CASE("meshes: an OBJ file through the parser, both engines agree, errors ca
     const Scene s = parse_scene(text, cfg);
     REQUIRE(s.objects.size() == 5);
     CHECK(s.objects[1].kind == ShapeKind::Mesh);
-    CHECK(s.objects[1].smooth);
-    CHECK(!s.objects[2].smooth);
+    CHECK(s.objects[1].param == 1.0);  // smooth
+    CHECK(s.objects[2].param == 0.0);
     CHECK(s.objects[1].mesh == s.objects[2].mesh);  // one file, loaded once
-    CHECK(s.objects[1].mesh->triangle_count() == 320);
-    CHECK(s.objects[4].mesh->triangle_count() == 2);  // the quad, triangulated
+    CHECK(s.meshes.size() == 3);
+    CHECK(s.mesh_of(s.objects[1])->triangle_count() == 320);
+    CHECK(s.mesh_of(s.objects[4])->triangle_count() == 2);  // the quad, triangulated
     Parallelism par(2);
     for (accel::AccelMode mode : {accel::AccelMode::Flat, accel::AccelMode::Bvh}) {
         accel::accel_config().mode = mode;

@@ -14,7 +14,9 @@ TEST_CASE("limits: the estimate counts the framebuffer, the output and the per-t
     Scene sc = parse_scene("image width=100 height=50 spp=1 depth=5 degree=5\nsphere\n", "t.cfg");
     const MemoryEstimate e = estimate_render_memory(sc, true, 4);
     CHECK(e.framebuffer_bytes == 100.0 * 50 * 3 * 4);
-    CHECK(e.output_bytes == 100.0 * 50 * 18);
+    // One PNG band (the whole image): two 8-bit rows 600, filtered rows 50 * 301, their
+    // deflate bound 15050 + 16 + 64, one deflate state 270336. PNG needs the most.
+    CHECK(e.output_bytes == 600 + 15050 + 15130 + 270336);
     CHECK(e.branching == 1);
     CHECK(e.peak_stream_rays == 4096);  // no mirror: the stream never grows
     CHECK(e.threads == 4);
@@ -44,12 +46,17 @@ TEST_CASE("limits: 2^depth secondaries only when one material both reflects and 
 TEST_CASE("limits: a render above the limit is refused with what it would need") {
     Scene sc = parse_scene("image width=32768 height=32768\nsphere\n", "t.cfg");
     CHECK_NOTHROW(check_render_memory(sc, true, 2, 1e12));
+    // The writer streams bands: 16 bands of 2 rows in flight, not a copy of the image, so
+    // the 12 GiB framebuffer fits a 24 GiB machine.
+    const MemoryEstimate big = estimate_render_memory(sc, true, 2);
+    CHECK(big.output_bytes == 16.0 * (2 * 98304 + 2 * 98305 + (2 * 98305 + 197 + 64) + 270336));
+    CHECK_NOTHROW(check_render_memory(sc, true, 2, 24.0 * 1024 * 1024 * 1024));
     try {
         check_render_memory(sc, true, 2, 8.0 * 1024 * 1024 * 1024);
         FAIL("expected a UsageError");
     } catch (const UsageError& e) {
         const std::string m = e.what();
-        CHECK(m.find("image 32768x32768, spp 1, depth 5 would need about 30.0 GiB of memory") == 0);
+        CHECK(m.find("image 32768x32768, spp 1, depth 5 would need about 12.0 GiB of memory") == 0);
         CHECK(m.find("framebuffer 12.0 GiB") != std::string::npos);
         CHECK(m.find("but this machine has 8.0 GiB") != std::string::npos);
         CHECK(m.find('\n') == std::string::npos);

@@ -203,12 +203,12 @@ TEST_CASE("parser: materials and shapes") {
                                ShapeKind::Cylinder, ShapeKind::Cone, ShapeKind::Plane};
     for (int i = 0; i < 6; ++i) {
         CHECK(s.objects[i].kind == kinds[i]);
-        CHECK(s.objects[i].where.file == "t.cfg");
-        CHECK(s.objects[i].where.line == i + 2);
-        CHECK(s.objects[i].where.column == 1);
+        CHECK(s.where(i).file == "t.cfg");
+        CHECK(s.where(i).line == i + 2);
+        CHECK(s.where(i).column == 1);
     }
-    const Material& g = s.objects[0].material;
-    CHECK(near(g.color, {1, 1, 1}));
+    const Material& g = s.material_of(s.objects[0]);
+    CHECK(near(glm::dvec3(s.objects[0].color), {1, 1, 1}));
     CHECK(g.ambi == 0.0);
     CHECK(g.diff == 0.0);
     CHECK(g.spec == doctest::Approx(0.5));
@@ -217,10 +217,10 @@ TEST_CASE("parser: materials and shapes") {
     CHECK(g.trans == doctest::Approx(0.9));
     CHECK(g.ior == doctest::Approx(1.5));
     CHECK_FALSE(g.checker);
-    CHECK(near(apply(s.objects[0].xf.md, {0, 0, 0}), {0, 1, 0}));
+    CHECK(near(apply(s.objects[0].direct(), {0, 0, 0}), {0, 1, 0}));
 
-    const Material& red = s.objects[1].material;
-    CHECK(near(red.color, {1, 0, 0}));
+    const Material& red = s.material_of(s.objects[1]);
+    CHECK(near(glm::dvec3(s.objects[1].color), {1, 0, 0}));
     CHECK(red.ambi == doctest::Approx(0.2));
     CHECK(red.diff == doctest::Approx(0.8));
     CHECK(red.spec == 0.0);  // defaults untouched
@@ -228,23 +228,23 @@ TEST_CASE("parser: materials and shapes") {
     // scale (0.5,1,0.5) then rotate_y 45 then translate: canonical (1,0,0) -> (0.5,0,0) ->
     // (0.5cos45, 0, -0.5sin45) -> + (2,0.5,0).
     const double h = 0.5 * std::sqrt(0.5);
-    CHECK(near(apply(s.objects[1].xf.md, {1, 0, 0}), {2 + h, 0.5, -h}));
-    // Mi and Mn are consistent with Md.
-    const glm::dmat4 id = s.objects[1].xf.mi * s.objects[1].xf.md;
+    CHECK(near(apply(s.objects[1].direct(), {1, 0, 0}), {2 + h, 0.5, -h}));
+    // The engines' Mi (affine_inverse) is consistent with Md.
+    const glm::dmat4 id = glm::dmat4(affine_inverse(s.objects[1].md)) * s.objects[1].direct();
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) CHECK(id[c][r] == doctest::Approx(c == r ? 1.0 : 0.0));
 
-    CHECK(s.objects[2].minor == doctest::Approx(0.25));
+    CHECK(s.objects[2].param == doctest::Approx(0.25));
     // rotate_x=90 takes +y to +z.
-    CHECK(near(apply(s.objects[2].xf.md, {0, 1, 0}), {-2, 1, 1}));
+    CHECK(near(apply(s.objects[2].direct(), {0, 1, 0}), {-2, 1, 1}));
 
-    const Material& floor = s.objects[5].material;
+    const Material& floor = s.material_of(s.objects[5]);
     CHECK(floor.checker);
     CHECK(near(floor.checker_color, {0.2, 0.2, 0.2}));
     CHECK(floor.cell == doctest::Approx(0.5));
     CHECK(floor.diff == doctest::Approx(0.9));
 
-    CHECK(parse("torus minor=0.4").objects[0].minor == doctest::Approx(0.4));
+    CHECK(parse("torus minor=0.4").objects[0].param == doctest::Approx(0.4));
 }
 
 TEST_CASE("parser: material= first, then direct keys override it") {
@@ -255,14 +255,14 @@ TEST_CASE("parser: material= first, then direct keys override it") {
         "material derived material=base diff=0.25\n"
         "cube material=derived\n");
     REQUIRE(s.objects.size() == 3);
-    CHECK(near(s.objects[0].material.color, {1, 0, 0}));
-    CHECK(s.objects[0].material.diff == doctest::Approx(0.5));
-    CHECK(s.objects[0].material.refl == doctest::Approx(0.3));
-    CHECK(near(s.objects[1].material.color, {0, 0, 1}));
-    CHECK(s.objects[1].material.refl == 0.0);
-    CHECK(near(s.objects[2].material.color, {0, 0, 1}));
-    CHECK(s.objects[2].material.diff == doctest::Approx(0.25));
-    CHECK(s.objects[2].material.refl == doctest::Approx(0.3));
+    CHECK(near(glm::dvec3(s.objects[0].color), {1, 0, 0}));
+    CHECK(s.material_of(s.objects[0]).diff == doctest::Approx(0.5));
+    CHECK(s.material_of(s.objects[0]).refl == doctest::Approx(0.3));
+    CHECK(near(glm::dvec3(s.objects[1].color), {0, 0, 1}));
+    CHECK(s.material_of(s.objects[1]).refl == 0.0);
+    CHECK(near(glm::dvec3(s.objects[2].color), {0, 0, 1}));
+    CHECK(s.material_of(s.objects[2]).diff == doctest::Approx(0.25));
+    CHECK(s.material_of(s.objects[2]).refl == doctest::Approx(0.3));
 }
 
 TEST_CASE("parser: transforms apply in written order") {
@@ -274,14 +274,14 @@ TEST_CASE("parser: transforms apply in written order") {
         "sphere rotate_y=90\n"
         "sphere rotate_x=90 rotate_y=90\n");
     REQUIRE(s.objects.size() == 6);
-    CHECK(near(apply(s.objects[0].xf.md, {1, 0, 0}), {3, 0, 0}));
-    CHECK(near(apply(s.objects[1].xf.md, {1, 0, 0}), {4, 0, 0}));
-    CHECK(near(apply(s.objects[2].xf.md, {1, 1, 1}), {1, 2, 3}));
-    CHECK(near(apply(s.objects[3].xf.md, {1, 0, 0}), {0, 1, 0}));   // x -> y
-    CHECK(near(apply(s.objects[4].xf.md, {0, 0, 1}), {1, 0, 0}));   // z -> x
-    CHECK(near(apply(s.objects[5].xf.md, {0, 1, 0}), {1, 0, 0}));   // y -> z -> x
+    CHECK(near(apply(s.objects[0].direct(), {1, 0, 0}), {3, 0, 0}));
+    CHECK(near(apply(s.objects[1].direct(), {1, 0, 0}), {4, 0, 0}));
+    CHECK(near(apply(s.objects[2].direct(), {1, 1, 1}), {1, 2, 3}));
+    CHECK(near(apply(s.objects[3].direct(), {1, 0, 0}), {0, 1, 0}));   // x -> y
+    CHECK(near(apply(s.objects[4].direct(), {0, 0, 1}), {1, 0, 0}));   // z -> x
+    CHECK(near(apply(s.objects[5].direct(), {0, 1, 0}), {1, 0, 0}));   // y -> z -> x
     // Negative (mirroring) scales are fine.
-    CHECK(near(apply(parse("cube scale=-1,1,1").objects[0].xf.md, {1, 0, 0}), {-1, 0, 0}));
+    CHECK(near(apply(parse("cube scale=-1,1,1").objects[0].direct(), {1, 0, 0}), {-1, 0, 0}));
 }
 
 TEST_CASE("parser: whitespace, comments and CRLF") {
@@ -291,9 +291,9 @@ TEST_CASE("parser: whitespace, comments and CRLF") {
         "#sphere\n"
         "cube#glued comment\n");
     REQUIRE(s.objects.size() == 2);
-    CHECK(s.objects[0].where.line == 2);
-    CHECK(s.objects[0].where.column == 3);
-    CHECK(s.objects[1].where.line == 4);
+    CHECK(s.where(0).line == 2);
+    CHECK(s.where(0).column == 3);
+    CHECK(s.where(1).line == 4);
 }
 
 TEST_CASE("parser: errors carry the exact line and column") {
@@ -435,11 +435,11 @@ TEST_CASE("parser: include, cycles, depth and missing files") {
         REQUIRE(s.objects.size() == 2);
         REQUIRE(s.lights.size() == 1);
         CHECK(s.settings.width == 100);
-        CHECK(s.objects[1].material.refl == doctest::Approx(0.5));
-        CHECK(s.objects[0].where.file == (t.dir / "sub/objects.cfg").string());
-        CHECK(s.objects[0].where.line == 2);
-        CHECK(s.objects[1].where.file == top.string());
-        CHECK(s.objects[1].where.line == 3);
+        CHECK(s.material_of(s.objects[1]).refl == doctest::Approx(0.5));
+        CHECK(s.where(0).file == (t.dir / "sub/objects.cfg").string());
+        CHECK(s.where(0).line == 2);
+        CHECK(s.where(1).file == top.string());
+        CHECK(s.where(1).line == 3);
         // parse_scene resolves includes against the name's directory.
         const Scene m = parse_scene("include sub/objects.cfg\n", (t.dir / "mem.cfg").string());
         CHECK(m.objects.size() == 1);

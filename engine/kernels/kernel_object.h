@@ -1,0 +1,40 @@
+#pragma once
+// One object as the stream engine's kernels and its shade stage read it. Raw data only, so
+// the per-ISA kernel files touch no container code (see kernels/intersect_kernel.h on why).
+#include <cstdint>
+
+#include "mesh/mesh_view.h"
+
+namespace streamrt {
+
+/// Mi's top three rows (world -> canonical, relative to the eye), broadcast into every lane,
+/// the shape parameter (torus minor radius; 1 for a smooth mesh), the object's id in the
+/// stream engine's tables, and for a mesh its triangles and hierarchy.
+struct ObjectXf {
+    float m[12];  ///< row-major 3x4
+    float param;
+    std::int32_t id;
+    const MeshView* mesh = nullptr;  ///< ShapeKind::Mesh only
+};
+
+/// An object's world-space bounding box, padded outwards; the flat kernels skip an object
+/// for a whole packet when no ray of it meets the box before its current closest hit.
+struct ObjectBounds {
+    float lo[3], hi[3];
+};
+
+/// The stream engine's record of an object (72 bytes): what the shape kernels need, plus its
+/// kind. The shade stage reads the same record (Mn is Mi's linear part transposed), so an
+/// object's transform is stored once.
+struct KernelObject {
+    ObjectXf xf;
+    std::uint32_t kind;  ///< ShapeKind
+};
+
+/// What shading needs of an object beside its KernelObject: its colour and material.
+struct SurfaceRecord {
+    float color[3];
+    std::uint32_t material;  ///< index into the stream engine's materials
+};
+
+}  // namespace streamrt
