@@ -12,24 +12,30 @@ CXX=${FUZZ_CXX:-clang++-14}
 command -v "$CXX" >/dev/null || CXX=clang++
 out=build-fuzz
 mkdir -p "$out/corpus" "$out/artifacts"
-# The reader needs the mesh loader (mesh statements) and TBB (it reads large texts in parallel).
+# parser.cpp reads large texts in parallel (TBB) and `mesh` statements with engine/mesh/mesh.cpp, which builds each mesh's
+# triangle hierarchy (engine/accel/bvh.cpp, in parallel with TBB) and reads OBJ files with
+# tinyobjloader; the memory estimate (limits.cpp) asks the image writer (image_io.cpp, zlib,
+# stb) for its buffer size.
 sources=(tests/fuzz/scene_fuzz.cpp engine/scene/parser.cpp engine/scene/scene.cpp
-         engine/core/transform.cpp engine/render/limits.cpp engine/mesh/mesh.cpp engine/accel/bvh.cpp)
+         engine/core/transform.cpp engine/render/limits.cpp engine/mesh/mesh.cpp
+         engine/accel/bvh.cpp engine/image/image_io.cpp)
 bin="$out/scene_fuzz"
 # Rebuild when a source is newer than the binary.
 rebuild=0
 [[ -x $bin ]] || rebuild=1
-for s in "${sources[@]}" engine/scene/*.h engine/core/*.h engine/render/limits.h engine/parallel/*.h tests/fuzz/*.h; do
+for s in "${sources[@]}" engine/scene/*.h engine/core/*.h engine/render/limits.h engine/mesh/*.h \
+         engine/accel/*.h engine/image/*.h engine/parallel/*.h tests/fuzz/*.h; do
   [[ $s -nt $bin ]] && rebuild=1
 done
 if ((rebuild)); then
   echo "fuzz.sh: building $bin with $CXX"
   "$CXX" -std=c++20 -O1 -g -fno-omit-frame-pointer \
     -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-    -Iengine -Itests "${sources[@]}" -ltbb -ltinyobjloader -o "$bin"
+    -Iengine -Itests -I/usr/include/stb "${sources[@]}" -ltinyobjloader -ltbb -lz -o "$bin"
 fi
-# Seed corpus: every example scene plus the regression inputs.
-cp -n scenes/*.cfg scenes/degrees/*.cfg "$out/corpus/" 2>/dev/null || true
+# Seed corpus: every example scene, the fuzz seeds (tests/fuzz/corpus: mesh statements on the
+# include tree's tri.obj) and the regression inputs.
+cp -n scenes/*.cfg scenes/degrees/*.cfg tests/fuzz/corpus/*.cfg "$out/corpus/" 2>/dev/null || true
 for f in tests/fuzz/regressions/*; do [[ -f $f ]] && cp -n "$f" "$out/corpus/"; done
 echo "fuzz.sh: running for ${seconds}s (corpus $(ls "$out/corpus" | wc -l) files)"
 exec "$bin" "$out/corpus" -dict=tests/fuzz/scene.dict -max_total_time="$seconds" \

@@ -13,7 +13,7 @@ inline void write_file(const std::filesystem::path& p, const std::string& text) 
 }
 
 // A valid fragment, a chain, a self-cycle, a mutual cycle, a file with an error, a file in a
-// sub-folder going back up, an empty file, a file including itself after two others.
+// sub-folder going back up, an empty file, a file including itself after two others, an OBJ.
 inline void make_include_tree(const std::filesystem::path& dir) {
     std::filesystem::create_directories(dir / "sub");
     write_file(dir / "a.cfg", "material m color=1,0,0 refl=0.5 trans=0.5 ior=1.5\nlight point pos=0,5,0\n");
@@ -25,6 +25,8 @@ inline void make_include_tree(const std::filesystem::path& dir) {
     write_file(dir / "empty.cfg", "");
     write_file(dir / "sub" / "up.cfg", "include ../a.cfg\ncamera eye=0,0,5 look=0,0,0\n");
     write_file(dir / "twice.cfg", "include empty.cfg\ninclude empty.cfg\ninclude twice.cfg\n");
+    // A tiny OBJ (two triangles, one quad) for `mesh file=tri.obj`.
+    write_file(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0.5\nf 1 2 3\nf 2 4 3\nf 1 2 4 3\n");
 }
 
 }  // namespace streamrt_fuzz
