@@ -589,7 +589,7 @@ class Parser {
                                   text.data() + std::min(text.size(), e + kFolio), MADV_DONTNEED);
                 }
             }
-            chunks.push_back({});
+            chunks.emplace_back();
             chunks.back().begin = b;
             chunks.back().end = e;
             b = e;
