@@ -172,7 +172,13 @@ int run(int argc, char** argv) {
     std::signal(SIGINT, on_sigint);
     std::signal(SIGTERM, on_sigint);
 
+    // The whole process's phases, reported on the summary line: reading, set-up (inside
+    // render_once), rendering and writing.
+    using Clock = std::chrono::steady_clock;
+    const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    auto phase_start = Clock::now();
     Scene scene = load_scene(opt.scene_path, opt.jobs);
+    const double read_seconds = since(phase_start);
     RenderSettings& s = scene.settings;
     if (opt.spp) s.spp = *opt.spp;
     if (opt.width) s.width = *opt.width;
@@ -251,7 +257,9 @@ int run(int argc, char** argv) {
     WriteOptions wo;
     wo.par = &par;
     wo.cancel = &g_cancel;
+    phase_start = Clock::now();
     if (!write_image(s.output, r.image, s.calibration, wo)) throw Interrupted{};
+    const double write_seconds = since(phase_start);
     if (opt.profile) std::printf("%s", profile.text().c_str());
     if (!opt.profile_json.empty()) {
         std::FILE* f = std::fopen(opt.profile_json.c_str(), "w");
@@ -262,10 +270,11 @@ int run(int argc, char** argv) {
     }
     if (!opt.quiet) {
         const double mrays = r.counts.total() / std::max(r.seconds, 1e-9) / 1e6;
-        std::printf("%s: %dx%d, spp %d, degree %d, %s engine, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s\n",
+        std::printf("%s: %dx%d, spp %d, degree %d, %s engine, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s"
+                    " (read %.3f s, set-up %.3f s, render %.3f s, write %.3f s)\n",
                     opt.scene_path.c_str(), s.width, s.height, s.spp, s.degree, engine_name(engine), par.jobs(),
                     r.seconds, static_cast<unsigned long long>(r.counts.total()), mrays, r.setup_seconds,
-                    s.output.c_str());
+                    s.output.c_str(), read_seconds, r.setup_seconds, r.seconds, write_seconds);
     }
     return 0;
 }

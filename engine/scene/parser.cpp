@@ -376,11 +376,21 @@ bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
 bool apply_transform_key(const Statement& st, const Arg& a, glm::dmat4& md) {
     const auto k = a.key;
     glm::dmat4 t;
-    if (same(k, "scale")) t = scale_matrix(st.scale(a));
-    else if (same(k, "rotate_x")) t = rotate_x_matrix(st.number(a));
+    // Scale and translate, the common keys, touch only what they change: the same values as
+    // the full products S Md and T Md of an affine Md (the skipped terms are exact zeros).
+    if (same(k, "scale")) {
+        const glm::dvec3 s = st.scale(a);
+        for (int c = 0; c < 4; ++c) md[c] *= glm::dvec4(s, 1.0);
+        return true;
+    }
+    if (same(k, "translate")) {
+        const glm::dvec3 v = st.vec3(a);
+        for (int c = 0; c < 4; ++c) md[c] += glm::dvec4(v * md[c][3], 0.0);
+        return true;
+    }
+    if (same(k, "rotate_x")) t = rotate_x_matrix(st.number(a));
     else if (same(k, "rotate_y")) t = rotate_y_matrix(st.number(a));
     else if (same(k, "rotate_z")) t = rotate_z_matrix(st.number(a));
-    else if (same(k, "translate")) t = translate_matrix(st.vec3(a));
     else return false;
     md = t * md;
     return true;
