@@ -47,7 +47,9 @@ inline mask_t<V> finite(const V& a) {
 }
 
 /// Safeguarded Newton/bisection on [a, b] where fn(a) has sign `neg_a` (true: negative) and
-/// fn(b) the other sign. fn(x, f, df) evaluates the function and its derivative. Newton steps
+/// fn(b) the other sign, for the lanes in `active` (the others are frozen from the start: a
+/// lane without a bracket would otherwise bisect towards an end for all `iters` steps and hold
+/// its whole packet back). fn(x, f, df) evaluates the function and its derivative. Newton steps
 /// are taken when they stay in the (shrinking) bracket and at least halve the previous step,
 /// otherwise the bracket is bisected. Returns the evaluated point with the smallest |f|.
 ///
@@ -56,14 +58,14 @@ inline mask_t<V> finite(const V& a) {
 /// merely exiting makes a lane's answer independent of its neighbours: a ray gets the same
 /// bits alone (V = double) as in any batch.
 template <class V, class Fn>
-inline V bracket_solve(V a, V b, const mask_t<V>& neg_a, Fn&& fn, int iters) {
+inline V bracket_solve(V a, V b, const mask_t<V>& neg_a, const mask_t<V>& active, Fn&& fn, int iters) {
     using S = simd::scalar_t<V>;
     const V tol(S(8) * std::numeric_limits<S>::epsilon());
     V x = (a + b) * V(0.5);
     V step_old = simd::abs(b - a);
     V best = x;
     V best_f = inf_v<V>();
-    mask_t<V> live = x == x || x != x;  // every lane
+    mask_t<V> live = active;
     for (int i = 0; i < iters; ++i) {
         V f, df;
         fn(x, f, df);
@@ -209,7 +211,7 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
         fprime(v, fv, dummy);
         const M nu = fu < zero;
         const M change = simd::mask_xor(nu, fv < zero);
-        const V k = bracket_solve(u, v, nu, fprime, kCriticalIters);
+        const V k = bracket_solve(u, v, nu, change, fprime, kCriticalIters);
         return simd::select(change, k, v);
     };
     const V k1 = critical(lo, q1);
@@ -237,7 +239,7 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     }
     valid = valid & found;
     if (!simd::any(valid)) return inf;
-    const V s_hit = bracket_solve(a, bb, neg_a, ffun, kRootIters);
+    const V s_hit = bracket_solve(a, bb, neg_a, valid, ffun, kRootIters);
     const V t = (s_hit + tc) / len;
     const M hit = valid & (t > t_min) & (t < t_max);
     return simd::select(hit, t, inf);
