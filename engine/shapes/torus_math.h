@@ -46,50 +46,65 @@ inline mask_t<V> finite(const V& a) {
     return simd::abs(a) <= V(std::numeric_limits<simd::scalar_t<V>>::max());
 }
 
-/// Safeguarded Newton/bisection on [a, b] where fn(a) has sign `neg_a` (true: negative) and
-/// fn(b) the other sign, for the lanes in `active` (the others are frozen from the start: a
-/// lane without a bracket would otherwise bisect towards an end for all `iters` steps and hold
-/// its whole packet back). fn(x, f, df) evaluates the function and its derivative. Newton steps
-/// are taken when they stay in the (shrinking) bracket and at least halve the previous step,
-/// otherwise the bracket is bisected. Returns the evaluated point with the smallest |f|.
+/// Safeguarded Newton/bisection on N independent brackets [a[j], b[j]] at once, where
+/// fn(a[j]) has sign neg_a[j] (true: negative) and fn(b[j]) the other sign, for the lanes in
+/// active[j]; the others are frozen from the start (a lane without a bracket would otherwise
+/// bisect towards an end for all `iters` steps and hold its whole packet back). fn(x, f, df)
+/// evaluates the function and its derivative. Newton steps are taken when they stay in the
+/// (shrinking) bracket and at least halve the previous step, otherwise the bracket is
+/// bisected. Writes to out[j] the evaluated point with the smallest |f|.
+///
+/// Each step is a chain of dependent operations (evaluate, divide, compare, select), so a
+/// single solve is bound by latency; the N solves share one loop so that their chains overlap.
 ///
 /// A lane stops (is frozen, its values no longer updated) once its step falls to a few ulps;
-/// the loop ends when every lane has stopped or after `iters` steps. Freezing rather than
-/// merely exiting makes a lane's answer independent of its neighbours: a ray gets the same
-/// bits alone (V = double) as in any batch.
-template <class V, class Fn>
-inline V bracket_solve(V a, V b, const mask_t<V>& neg_a, const mask_t<V>& active, Fn&& fn, int iters) {
+/// the loop ends when every lane of every bracket has stopped or after `iters` steps. Freezing
+/// rather than merely exiting makes a lane's answer independent of its neighbours and of the
+/// other brackets: a ray gets the same bits alone (V = double) as in any batch.
+template <int N, class V, class Fn>
+inline void bracket_solve(V (&a)[N], V (&b)[N], const mask_t<V> (&neg_a)[N], const mask_t<V> (&active)[N], Fn&& fn,
+                          int iters, V (&out)[N]) {
     using S = simd::scalar_t<V>;
     const V tol(S(8) * std::numeric_limits<S>::epsilon());
-    V x = (a + b) * V(0.5);
-    V step_old = simd::abs(b - a);
-    V best = x;
-    V best_f = inf_v<V>();
-    mask_t<V> live = active;
-    for (int i = 0; i < iters; ++i) {
-        V f, df;
-        fn(x, f, df);
-        const V af = simd::abs(f);
-        const auto better = live & (af < best_f);
-        best = simd::select(better, x, best);
-        best_f = simd::select(better, af, best_f);
-        // Same sign as at a: the root lies right of x.
-        const auto right = !simd::mask_xor(f < V(0), neg_a);
-        a = simd::select(live & right, x, a);
-        b = simd::select(live & !right, x, b);
-        const V step = f / df;
-        const V xn = x - step;
-        const auto newton_ok = (xn >= a) & (xn <= b) & (simd::abs(step) * V(2) <= step_old);
-        const V xnew = simd::select(newton_ok, xn, (a + b) * V(0.5));
-        const V moved = simd::abs(xnew - x);
-        step_old = simd::select(live, moved, step_old);
-        x = simd::select(live, xnew, x);
-        live = live & (moved > tol * simd::abs(x));  // NaN steps stop too
-        if (!simd::any(live)) break;
+    V x[N], step_old[N], best[N], best_f[N];
+    mask_t<V> live[N];
+    for (int j = 0; j < N; ++j) {
+        x[j] = (a[j] + b[j]) * V(0.5);
+        step_old[j] = simd::abs(b[j] - a[j]);
+        best[j] = x[j];
+        best_f[j] = inf_v<V>();
+        live[j] = active[j];
     }
-    V f, df;
-    fn(x, f, df);
-    return simd::select(simd::abs(f) < best_f, x, best);
+    for (int i = 0; i < iters; ++i) {
+        mask_t<V> any_live = live[0];
+        for (int j = 0; j < N; ++j) {
+            V f, df;
+            fn(x[j], f, df);
+            const V af = simd::abs(f);
+            const auto better = live[j] & (af < best_f[j]);
+            best[j] = simd::select(better, x[j], best[j]);
+            best_f[j] = simd::select(better, af, best_f[j]);
+            // Same sign as at a: the root lies right of x.
+            const auto right = !simd::mask_xor(f < V(0), neg_a[j]);
+            a[j] = simd::select(live[j] & right, x[j], a[j]);
+            b[j] = simd::select(live[j] & !right, x[j], b[j]);
+            const V step = f / df;
+            const V xn = x[j] - step;
+            const auto newton_ok = (xn >= a[j]) & (xn <= b[j]) & (simd::abs(step) * V(2) <= step_old[j]);
+            const V xnew = simd::select(newton_ok, xn, (a[j] + b[j]) * V(0.5));
+            const V moved = simd::abs(xnew - x[j]);
+            step_old[j] = simd::select(live[j], moved, step_old[j]);
+            x[j] = simd::select(live[j], xnew, x[j]);
+            live[j] = live[j] & (moved > tol * simd::abs(x[j]));  // NaN steps stop too
+            any_live = any_live | live[j];
+        }
+        if (!simd::any(any_live)) break;
+    }
+    for (int j = 0; j < N; ++j) {
+        V f, df;
+        fn(x[j], f, df);
+        out[j] = simd::select(simd::abs(f) < best_f[j], x[j], best[j]);
+    }
 }
 
 template <class V>
@@ -205,18 +220,21 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     const V hq = simd::sqrt(simd::max(b * b - A2 * V(1.0 / 6.0), zero));
     const V q1 = simd::min(simd::max(-b - hq, lo), hi);
     const V q2 = simd::min(simd::max(-b + hq, lo), hi);
-    auto critical = [&](const V& u, const V& v) {
+    // The three pieces [lo, q1], [q1, q2], [q2, hi] are solved together (independent chains).
+    V cu[3] = {lo, q1, q2}, cv[3] = {q1, q2, hi}, k[3];
+    M cneg[3], cchange[3];
+    for (int j = 0; j < 3; ++j) {
         V fu, fv, dummy;
-        fprime(u, fu, dummy);
-        fprime(v, fv, dummy);
-        const M nu = fu < zero;
-        const M change = simd::mask_xor(nu, fv < zero);
-        const V k = bracket_solve(u, v, nu, change, fprime, kCriticalIters);
-        return simd::select(change, k, v);
-    };
-    const V k1 = critical(lo, q1);
-    const V k2 = critical(q1, q2);
-    const V k3 = critical(q2, hi);
+        fprime(cu[j], fu, dummy);
+        fprime(cv[j], fv, dummy);
+        cneg[j] = fu < zero;
+        cchange[j] = simd::mask_xor(cneg[j], fv < zero);
+    }
+    const V cend[3] = {cv[0], cv[1], cv[2]};
+    bracket_solve(cu, cv, cneg, cchange, fprime, kCriticalIters, k);
+    const V k1 = simd::select(cchange[0], k[0], cend[0]);
+    const V k2 = simd::select(cchange[1], k[1], cend[1]);
+    const V k3 = simd::select(cchange[2], k[2], cend[2]);
 
     // 5. First monotone piece with a sign change of F, then solve it.
     auto ffun = [&](const V& s, V& f, V& df) { torus_f(p0, D, r2, s, f, df); };
@@ -239,8 +257,10 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     }
     valid = valid & found;
     if (!simd::any(valid)) return inf;
-    const V s_hit = bracket_solve(a, bb, neg_a, valid, ffun, kRootIters);
-    const V t = (s_hit + tc) / len;
+    V ra[1] = {a}, rb[1] = {bb}, s_hit[1];
+    const M rneg[1] = {neg_a}, ractive[1] = {valid};
+    bracket_solve(ra, rb, rneg, ractive, ffun, kRootIters, s_hit);
+    const V t = (s_hit[0] + tc) / len;
     const M hit = valid & (t > t_min) & (t < t_max);
     return simd::select(hit, t, inf);
 }
