@@ -21,6 +21,7 @@
 //   5. take the first piece whose end points have opposite signs of F (evaluated in the
 //      factored, cancellation-free form) and solve it with safeguarded Newton/bisection on the
 //      factored F, which doubles as the final Newton polish.
+#include <algorithm>
 #include <limits>
 
 #include "core/vec3.h"
@@ -37,6 +38,19 @@ using mask_t = decltype(V() < V());
 inline constexpr int kCriticalIters = 20;
 inline constexpr int kRootIters = 28;
 
+/// When a bracket_solve lane stops: a step (any kind) at most `step` times |x|, or a Newton step
+/// at most `newton_step` times |x| (quadratic convergence: the error left is ~ C newton_step^2).
+struct SolveTol {
+    double step, newton_step;
+};
+
+/// The critical points only place the piece ends where F's sign is read, and F is flat there
+/// (an error d in the point moves F by ~F'' d^2 / 2), so 1e-10 relative is ample.
+inline constexpr SolveTol kCriticalTol{1e-10, 1e-7};
+/// The root: a few ulps, or a Newton step below 1e-9 relative (error left ~ C 1e-18).
+template <class S>
+inline constexpr SolveTol kRootTol{8 * double(std::numeric_limits<S>::epsilon()), 1e-9};
+
 template <class V>
 inline V inf_v() { return V(std::numeric_limits<simd::scalar_t<V>>::infinity()); }
 
@@ -52,7 +66,8 @@ inline mask_t<V> finite(const V& a) {
 /// bisect towards an end for all `iters` steps and hold its whole packet back). fn(x, f, df)
 /// evaluates the function and its derivative. Newton steps are taken when they stay in the
 /// (shrinking) bracket and at least halve the previous step, otherwise the bracket is
-/// bisected. Writes to out[j] the evaluated point with the smallest |f|.
+/// bisected. The first point is start[j] (inside the bracket). Writes to out[j] the evaluated
+/// point with the smallest |f|.
 ///
 /// Each step is a chain of dependent operations (evaluate, divide, compare, select), so a
 /// single solve is bound by latency; the N solves share one loop so that their chains overlap.
@@ -62,14 +77,16 @@ inline mask_t<V> finite(const V& a) {
 /// rather than merely exiting makes a lane's answer independent of its neighbours and of the
 /// other brackets: a ray gets the same bits alone (V = double) as in any batch.
 template <int N, class V, class Fn>
-inline void bracket_solve(V (&a)[N], V (&b)[N], const mask_t<V> (&neg_a)[N], const mask_t<V> (&active)[N], Fn&& fn,
-                          int iters, V (&out)[N]) {
+inline void bracket_solve(V (&a)[N], V (&b)[N], const mask_t<V> (&neg_a)[N], const mask_t<V> (&active)[N],
+                          const V (&start)[N], const SolveTol& st, Fn&& fn, int iters, V (&out)[N]) {
+    // Never below a few ulps of the lane type (float lanes).
     using S = simd::scalar_t<V>;
-    const V tol(S(8) * std::numeric_limits<S>::epsilon());
+    const S few_ulps = S(8) * std::numeric_limits<S>::epsilon();
+    const V tol(std::max(S(st.step), few_ulps)), tol_newton(std::max(S(st.newton_step), few_ulps));
     V x[N], step_old[N], best[N], best_f[N];
     mask_t<V> live[N];
     for (int j = 0; j < N; ++j) {
-        x[j] = (a[j] + b[j]) * V(0.5);
+        x[j] = start[j];
         step_old[j] = simd::abs(b[j] - a[j]);
         best[j] = x[j];
         best_f[j] = inf_v<V>();
@@ -78,6 +95,9 @@ inline void bracket_solve(V (&a)[N], V (&b)[N], const mask_t<V> (&neg_a)[N], con
     for (int i = 0; i < iters; ++i) {
         mask_t<V> any_live = live[0];
         for (int j = 0; j < N; ++j) {
+            // Often only one bracket has lanes left: skip the others' division (the divider,
+            // not the chain, is then the bottleneck).
+            if (!simd::any(live[j])) continue;
             V f, df;
             fn(x[j], f, df);
             const V af = simd::abs(f);
@@ -95,7 +115,10 @@ inline void bracket_solve(V (&a)[N], V (&b)[N], const mask_t<V> (&neg_a)[N], con
             const V moved = simd::abs(xnew - x[j]);
             step_old[j] = simd::select(live[j], moved, step_old[j]);
             x[j] = simd::select(live[j], xnew, x[j]);
-            live[j] = live[j] & (moved > tol * simd::abs(x[j]));  // NaN steps stop too
+            const V ax = simd::abs(x[j]);
+            // A Newton step of relative size m leaves an error ~ C m^2: below tol_newton the
+            // next step would be lost in rounding, so stop now. NaN steps stop too.
+            live[j] = live[j] & (moved > tol * ax) & !(newton_ok & (moved <= tol_newton * ax));
             any_live = any_live | live[j];
         }
         if (!simd::any(any_live)) break;
@@ -105,6 +128,19 @@ inline void bracket_solve(V (&a)[N], V (&b)[N], const mask_t<V> (&neg_a)[N], con
         fn(x[j], f, df);
         out[j] = simd::select(simd::abs(f) < best_f[j], x[j], best[j]);
     }
+}
+
+/// First guess in a bracket [u, v] with f(u), f(v) of opposite signs: where the chord crosses
+/// zero (closer to the root than the midpoint when f is nearly linear, as it is once the
+/// bracket is a monotone piece), clamped into the bracket against rounding; the midpoint for
+/// lanes without a bracket.
+template <class V>
+inline V false_position(const V& u, const V& v, const V& fu, const V& fv, const mask_t<V>& bracketed) {
+    const V mid = (u + v) * V(0.5);
+    const V den = simd::select(bracketed, fu - fv, V(1));
+    const V x = u + (v - u) * (fu / den);
+    const V lo = simd::min(u, v), hi = simd::max(u, v);
+    return simd::select(bracketed & (x >= lo) & (x <= hi), x, mid);
 }
 
 template <class V>
@@ -222,6 +258,7 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     const V q2 = simd::min(simd::max(-b + hq, lo), hi);
     // The three pieces [lo, q1], [q1, q2], [q2, hi] are solved together (independent chains).
     V cu[3] = {lo, q1, q2}, cv[3] = {q1, q2, hi}, k[3];
+    V cstart[3];
     M cneg[3], cchange[3];
     for (int j = 0; j < 3; ++j) {
         V fu, fv, dummy;
@@ -229,9 +266,10 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
         fprime(cv[j], fv, dummy);
         cneg[j] = fu < zero;
         cchange[j] = simd::mask_xor(cneg[j], fv < zero);
+        cstart[j] = false_position(cu[j], cv[j], fu, fv, cchange[j]);
     }
     const V cend[3] = {cv[0], cv[1], cv[2]};
-    bracket_solve(cu, cv, cneg, cchange, fprime, kCriticalIters, k);
+    bracket_solve(cu, cv, cneg, cchange, cstart, kCriticalTol, fprime, kCriticalIters, k);
     const V k1 = simd::select(cchange[0], k[0], cend[0]);
     const V k2 = simd::select(cchange[1], k[1], cend[1]);
     const V k3 = simd::select(cchange[2], k[2], cend[2]);
@@ -239,27 +277,31 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     // 5. First monotone piece with a sign change of F, then solve it.
     auto ffun = [&](const V& s, V& f, V& df) { torus_f(p0, D, r2, s, f, df); };
     const V pts[5] = {lo, k1, k2, k3, hi};
+    V fpts[5];
     M neg[5];
     for (int i = 0; i < 5; ++i) {
-        V f, df;
-        ffun(pts[i], f, df);
-        neg[i] = f < zero;
+        V df;
+        ffun(pts[i], fpts[i], df);
+        neg[i] = fpts[i] < zero;
     }
-    V a = zero, bb = zero;
+    V a = zero, bb = zero, fa = zero, fb = zero;
     M neg_a = neg[0];
     M found = neg[0] & !neg[0];  // all false
     for (int i = 3; i >= 0; --i) {
         const M change = simd::mask_xor(neg[i], neg[i + 1]);
         a = simd::select(change, pts[i], a);
         bb = simd::select(change, pts[i + 1], bb);
+        fa = simd::select(change, fpts[i], fa);
+        fb = simd::select(change, fpts[i + 1], fb);
         neg_a = (change & neg[i]) | ((!change) & neg_a);
         found = found | change;
     }
     valid = valid & found;
     if (!simd::any(valid)) return inf;
     V ra[1] = {a}, rb[1] = {bb}, s_hit[1];
+    const V rstart[1] = {false_position(a, bb, fa, fb, valid)};
     const M rneg[1] = {neg_a}, ractive[1] = {valid};
-    bracket_solve(ra, rb, rneg, ractive, ffun, kRootIters, s_hit);
+    bracket_solve(ra, rb, rneg, ractive, rstart, kRootTol<S>, ffun, kRootIters, s_hit);
     const V t = (s_hit[0] + tc) / len;
     const M hit = valid & (t > t_min) & (t < t_max);
     return simd::select(hit, t, inf);
