@@ -21,6 +21,7 @@
 //   5. take the first piece whose end points have opposite signs of F (evaluated in the
 //      factored, cancellation-free form) and solve it with safeguarded Newton/bisection on the
 //      factored F, which doubles as the final Newton polish.
+#include <algorithm>
 #include <limits>
 
 #include "core/vec3.h"
@@ -37,6 +38,19 @@ using mask_t = decltype(V() < V());
 inline constexpr int kCriticalIters = 20;
 inline constexpr int kRootIters = 28;
 
+/// When a bracket_solve lane stops: a step (any kind) at most `step` times |x|, or a Newton step
+/// at most `newton_step` times |x| (quadratic convergence: the error left is ~ C newton_step^2).
+struct SolveTol {
+    double step, newton_step;
+};
+
+/// The critical points only place the piece ends where F's sign is read, and F is flat there
+/// (an error d in the point moves F by ~F'' d^2 / 2), so 1e-10 relative is ample.
+inline constexpr SolveTol kCriticalTol{1e-10, 1e-7};
+/// The root: a few ulps, or a Newton step below 1e-9 relative (error left ~ C 1e-18).
+template <class S>
+inline constexpr SolveTol kRootTol{8 * double(std::numeric_limits<S>::epsilon()), 1e-9};
+
 template <class V>
 inline V inf_v() { return V(std::numeric_limits<simd::scalar_t<V>>::infinity()); }
 
@@ -46,48 +60,87 @@ inline mask_t<V> finite(const V& a) {
     return simd::abs(a) <= V(std::numeric_limits<simd::scalar_t<V>>::max());
 }
 
-/// Safeguarded Newton/bisection on [a, b] where fn(a) has sign `neg_a` (true: negative) and
-/// fn(b) the other sign. fn(x, f, df) evaluates the function and its derivative. Newton steps
-/// are taken when they stay in the (shrinking) bracket and at least halve the previous step,
-/// otherwise the bracket is bisected. Returns the evaluated point with the smallest |f|.
+/// Safeguarded Newton/bisection on N independent brackets [a[j], b[j]] at once, where
+/// fn(a[j]) has sign neg_a[j] (true: negative) and fn(b[j]) the other sign, for the lanes in
+/// active[j]; the others are frozen from the start (a lane without a bracket would otherwise
+/// bisect towards an end for all `iters` steps and hold its whole packet back). fn(x, f, df)
+/// evaluates the function and its derivative. Newton steps are taken when they stay in the
+/// (shrinking) bracket and at least halve the previous step, otherwise the bracket is
+/// bisected. The first point is start[j] (inside the bracket). Writes to out[j] the evaluated
+/// point with the smallest |f|.
+///
+/// Each step is a chain of dependent operations (evaluate, divide, compare, select), so a
+/// single solve is bound by latency; the N solves share one loop so that their chains overlap.
 ///
 /// A lane stops (is frozen, its values no longer updated) once its step falls to a few ulps;
-/// the loop ends when every lane has stopped or after `iters` steps. Freezing rather than
-/// merely exiting makes a lane's answer independent of its neighbours: a ray gets the same
-/// bits alone (V = double) as in any batch.
-template <class V, class Fn>
-inline V bracket_solve(V a, V b, const mask_t<V>& neg_a, Fn&& fn, int iters) {
+/// the loop ends when every lane of every bracket has stopped or after `iters` steps. Freezing
+/// rather than merely exiting makes a lane's answer independent of its neighbours and of the
+/// other brackets: a ray gets the same bits alone (V = double) as in any batch.
+template <int N, class V, class Fn>
+inline void bracket_solve(V (&a)[N], V (&b)[N], const mask_t<V> (&neg_a)[N], const mask_t<V> (&active)[N],
+                          const V (&start)[N], const SolveTol& st, Fn&& fn, int iters, V (&out)[N]) {
+    // Never below a few ulps of the lane type (float lanes).
     using S = simd::scalar_t<V>;
-    const V tol(S(8) * std::numeric_limits<S>::epsilon());
-    V x = (a + b) * V(0.5);
-    V step_old = simd::abs(b - a);
-    V best = x;
-    V best_f = inf_v<V>();
-    mask_t<V> live = x == x || x != x;  // every lane
-    for (int i = 0; i < iters; ++i) {
-        V f, df;
-        fn(x, f, df);
-        const V af = simd::abs(f);
-        const auto better = live & (af < best_f);
-        best = simd::select(better, x, best);
-        best_f = simd::select(better, af, best_f);
-        // Same sign as at a: the root lies right of x.
-        const auto right = !simd::mask_xor(f < V(0), neg_a);
-        a = simd::select(live & right, x, a);
-        b = simd::select(live & !right, x, b);
-        const V step = f / df;
-        const V xn = x - step;
-        const auto newton_ok = (xn >= a) & (xn <= b) & (simd::abs(step) * V(2) <= step_old);
-        const V xnew = simd::select(newton_ok, xn, (a + b) * V(0.5));
-        const V moved = simd::abs(xnew - x);
-        step_old = simd::select(live, moved, step_old);
-        x = simd::select(live, xnew, x);
-        live = live & (moved > tol * simd::abs(x));  // NaN steps stop too
-        if (!simd::any(live)) break;
+    const S few_ulps = S(8) * std::numeric_limits<S>::epsilon();
+    const V tol(std::max(S(st.step), few_ulps)), tol_newton(std::max(S(st.newton_step), few_ulps));
+    V x[N], step_old[N], best[N], best_f[N];
+    mask_t<V> live[N];
+    for (int j = 0; j < N; ++j) {
+        x[j] = start[j];
+        step_old[j] = simd::abs(b[j] - a[j]);
+        best[j] = x[j];
+        best_f[j] = inf_v<V>();
+        live[j] = active[j];
     }
-    V f, df;
-    fn(x, f, df);
-    return simd::select(simd::abs(f) < best_f, x, best);
+    for (int i = 0; i < iters; ++i) {
+        mask_t<V> any_live = live[0];
+        for (int j = 0; j < N; ++j) {
+            // Often only one bracket has lanes left: skip the others' division (the divider,
+            // not the chain, is then the bottleneck).
+            if (!simd::any(live[j])) continue;
+            V f, df;
+            fn(x[j], f, df);
+            const V af = simd::abs(f);
+            const auto better = live[j] & (af < best_f[j]);
+            best[j] = simd::select(better, x[j], best[j]);
+            best_f[j] = simd::select(better, af, best_f[j]);
+            // Same sign as at a: the root lies right of x.
+            const auto right = !simd::mask_xor(f < V(0), neg_a[j]);
+            a[j] = simd::select(live[j] & right, x[j], a[j]);
+            b[j] = simd::select(live[j] & !right, x[j], b[j]);
+            const V step = f / df;
+            const V xn = x[j] - step;
+            const auto newton_ok = (xn >= a[j]) & (xn <= b[j]) & (simd::abs(step) * V(2) <= step_old[j]);
+            const V xnew = simd::select(newton_ok, xn, (a[j] + b[j]) * V(0.5));
+            const V moved = simd::abs(xnew - x[j]);
+            step_old[j] = simd::select(live[j], moved, step_old[j]);
+            x[j] = simd::select(live[j], xnew, x[j]);
+            const V ax = simd::abs(x[j]);
+            // A Newton step of relative size m leaves an error ~ C m^2: below tol_newton the
+            // next step would be lost in rounding, so stop now. NaN steps stop too.
+            live[j] = live[j] & (moved > tol * ax) & !(newton_ok & (moved <= tol_newton * ax));
+            any_live = any_live | live[j];
+        }
+        if (!simd::any(any_live)) break;
+    }
+    for (int j = 0; j < N; ++j) {
+        V f, df;
+        fn(x[j], f, df);
+        out[j] = simd::select(simd::abs(f) < best_f[j], x[j], best[j]);
+    }
+}
+
+/// First guess in a bracket [u, v] with f(u), f(v) of opposite signs: where the chord crosses
+/// zero (closer to the root than the midpoint when f is nearly linear, as it is once the
+/// bracket is a monotone piece), clamped into the bracket against rounding; the midpoint for
+/// lanes without a bracket.
+template <class V>
+inline V false_position(const V& u, const V& v, const V& fu, const V& fv, const mask_t<V>& bracketed) {
+    const V mid = (u + v) * V(0.5);
+    const V den = simd::select(bracketed, fu - fv, V(1));
+    const V x = u + (v - u) * (fu / den);
+    const V lo = simd::min(u, v), hi = simd::max(u, v);
+    return simd::select(bracketed & (x >= lo) & (x <= hi), x, mid);
 }
 
 template <class V>
@@ -203,42 +256,53 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     const V hq = simd::sqrt(simd::max(b * b - A2 * V(1.0 / 6.0), zero));
     const V q1 = simd::min(simd::max(-b - hq, lo), hi);
     const V q2 = simd::min(simd::max(-b + hq, lo), hi);
-    auto critical = [&](const V& u, const V& v) {
+    // The three pieces [lo, q1], [q1, q2], [q2, hi] are solved together (independent chains).
+    V cu[3] = {lo, q1, q2}, cv[3] = {q1, q2, hi}, k[3];
+    V cstart[3];
+    M cneg[3], cchange[3];
+    for (int j = 0; j < 3; ++j) {
         V fu, fv, dummy;
-        fprime(u, fu, dummy);
-        fprime(v, fv, dummy);
-        const M nu = fu < zero;
-        const M change = simd::mask_xor(nu, fv < zero);
-        const V k = bracket_solve(u, v, nu, fprime, kCriticalIters);
-        return simd::select(change, k, v);
-    };
-    const V k1 = critical(lo, q1);
-    const V k2 = critical(q1, q2);
-    const V k3 = critical(q2, hi);
+        fprime(cu[j], fu, dummy);
+        fprime(cv[j], fv, dummy);
+        cneg[j] = fu < zero;
+        cchange[j] = simd::mask_xor(cneg[j], fv < zero);
+        cstart[j] = false_position(cu[j], cv[j], fu, fv, cchange[j]);
+    }
+    const V cend[3] = {cv[0], cv[1], cv[2]};
+    bracket_solve(cu, cv, cneg, cchange, cstart, kCriticalTol, fprime, kCriticalIters, k);
+    const V k1 = simd::select(cchange[0], k[0], cend[0]);
+    const V k2 = simd::select(cchange[1], k[1], cend[1]);
+    const V k3 = simd::select(cchange[2], k[2], cend[2]);
 
     // 5. First monotone piece with a sign change of F, then solve it.
     auto ffun = [&](const V& s, V& f, V& df) { torus_f(p0, D, r2, s, f, df); };
     const V pts[5] = {lo, k1, k2, k3, hi};
+    V fpts[5];
     M neg[5];
     for (int i = 0; i < 5; ++i) {
-        V f, df;
-        ffun(pts[i], f, df);
-        neg[i] = f < zero;
+        V df;
+        ffun(pts[i], fpts[i], df);
+        neg[i] = fpts[i] < zero;
     }
-    V a = zero, bb = zero;
+    V a = zero, bb = zero, fa = zero, fb = zero;
     M neg_a = neg[0];
     M found = neg[0] & !neg[0];  // all false
     for (int i = 3; i >= 0; --i) {
         const M change = simd::mask_xor(neg[i], neg[i + 1]);
         a = simd::select(change, pts[i], a);
         bb = simd::select(change, pts[i + 1], bb);
+        fa = simd::select(change, fpts[i], fa);
+        fb = simd::select(change, fpts[i + 1], fb);
         neg_a = (change & neg[i]) | ((!change) & neg_a);
         found = found | change;
     }
     valid = valid & found;
     if (!simd::any(valid)) return inf;
-    const V s_hit = bracket_solve(a, bb, neg_a, ffun, kRootIters);
-    const V t = (s_hit + tc) / len;
+    V ra[1] = {a}, rb[1] = {bb}, s_hit[1];
+    const V rstart[1] = {false_position(a, bb, fa, fb, valid)};
+    const M rneg[1] = {neg_a}, ractive[1] = {valid};
+    bracket_solve(ra, rb, rneg, ractive, rstart, kRootTol<S>, ffun, kRootIters, s_hit);
+    const V t = (s_hit[0] + tc) / len;
     const M hit = valid & (t > t_min) & (t < t_max);
     return simd::select(hit, t, inf);
 }
