@@ -21,6 +21,7 @@ except ImportError:  # pragma: no cover - the pure-Python path is slower but equ
     np = None
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PHASES_RE = re.compile(r"\(read ([0-9.]+) s, set-up ([0-9.]+) s, render ([0-9.]+) s, write ([0-9.]+) s\)")
 SUMMARY_RE = re.compile(r": (\d+)x(\d+), spp (\d+), degree (\d+), (\w+) engine, -j(\d+): ([0-9.]+) s, (\d+) rays")
 
 
@@ -61,6 +62,10 @@ def run_streamrt(exe, scene, out_pfm, engine="stream", jobs=1, spp=None, width=N
     r = {"seconds": float(m.group(7)), "rays": int(m.group(8)), "wall": wall,
          "peak_rss_mib": ru.ru_maxrss / 1024.0, "width": int(m.group(1)), "height": int(m.group(2)),
          "spp": int(m.group(3))}
+    phases = PHASES_RE.search(text)  # the whole process's phases (binaries before they were reported lack them)
+    if phases:
+        r.update(read=float(phases.group(1)), setup=float(phases.group(2)), render=float(phases.group(3)),
+                 write=float(phases.group(4)))
     if profile_json:
         with open(profile_json) as f:
             prof = json.load(f)

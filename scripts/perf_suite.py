@@ -17,6 +17,12 @@ Groups (all by default):
               engines, -j1 and -j2, plus one --profile of the stream engine per scene
   resolution  whitted at 320x180 .. 1920x1080, both engines, -j2, 1 spp
   objects     N spheres (N = 1 .. 1e6), stream engine (recursive to 1e5), -j2, 1 spp, 1280x720
+  endtoend    the whole process as a user runs it (not in the default set): 1e6 spheres + plane
+              at 1280x720, 1 spp, -j2, to PNG; whitted at 2560x1440, 1 spp, -j2, to PNG and PPM.
+              Medians of max(--runs, 5) runs of process wall time, its phases (read, set-up,
+              render, write, from the summary line) and peak RSS, into
+              results_endtoend.{json,md}; --before DIR also runs DIR/engine/streamrt (an older
+              build) alternately with this one, for a before/after measured in one run.
 --quick runs a ~2 minute subset (one run after the warm-up, fewer cases).
 Times are streamrt's own render clock (scene parsing, hierarchy build and image writing
 excluded); "wall" is the whole process. Peak memory is the process's maximum RSS (wait4).
@@ -178,6 +184,54 @@ def write_outputs(results, meta, out_dir):
         f.write("\n".join(lines) + "\n")
 
 
+ENDTOEND_PHASES = ("read", "setup", "render", "write")
+
+
+def endtoend(exe, before_exe, args, gen_dir, out_dir):
+    """The endtoend group: whole-process wall time, phases and peak RSS per case, for this
+    build and optionally an older one run alternately (so both see the same machine)."""
+    spheres = pc.sphere_scene(1000000, os.path.join(gen_dir, "spheres_1000000.cfg"))
+    whitted = os.path.join(pc.ROOT, "scenes", "whitted.cfg")
+    cases = [("1e6 spheres + plane", spheres, 1280, 720, ".png"),
+             ("whitted 2560x1440", whitted, 2560, 1440, ".png"),
+             ("whitted 2560x1440", whitted, 2560, 1440, ".ppm")]
+    builds = [("after", exe)] + ([("before", before_exe)] if before_exe else [])
+    runs = max(args.runs, 5)
+    rows = []
+    for name, path, w, h, ext in cases:
+        samples = {b: [] for b, _ in builds}
+        out = os.path.join(out_dir, "endtoend" + ext)
+        for _ in range(runs):
+            for b, e in builds:
+                samples[b].append(pc.run_streamrt(e, path, out, jobs=2, spp=1, width=w, height=h))
+        for b, _ in builds:
+            rs = samples[b]
+            row = dict(case=name, output=ext, build=b, runs=runs, wall=pc.median([r["wall"] for r in rs]),
+                       peak_rss_mib=pc.median([r["peak_rss_mib"] for r in rs]))
+            for k in ENDTOEND_PHASES:
+                if all(k in r for r in rs):
+                    row[k] = pc.median([r[k] for r in rs])
+            if "render" not in row:
+                row["render"] = pc.median([r["seconds"] for r in rs])
+            row["wall_over_render"] = row["wall"] / row["render"]
+            rows.append(row)
+            print("%-20s %s %-6s wall %.3f s, render %.3f s, wall/render %.2f, peak %.0f MiB" % (
+                name, ext, b, row["wall"], row["render"], row["wall_over_render"], row["peak_rss_mib"]), flush=True)
+        if os.path.exists(out):
+            os.remove(out)
+    with open(os.path.join(out_dir, "results_endtoend.json"), "w") as f:
+        json.dump({"meta": pc.machine_info(), "rows": rows}, f, indent=1)
+    lines = ["| case | output | build | wall s | read s | set-up s | render s | write s | wall / render | peak MiB |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            r["case"], r["output"], r["build"], fmt(r["wall"]), fmt(r.get("read")), fmt(r.get("setup")),
+            fmt(r["render"]), fmt(r.get("write")), fmt(r["wall_over_render"], 2), fmt(r["peak_rss_mib"], 0)))
+    with open(os.path.join(out_dir, "results_endtoend.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="a ~2 minute smoke run")
@@ -186,6 +240,7 @@ def main(argv=None):
     ap.add_argument("--warmup", type=int, default=1, help="untimed runs before (default 1)")
     ap.add_argument("--groups", default="matrix,headline,resolution,objects")
     ap.add_argument("--out", help="output folder (default BUILD/perf, quick: BUILD/perf-quick)")
+    ap.add_argument("--before", help="endtoend group: an older build folder to compare with, run alternately")
     args = ap.parse_args(argv)
     args.groups = args.groups.split(",")
     args.runs = args.runs or (1 if args.quick else 3)
@@ -195,6 +250,11 @@ def main(argv=None):
     gen_dir = os.path.join(args.build, "perf", "scenes")
     tmp = os.path.join(out_dir, "images")
     os.makedirs(tmp, exist_ok=True)
+    if "endtoend" in args.groups:
+        endtoend(exe, pc.binary(args.before) if args.before else None, args, gen_dir, out_dir)
+        args.groups = [g for g in args.groups if g != "endtoend"]
+        if not args.groups:
+            return 0
     cases = build_cases(args, gen_dir)
     meta = pc.machine_info()
     meta.update(runs=args.runs, warmup=args.warmup, command=" ".join(["scripts/perf_suite.py"] + (argv or sys.argv[1:])),

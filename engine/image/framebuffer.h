@@ -4,28 +4,9 @@
 #include <memory>
 #include <vector>
 
-namespace streamrt {
+#include "core/default_init.h"
 
-/// std::allocator whose value-less construct() leaves the float uninitialised, so that a
-/// framebuffer every tile overwrites is not zero-filled first (12 GiB at 32768x32768).
-template <class T>
-struct DefaultInitAllocator : std::allocator<T> {
-    template <class U>
-    struct rebind {
-        using other = DefaultInitAllocator<U>;
-    };
-    DefaultInitAllocator() = default;
-    template <class U>
-    DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
-    template <class U>
-    void construct(U* p) noexcept {
-        ::new (static_cast<void*>(p)) U;
-    }
-    template <class U, class... Args>
-    void construct(U* p, Args&&... args) {
-        ::new (static_cast<void*>(p)) U(static_cast<Args&&>(args)...);
-    }
-};
+namespace streamrt {
 
 struct Framebuffer {
     int width = 0, height = 0;

@@ -2,6 +2,7 @@
 // One object as the stream engine's kernels and its shade stage read it. Raw data only, so
 // the per-ISA kernel files touch no container code (see kernels/intersect_kernel.h on why).
 #include <cstdint>
+#include <type_traits>
 
 #include "mesh/mesh_view.h"
 
@@ -14,8 +15,9 @@ struct ObjectXf {
     float m[12];  ///< row-major 3x4
     float param;
     std::int32_t id;
-    const MeshView* mesh = nullptr;  ///< ShapeKind::Mesh only
+    const MeshView* mesh;  ///< ShapeKind::Mesh only (null otherwise); no default, so records can be made unwritten
 };
+static_assert(std::is_trivially_default_constructible_v<ObjectXf>);
 
 /// An object's world-space bounding box, padded outwards; the flat kernels skip an object
 /// for a whole packet when no ray of it meets the box before its current closest hit.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "accel/scene_bvh.h"
+#include "core/default_init.h"
 #include "kernels/accel_kernel_table.h"
 #include "kernels/kernel_table.h"
 #include "stream/ray_stream.h"
@@ -34,7 +35,7 @@ class StreamAccel {
     void any(const KernelTable& kt, RayView rays) const;
 
     /// Every object, bounded ones in leaf order then the unbounded ones; ids index it.
-    const std::vector<KernelObject>& objects() const { return objects_; }
+    const FillLaterVec<KernelObject>& objects() const { return objects_; }
     /// The scene index of the object with id `id`.
     std::uint32_t scene_index(std::int32_t id) const { return order_[std::size_t(id)]; }
     const std::vector<std::uint32_t>& scene_order() const { return order_; }
@@ -44,7 +45,7 @@ class StreamAccel {
 
   private:
     std::unique_ptr<accel::SceneBvh> bvh_;
-    std::vector<KernelObject> objects_;                 ///< by id: leaf order, then unbounded
+    FillLaterVec<KernelObject> objects_;                ///< by id: leaf order, then unbounded
     std::vector<std::uint32_t> order_;                  ///< id -> scene index
     std::vector<ObjectXf> unbounded_[kShapeKindCount];  ///< per kind, outside the hierarchy
     accel::Traversal primary_, secondary_, shadow_;

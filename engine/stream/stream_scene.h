@@ -32,7 +32,7 @@ struct StreamScene {
     /// stage writes): the hierarchy's leaf order when there is one, scene order otherwise.
     const KernelObject* objects = nullptr;
     std::size_t object_count = 0;
-    std::vector<SurfaceRecord> surfaces;      ///< by id: colour and material index
+    FillLaterVec<SurfaceRecord> surfaces;     ///< by id: colour and material index
     std::vector<MaterialT<float>> materials;  ///< by scene material index
     std::vector<LightT<float>> lights;
     /// Without a hierarchy: per shape kind (indexed by ShapeKind), the objects of that kind;
