@@ -1,6 +1,10 @@
 // The streamrt command end to end (the binary is STREAMRT_BINARY): exit codes, one-line
 // errors, --check, output-path checks before rendering, limits, and Ctrl-C.
 #include <doctest/doctest.h>
+
+#include "image/image_io.h"
+#include "render/render.h"
+#include "scene/parser.h"
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -57,7 +61,7 @@ struct Run {
 };
 
 /// Runs streamrt with `args` (already shell-quoted), capturing stdout and stderr.
-Run streamrt(const std::string& args) {
+Run run_streamrt(const std::string& args) {
     static int counter = 0;
     const fs::path base = fs::temp_directory_path() /
                           ("streamrt_cli_io_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
@@ -94,23 +98,23 @@ const char* kSmallScene =
 TEST_CASE("cli: --check validates a scene without rendering") {
     Dir d;
     const fs::path scene = d.write("s.cfg", kSmallScene);
-    const Run ok = streamrt("--check " + q(scene) + " -o " + q(d.path / "x.png"));
+    const Run ok = run_streamrt("--check " + q(scene) + " -o " + q(d.path / "x.png"));
     CHECK(ok.code == 0);
     CHECK(ok.out.find("ok (1 objects, 1 lights, 32x24") != std::string::npos);
     CHECK(!fs::exists(d.path / "x.png"));
     CHECK(d.files().size() == 1);  // no probe file left behind
 
     const fs::path bad = d.write("bad.cfg", "image width=32\nsphere radius=2\n");
-    const Run r = streamrt("--check " + q(bad));
+    const Run r = run_streamrt("--check " + q(bad));
     CHECK(r.code == 2);
     check_one_line_error(r, bad.string() + ":2:8: unknown key 'radius' for 'sphere' (expected one of:");
 
-    const Run missing = streamrt("--check " + q(d.path / "nope.cfg"));
+    const Run missing = run_streamrt("--check " + q(d.path / "nope.cfg"));
     CHECK(missing.code == 2);
     check_one_line_error(missing, "nope.cfg: cannot open scene file");
 
     for (const auto& name : {"whitted.cfg", "shapes.cfg", "cornell.cfg", "random_spheres.cfg"}) {
-        const Run s = streamrt("--check -q " + q(fs::path(STREAMRT_SOURCE_DIR) / "scenes" / name) + " -o " +
+        const Run s = run_streamrt("--check -q " + q(fs::path(STREAMRT_SOURCE_DIR) / "scenes" / name) + " -o " +
                                q(d.path / "o.png"));
         INFO(name, ": ", s.err);
         CHECK(s.code == 0);
@@ -126,12 +130,12 @@ TEST_CASE("cli: bad command lines are one-line errors with exit status 2") {
         {"--engine gpu", "--engine"},      {"-j 0", "--jobs"},           {"--no-such-option", "no-such-option"},
     };
     for (const auto& [args, needle] : cases) {
-        const Run r = streamrt("--check " + q(scene) + " " + args);
+        const Run r = run_streamrt("--check " + q(scene) + " " + args);
         INFO(args);
         CHECK(r.code == 2);
         check_one_line_error(r, needle);
     }
-    const Run none = streamrt("");
+    const Run none = run_streamrt("");
     CHECK(none.code == 2);
     check_one_line_error(none, "scene is required");
 }
@@ -146,7 +150,7 @@ TEST_CASE("cli: absurd scene values are refused with their location") {
     };
     for (const auto& [text, needle] : cases) {
         const fs::path scene = d.write("s.cfg", text);
-        const Run r = streamrt("--check " + q(scene));
+        const Run r = run_streamrt("--check " + q(scene));
         INFO(text);
         CHECK(r.code == 2);
         check_one_line_error(r, scene.string() + needle);
@@ -159,17 +163,17 @@ TEST_CASE("cli: a render that cannot fit in memory is refused before it starts")
     const fs::path scene = d.write("deep.cfg",
                                    "image width=64 height=64 depth=256 degree=5\n"
                                    "material glass refl=0.5 trans=0.5 ior=1.5\nsphere material=glass\n");
-    const Run r = streamrt(q(scene) + " -o " + q(d.path / "deep.png"));
+    const Run r = run_streamrt(q(scene) + " -o " + q(d.path / "deep.png"));
     CHECK(r.code == 2);
     check_one_line_error(r, "would need about");
     CHECK(r.err.find("2^256") != std::string::npos);
     CHECK(r.err.find("but this machine has") != std::string::npos);
     CHECK(!fs::exists(d.path / "deep.png"));
     // The same scene is fine for the recursive engine (its memory does not grow with 2^depth)...
-    const Run rec = streamrt("--check --engine recursive " + q(scene) + " -o " + q(d.path / "deep.png"));
+    const Run rec = run_streamrt("--check --engine recursive " + q(scene) + " -o " + q(d.path / "deep.png"));
     CHECK(rec.code == 0);
     // ...and for the stream engine at a sane depth.
-    const Run shallow = streamrt("--check --depth 5 " + q(scene) + " -o " + q(d.path / "deep.png"));
+    const Run shallow = run_streamrt("--check --depth 5 " + q(scene) + " -o " + q(d.path / "deep.png"));
     CHECK(shallow.code == 0);
 }
 
@@ -178,7 +182,7 @@ TEST_CASE("cli: output path mistakes are caught before rendering, nothing is cre
     const fs::path scene = d.write("s.cfg", kSmallScene);
     SUBCASE("missing folder") {
         const fs::path out = d.path / "no" / "such" / "x.png";
-        const Run r = streamrt(q(scene) + " -o " + q(out));
+        const Run r = run_streamrt(q(scene) + " -o " + q(out));
         CHECK(r.code == 2);
         check_one_line_error(r, "output folder '" + (d.path / "no" / "such").string() + "' does not exist");
         CHECK(!fs::exists(d.path / "no"));
@@ -191,26 +195,26 @@ TEST_CASE("cli: output path mistakes are caught before rendering, nothing is cre
             fs::create_directories(ro);
             fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
         }
-        const Run r = streamrt(q(scene) + " -o " + q(ro / "x.png"));
+        const Run r = run_streamrt(q(scene) + " -o " + q(ro / "x.png"));
         CHECK(r.code == 2);
         check_one_line_error(r, "output folder '" + ro.string() + "' is not writable");
         CHECK(!fs::exists(ro / "x.png"));
     }
     SUBCASE("the scene file itself") {
         const fs::path same = d.write("same.ppm", kSmallScene);
-        const Run r = streamrt(q(same) + " -o " + q(same));
+        const Run r = run_streamrt(q(same) + " -o " + q(same));
         CHECK(r.code == 2);
         check_one_line_error(r, "is the scene file itself");
         CHECK(slurp(same) == kSmallScene);
     }
     SUBCASE("a folder") {
         fs::create_directories(d.path / "dir.png");
-        const Run r = streamrt(q(scene) + " -o " + q(d.path / "dir.png"));
+        const Run r = run_streamrt(q(scene) + " -o " + q(d.path / "dir.png"));
         CHECK(r.code == 2);
         check_one_line_error(r, "is a folder");
     }
     SUBCASE("unknown format") {
-        const Run r = streamrt(q(scene) + " -o " + q(d.path / "x.jpg"));
+        const Run r = run_streamrt(q(scene) + " -o " + q(d.path / "x.jpg"));
         CHECK(r.code == 2);
         check_one_line_error(r, "unknown image format");
         CHECK(!fs::exists(d.path / "x.jpg"));
@@ -222,12 +226,35 @@ TEST_CASE("cli: a render writes the image and leaves no temporary file") {
     const fs::path scene = d.write("s.cfg", kSmallScene);
     for (const std::string ext : {".png", ".ppm", ".pfm"}) {
         const fs::path out = d.path / ("img" + ext);
-        const Run r = streamrt("-q -j1 " + q(scene) + " -o " + q(out));
+        const Run r = run_streamrt("-q -j1 " + q(scene) + " -o " + q(out));
         INFO(ext, ": ", r.err);
         CHECK(r.code == 0);
         CHECK(fs::file_size(out) > 100);
     }
     CHECK(d.files().size() == 4);  // the scene and the three images, nothing else
+}
+
+TEST_CASE("cli: the summary line gives the process's phases; releasing the scene's records changes no pixel") {
+    // Enough objects for the hierarchy, so the stream engine renders from its own records
+    // after the command line has released the scene's.
+    Dir d;
+    std::string text = "image width=48 height=32 spp=1 depth=2 degree=5\ncamera eye=0,3,9 look=0,0,0\n"
+                       "light point pos=5,8,5\nplane color=0.8,0.8,0.8 checker=0.2,0.2,0.2\n";
+    for (int i = 0; i < 30; ++i)
+        text += "sphere color=" + std::to_string(0.03 * i) + ",0.5,0.7 refl=0.2 scale=0.3 translate=" +
+                std::to_string(i % 6 - 2.5) + ",0.3," + std::to_string(i / 6 - 2) + "\n";
+    const fs::path scene = d.write("many.cfg", text);
+    const fs::path out = d.path / "many.pfm";
+    const Run r = run_streamrt("-j2 " + q(scene) + " -o " + q(out));
+    INFO(r.out, r.err);
+    REQUIRE(r.code == 0);
+    for (const char* phase : {"(read ", ", set-up ", ", render ", ", write "}) CHECK(r.out.find(phase) != std::string::npos);
+    streamrt::Parallelism par(2);
+    const streamrt::Framebuffer in_process =
+        streamrt::render_scene(streamrt::load_scene(scene.string()), streamrt::EngineKind::Stream, par).image;
+    const streamrt::Framebuffer written = streamrt::read_image(out.string());
+    REQUIRE(written.rgb.size() == in_process.rgb.size());
+    CHECK(std::equal(written.rgb.begin(), written.rgb.end(), in_process.rgb.begin()));
 }
 
 TEST_CASE("cli: the PNG file's bytes are the same at -j1 and -j2") {
@@ -237,7 +264,7 @@ TEST_CASE("cli: the PNG file's bytes are the same at -j1 and -j2") {
     std::string bytes[2];
     for (int j = 1; j <= 2; ++j) {
         const fs::path out = d.path / ("j" + std::to_string(j) + ".png");
-        const Run r = streamrt("-q -j" + std::to_string(j) + " --width 400 --height 300 " + q(scene) + " -o " + q(out));
+        const Run r = run_streamrt("-q -j" + std::to_string(j) + " --width 400 --height 300 " + q(scene) + " -o " + q(out));
         REQUIRE(r.code == 0);
         bytes[j - 1] = slurp(out);
     }
@@ -251,7 +278,7 @@ TEST_CASE("cli: a 32768x32768 render fits a 24 GiB machine: --check says ok") {
     if (memory < 20.0 * (1ull << 30)) return;  // a smaller machine rightly refuses it
     Dir d;
     const fs::path scene = d.write("s.cfg", kSmallScene);
-    const Run r = streamrt("--check -j2 --width 32768 --height 32768 " + q(scene) + " -o " + q(d.path / "big.png"));
+    const Run r = run_streamrt("--check -j2 --width 32768 --height 32768 " + q(scene) + " -o " + q(d.path / "big.png"));
     INFO(r.err);
     CHECK(r.code == 0);
     CHECK(r.out.find("ok") != std::string::npos);

@@ -265,6 +265,26 @@ TEST_CASE("parser: material= first, then direct keys override it") {
     CHECK(s.material_of(s.objects[2]).refl == doctest::Approx(0.3));
 }
 
+TEST_CASE("parser: materials are stored once, colours stay with their objects") {
+    const Scene s = parse(
+        "material gloss color=0,1,0 spec=0.5\n"
+        "sphere color=1,0,0 spec=0.5\n"     // gloss's parameters, its own colour
+        "sphere color=0,0,1 spec=0.5\n"     // the same again, another colour
+        "sphere color=1,0,0 spec=0.25\n"    // another material
+        "cube material=gloss\n");           // gloss: the first material again
+    REQUIRE(s.objects.size() == 4);
+    REQUIRE(s.materials.size() == 2);  // in order of first use
+    CHECK(s.materials[0].spec == 0.5);
+    CHECK(s.materials[1].spec == 0.25);
+    CHECK(s.objects[0].material == 0);
+    CHECK(s.objects[1].material == 0);
+    CHECK(s.objects[2].material == 1);
+    CHECK(s.objects[3].material == 0);
+    CHECK(s.objects[0].color == glm::vec3(1, 0, 0));
+    CHECK(s.objects[1].color == glm::vec3(0, 0, 1));
+    CHECK(s.objects[3].color == glm::vec3(0, 1, 0));
+}
+
 TEST_CASE("parser: transforms apply in written order") {
     const Scene s = parse(
         "sphere scale=2 translate=1,0,0\n"
