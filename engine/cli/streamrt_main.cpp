@@ -146,8 +146,10 @@ int run(int argc, char** argv) {
         ->check(CLI::IsMember({"auto", "bvh", "flat"}));
     app.add_flag("--profile", opt.profile, "Print per-stage throughput of the stream engine");
     app.add_option("--profile-json", opt.profile_json, "Write the profile as JSON to FILE (also: --profile=json FILE)");
-    app.add_option("--shade", opt.shade, "Stream shade stage: simd (sorted by object, default) or scalar (for measurement)")
-        ->check(CLI::IsMember({"simd", "scalar"}));
+    app.add_option("--shade", opt.shade,
+                   "Stream shade stage: simd (default: hits regrouped by object up to 8192 objects, by material and "
+                   "kind above), sorted, gathered or scalar (for measurement)")
+        ->check(CLI::IsMember({"simd", "sorted", "gathered", "scalar"}));
     app.add_flag("--compare", opt.compare, "Render with both engines and report times, speedup and image difference");
     app.add_option("--sampler", opt.sampler, "Pixel sampling: stratified, grid or random")
         ->check(CLI::IsMember({"stratified", "grid", "random"}));
@@ -211,7 +213,10 @@ int run(int argc, char** argv) {
         parse_isa(opt.isa, eo.isa);
         if (!isa_supported(eo.isa)) throw UsageError("--isa " + opt.isa + ": this CPU does not support it");
     }
-    eo.scalar_shade = opt.shade == "scalar";
+    eo.shade = opt.shade == "scalar"     ? ShadeMode::Scalar
+               : opt.shade == "sorted"   ? ShadeMode::Sorted
+               : opt.shade == "gathered" ? ShadeMode::Gathered
+                                         : ShadeMode::Auto;
     StreamProfile profile;
     const bool profiling = opt.profile || !opt.profile_json.empty();
     if (profiling) eo.profile = &profile;

@@ -25,6 +25,18 @@ inline unsigned lane_bits(const xsimd::batch_bool<float, A>& m) {
     return bits;
 }
 
+/// src[index[l]] in lane l. xsimd 8.1's gather takes a generic element-by-element path for
+/// float on AVX-512 and AVX2; these levels get their gather instructions here.
+template <class A>
+inline xsimd::batch<float, A> gather_floats(const float* src, const xsimd::batch<std::int32_t, A>& index) {
+    constexpr std::size_t W = xsimd::batch<float, A>::size;
+    alignas(64) std::int32_t at[W];
+    alignas(64) float out[W];
+    index.store_aligned(at);
+    for (std::size_t l = 0; l < W; ++l) out[l] = src[at[l]];
+    return xsimd::batch<float, A>::load_aligned(out);
+}
+
 template <class A, class T>
 inline std::size_t compress_store(const xsimd::batch<T, A>& v, unsigned bits, T* dst) {
     alignas(64) T tmp[xsimd::batch<T, A>::size];
@@ -36,6 +48,10 @@ inline std::size_t compress_store(const xsimd::batch<T, A>& v, unsigned bits, T*
 }
 
 #if defined(__AVX512F__)
+inline xsimd::batch<float, xsimd::avx512bw> gather_floats(const float* src,
+                                                          const xsimd::batch<std::int32_t, xsimd::avx512bw>& index) {
+    return _mm512_i32gather_ps(index, src, 4);
+}
 inline unsigned lane_bits(const xsimd::batch_bool<float, xsimd::avx512bw>& m) { return unsigned(m.data); }
 inline std::size_t compress_store(const xsimd::batch<float, xsimd::avx512bw>& v, unsigned bits, float* dst) {
     // Compress in a register, then one full store: faster than a compressing store.
@@ -70,6 +86,10 @@ inline __m256i permutation(unsigned bits) {
     return _mm256_and_si256(_mm256_srlv_epi32(packed, shifts), _mm256_set1_epi32(7));
 }
 }  // namespace compress_detail
+inline xsimd::batch<float, xsimd::fma3<xsimd::avx2>> gather_floats(
+    const float* src, const xsimd::batch<std::int32_t, xsimd::fma3<xsimd::avx2>>& index) {
+    return _mm256_i32gather_ps(src, index, 4);
+}
 inline unsigned lane_bits(const xsimd::batch_bool<float, xsimd::fma3<xsimd::avx2>>& m) {
     return unsigned(_mm256_movemask_ps(m));
 }

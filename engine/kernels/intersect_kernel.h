@@ -210,7 +210,8 @@ void mesh_any_culled(RayView rays, const ObjectXf* objs, const ObjectBounds*, st
     mesh_any_hit<Arch>(rays, objs, n_objs);
 }
 
-#define SHADE_VARIANT(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8)>
+#define SHADE_VARIANT(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8), false>
+#define SHADE_GATHERED(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8), true>
 template <class Arch>
 KernelTable make_table(Isa isa, const char* name) {
     return KernelTable{isa,
@@ -233,9 +234,14 @@ KernelTable make_table(Isa isa, const char* name) {
                         SHADE_VARIANT(5), SHADE_VARIANT(6), SHADE_VARIANT(7), SHADE_VARIANT(8), SHADE_VARIANT(9),
                         SHADE_VARIANT(10), SHADE_VARIANT(11), SHADE_VARIANT(12), SHADE_VARIANT(13), SHADE_VARIANT(14),
                         SHADE_VARIANT(15)},
+                       {SHADE_GATHERED(0), SHADE_GATHERED(1), SHADE_GATHERED(2), SHADE_GATHERED(3),
+                        SHADE_GATHERED(4), SHADE_GATHERED(5), SHADE_GATHERED(6), SHADE_GATHERED(7),
+                        SHADE_GATHERED(8), SHADE_GATHERED(9), SHADE_GATHERED(10), SHADE_GATHERED(11),
+                        SHADE_GATHERED(12), SHADE_GATHERED(13), SHADE_GATHERED(14), SHADE_GATHERED(15)},
                        &generate_rays<Arch>};
 }
 
 #undef SHADE_VARIANT
+#undef SHADE_GATHERED
 
 }  // namespace streamrt::STREAMRT_ISA_NAMESPACE

@@ -41,6 +41,7 @@ struct KernelTable {
     ClosestCulledFn closest_culled[kShapeKindCount];
     AnyCulledFn any_culled[kShapeKindCount];
     ShadeFn shade[kShadeVariants];
+    ShadeFn shade_gathered[kShadeVariants];  ///< runs of one material and kind, objects per lane
     GenerateFn generate;
 };
 

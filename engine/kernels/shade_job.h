@@ -34,6 +34,8 @@ struct ShadeJob {
     const std::int32_t* pixel;
     std::size_t begin, end;
     // The object they all hit: its record (Mi, kind, parameter, mesh), colour and material.
+    // Gathered runs (scenes too large to regroup by object) share only the material and the
+    // shape kind: each lane's record is read through ids[] (the last fields, shade_kernel.h).
     const KernelObject* object;
     ColorT<float> color;
     const MaterialT<float>* material;
@@ -52,6 +54,10 @@ struct ShadeJob {
     const std::int32_t* prim = nullptr;
     const float* bu = nullptr;
     const float* bv = nullptr;
+    const std::int32_t* ids = nullptr;         ///< gathered: per ray, its object's id
+    const KernelObject* objects = nullptr;     ///< gathered: every object's record, by id
+    const SurfaceRecord* surfaces = nullptr;   ///< gathered: every object's colour, by id
+    ShapeKind kind = ShapeKind::Sphere;        ///< gathered: the run's shape kind (never Mesh)
 };
 
 /// Camera rays for one chunk. Per ray (arrays padded to whole packets): the pixel's corner

@@ -4,6 +4,7 @@
 // the scene uses. Included only by kernels/isa_*.cpp, inside their own namespace.
 #include <xsimd/xsimd.hpp>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstring>
 #include <limits>
@@ -15,24 +16,32 @@
 
 namespace streamrt::STREAMRT_ISA_NAMESPACE {
 
+/// Mi's twelve entries as batches: the same value in every lane (a run of one object) or
+/// each lane its own object's (a gathered run).
 template <class B>
-inline Vec3T<B> apply_point(const float* m, const Vec3T<B>& p) {
-    return {xsimd::fma(B(m[0]), p.x, xsimd::fma(B(m[1]), p.y, xsimd::fma(B(m[2]), p.z, B(m[3])))),
-            xsimd::fma(B(m[4]), p.x, xsimd::fma(B(m[5]), p.y, xsimd::fma(B(m[6]), p.z, B(m[7])))),
-            xsimd::fma(B(m[8]), p.x, xsimd::fma(B(m[9]), p.y, xsimd::fma(B(m[10]), p.z, B(m[11]))))};
+struct LaneRows {
+    B v[12];
+    const B& operator[](int k) const { return v[k]; }
+};
+
+template <class B, class M>
+inline Vec3T<B> apply_point(const M& m, const Vec3T<B>& p) {
+    return {xsimd::fma(m[0], p.x, xsimd::fma(m[1], p.y, xsimd::fma(m[2], p.z, m[3]))),
+            xsimd::fma(m[4], p.x, xsimd::fma(m[5], p.y, xsimd::fma(m[6], p.z, m[7]))),
+            xsimd::fma(m[8], p.x, xsimd::fma(m[9], p.y, xsimd::fma(m[10], p.z, m[11])))};
 }
-template <class B>
-inline Vec3T<B> apply_vector(const float* m, const Vec3T<B>& v) {
-    return {xsimd::fma(B(m[0]), v.x, xsimd::fma(B(m[1]), v.y, B(m[2]) * v.z)),
-            xsimd::fma(B(m[4]), v.x, xsimd::fma(B(m[5]), v.y, B(m[6]) * v.z)),
-            xsimd::fma(B(m[8]), v.x, xsimd::fma(B(m[9]), v.y, B(m[10]) * v.z))};
+template <class B, class M>
+inline Vec3T<B> apply_vector(const M& m, const Vec3T<B>& v) {
+    return {xsimd::fma(m[0], v.x, xsimd::fma(m[1], v.y, m[2] * v.z)),
+            xsimd::fma(m[4], v.x, xsimd::fma(m[5], v.y, m[6] * v.z)),
+            xsimd::fma(m[8], v.x, xsimd::fma(m[9], v.y, m[10] * v.z))};
 }
 /// Mn n with Mn = (Mi's linear part) transposed, read from Mi's row-major 3x4 rows.
-template <class B>
-inline Vec3T<B> apply_normal(const float* mi, const Vec3T<B>& n) {
-    return normalize(Vec3T<B>{xsimd::fma(B(mi[0]), n.x, xsimd::fma(B(mi[4]), n.y, B(mi[8]) * n.z)),
-                              xsimd::fma(B(mi[1]), n.x, xsimd::fma(B(mi[5]), n.y, B(mi[9]) * n.z)),
-                              xsimd::fma(B(mi[2]), n.x, xsimd::fma(B(mi[6]), n.y, B(mi[10]) * n.z))});
+template <class B, class M>
+inline Vec3T<B> apply_normal(const M& mi, const Vec3T<B>& n) {
+    return normalize(Vec3T<B>{xsimd::fma(mi[0], n.x, xsimd::fma(mi[4], n.y, mi[8] * n.z)),
+                              xsimd::fma(mi[1], n.x, xsimd::fma(mi[5], n.y, mi[9] * n.z)),
+                              xsimd::fma(mi[2], n.x, xsimd::fma(mi[6], n.y, mi[10] * n.z))});
 }
 
 template <class B>
@@ -110,13 +119,21 @@ inline void append(const ShadeJob& job, std::size_t i, const M& active, const Ve
     *r.count = j + n;
 }
 
-template <class Arch, bool kLit, bool kShadows, bool kReflect, bool kRefract>
+/// kGathered: the run shares a material and a shape kind, not an object; each lane's Mi, shape
+/// parameter and colour are gathered from its object's records (the same values a run of that
+/// object would broadcast, so the same arithmetic per lane).
+template <class Arch, bool kLit, bool kShadows, bool kReflect, bool kRefract, bool kGathered>
 void shade_run(const ShadeJob& job) {
     using B = xsimd::batch<float, Arch>;
+    using I = xsimd::batch<std::int32_t, Arch>;
     constexpr std::size_t W = B::size;
     const simd::FlushDenormals ftz;  // see simd/lanes.h
-    const ObjectXf& ob = job.object->xf;
-    const ShapeKind kind = ShapeKind(job.object->kind);
+    const ObjectXf& ob = kGathered ? job.objects[0].xf : job.object->xf;
+    const ShapeKind kind = kGathered ? job.kind : ShapeKind(job.object->kind);
+    // Gather strides, in floats: a KernelObject is 18, a SurfaceRecord 4.
+    static_assert(sizeof(KernelObject) == 18 * sizeof(float) && sizeof(SurfaceRecord) == 4 * sizeof(float));
+    const float* object_floats = reinterpret_cast<const float*>(kGathered ? job.objects : job.object);
+    const float* surface_floats = reinterpret_cast<const float*>(job.surfaces);
     const MaterialT<float>& m = *job.material;
     const bool reflect_here = kReflect && job.spawn && m.refl > 0.f;
     const bool refract_here = kRefract && job.spawn && m.trans > 0.f;
@@ -133,20 +150,36 @@ void shade_run(const ShadeJob& job) {
         const B t = B::load_unaligned(job.t + i);
         const ColorT<B> w{B::load_unaligned(job.wr + i), B::load_unaligned(job.wg + i), B::load_unaligned(job.wb + i)};
 
+        // The object of each lane: broadcast from the run's record, or gathered per lane.
+        LaneRows<B> rows;
+        B param;
+        ColorT<B> color;
+        if constexpr (kGathered) {
+            const I ids = I::load_unaligned(job.ids + i);  // padding lanes hold id 0
+            const I at = ids * I(18), sat = ids * I(4);
+            for (int k = 0; k < 12; ++k) rows.v[k] = gather_floats(object_floats + k, at);
+            param = gather_floats(object_floats + 12, at);
+            color = {gather_floats(surface_floats, sat), gather_floats(surface_floats + 1, sat),
+                     gather_floats(surface_floats + 2, sat)};
+        } else {
+            for (int k = 0; k < 12; ++k) rows.v[k] = B(ob.m[k]);
+            param = B(ob.param);
+            color = splat<B>(job.color);
+        }
         // The canonical hit point gives the normal, brought back with Mn; the world point
         // is the ray's own.
-        const Vec3T<B> pc = apply_point(ob.m, o) + apply_vector(ob.m, d) * t;
+        const Vec3T<B> pc = apply_point(rows, o) + apply_vector(rows, d) * t;
         const Vec3T<B> p = o + d * t;
         const B cone_in = B::load_unaligned(job.cone + i);
         const B cone = cone_in + B(job.spread) * t;
         ColorT<B> base;
         Vec3T<B> n_out;
         if (kLit || m.checker)
-            n_out = apply_normal(ob.m, kind == ShapeKind::Mesh ? mesh_normals<B>(job, i)
-                                                                : canonical_normal(kind, pc, B(ob.param)));
+            n_out = apply_normal(rows, kind == ShapeKind::Mesh && !kGathered ? mesh_normals<B>(job, i)
+                                                                              : canonical_normal(kind, pc, param));
         if (m.checker)
-            base = surface_color(m, job.color, p, n_out, footprint_width(cone_in, B(job.spread), t, dot(d, n_out)));
-        else base = splat<B>(job.color);
+            base = surface_color(m, color, p, n_out, footprint_width(cone_in, B(job.spread), t, dot(d, n_out)));
+        else base = color;
         ColorT<B> local;
         if constexpr (!kLit) {
             local = mul(w, base);

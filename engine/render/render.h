@@ -6,6 +6,7 @@
 #include "image/framebuffer.h"
 #include "kernels/kernel_table.h"
 #include "stream/profile.h"
+#include "stream/shade_mode.h"
 #include "parallel/parallelism.h"
 #include "render/render_stats.h"
 #include "scene/scene.h"
@@ -25,7 +26,7 @@ struct RenderResult {
 struct EngineOptions {
     Isa isa = best_isa();               ///< stream engine: kernel level
     StreamProfile* profile = nullptr;   ///< stream engine: per-stage figures, when wanted
-    bool scalar_shade = false;          ///< stream engine: scalar shade stage (for measurement)
+    ShadeMode shade = ShadeMode::Auto;  ///< stream engine: how the shade stage groups hits
 };
 
 /// An engine with its set-up done (tables, hierarchy), ready to render.

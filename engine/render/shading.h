@@ -101,8 +101,8 @@ inline V odd_share(const V& c, const V& half) {
 /// odd), the closed form of a box filter applied to the 3-D checker. Far away, where a pixel
 /// covers many cells, this converges to the average colour instead of aliasing, and the
 /// float and double engines agree there.
-template <class V, class T>
-inline ColorT<V> surface_color(const MaterialT<T>& m, const ColorT<T>& color, const Vec3T<V>& p, const Vec3T<V>& n,
+template <class V, class T, class C>
+inline ColorT<V> surface_color(const MaterialT<T>& m, const ColorT<C>& color, const Vec3T<V>& p, const Vec3T<V>& n,
                                const V& footprint) {
     using namespace simd;
     if (!m.checker) return splat<V>(color);

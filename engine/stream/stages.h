@@ -14,6 +14,7 @@
 #include "shapes/shapes.h"
 #include "stream/profile.h"
 #include "stream/ray_stream.h"
+#include "stream/shade_mode.h"
 #include "stream/stream_scene.h"
 
 namespace streamrt {
@@ -22,7 +23,7 @@ namespace streamrt {
 /// shade kernel shares one object: its transforms and material are broadcast, not gathered.
 struct SortedHits {
     AlignedVec<float> ox, oy, oz, dx, dy, dz, t, wr, wg, wb, cone, lr, lg, lb, bu, bv;
-    AlignedVec<std::int32_t> pixel, prim;
+    AlignedVec<std::int32_t> pixel, prim, object;  ///< object: gathered runs only
     std::vector<std::uint32_t> run_start;  ///< per object, then one past the end
     void reserve(std::size_t n) {
         // Kernels read a whole packet past the last ray of a run.
@@ -31,6 +32,7 @@ struct SortedHits {
             for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t, &wr, &wg, &wb, &cone, &lr, &lg, &lb, &bu, &bv}) a->resize(cap);
             pixel.resize(cap);
             prim.resize(cap);
+            object.resize(cap);
         }
     }
 };
@@ -78,6 +80,23 @@ struct Workspace {
 /// (docs/performance.md, "Design choices"): sorted SIMD shading is 3.2x faster at 1e3 spheres,
 /// 2x at 4e3, even at 1e4, 8x slower at 1e5.
 inline constexpr std::size_t kSortedShadeMaxObjects = 8192;
+/// Above it, hits are regrouped by (material, shape kind) instead, whose count stays small
+/// when objects share materials, and each lane gathers its own object's record; scenes with
+/// meshes, or with more than this many (material, kind) pairs, shade one ray at a time.
+inline constexpr std::size_t kGatheredShadeMaxKeys = 65536;
+
+/// The shade mode a scene gets: `asked` resolved against what the scene allows.
+inline ShadeMode resolve_shade_mode(const StreamScene& sc, ShadeMode asked) {
+    const bool gather_ok = !sc.has_meshes && sc.materials.size() * kShapeKindCount <= kGatheredShadeMaxKeys;
+    switch (asked) {
+        case ShadeMode::Scalar: return ShadeMode::Scalar;
+        case ShadeMode::Sorted: return ShadeMode::Sorted;
+        case ShadeMode::Gathered: return gather_ok ? ShadeMode::Gathered : ShadeMode::Sorted;
+        case ShadeMode::Auto: break;
+    }
+    if (sc.object_count <= kSortedShadeMaxObjects) return ShadeMode::Sorted;
+    return gather_ok ? ShadeMode::Gathered : ShadeMode::Scalar;
+}
 
 namespace stage_detail {
 
@@ -305,11 +324,16 @@ struct PipelineStages {
     /// sorted order (fixed for a given tile, so the picture does not depend on threads).
     static void shade_sorted(const StreamScene& sc, const KernelTable& kt, const RayStream& rays,
                              const AlignedVec<std::int32_t>& object, int depth, Workspace& ws, float* accum,
-                             RayCounts& counts) {
+                             RayCounts& counts, bool gathered) {
         using namespace stage_detail;
         SortedHits& h = ws.sorted;
-        const std::size_t n_obj = sc.object_count;
-        h.run_start.assign(n_obj + 1, 0);
+        // The run key of a hit: its object, or (gathered) its material and shape kind.
+        const auto key_of = [&](std::int32_t id) -> std::size_t {
+            if (!gathered) return std::size_t(id);
+            return std::size_t(sc.surfaces[std::size_t(id)].material) * kShapeKindCount + sc.objects[id].kind;
+        };
+        const std::size_t n_keys = gathered ? sc.materials.size() * kShapeKindCount : sc.object_count;
+        h.run_start.assign(n_keys + 1, 0);
         std::size_t hits = 0;
         for (std::size_t i = 0; i < rays.count; ++i) {
             const std::int32_t id = object[i];
@@ -317,10 +341,10 @@ struct PipelineStages {
                 add(accum, rays.pixel[i], mul(ColorT<float>{rays.wr[i], rays.wg[i], rays.wb[i]}, sc.background));
                 continue;
             }
-            ++h.run_start[std::size_t(id) + 1];
+            ++h.run_start[key_of(id) + 1];
             ++hits;
         }
-        for (std::size_t k = 1; k <= n_obj; ++k) h.run_start[k] += h.run_start[k - 1];
+        for (std::size_t k = 1; k <= n_keys; ++k) h.run_start[k] += h.run_start[k - 1];
         h.reserve(hits);
         {
             std::vector<std::uint32_t>& next_slot = ws.slot;
@@ -328,7 +352,7 @@ struct PipelineStages {
             for (std::size_t i = 0; i < rays.count; ++i) {
                 const std::int32_t id = object[i];
                 if (id < 0) continue;
-                const std::size_t j = next_slot[std::size_t(id)]++;
+                const std::size_t j = next_slot[key_of(id)]++;
                 h.ox[j] = rays.ox[i];
                 h.oy[j] = rays.oy[i];
                 h.oz[j] = rays.oz[i];
@@ -341,12 +365,15 @@ struct PipelineStages {
                 h.wb[j] = rays.wb[i];
                 h.cone[j] = rays.cone[i];
                 h.pixel[j] = rays.pixel[i];
+                if (gathered) h.object[j] = id;
                 if (sc.has_meshes) {
                     h.prim[j] = ws.mesh_hits.prim[i];
                     h.bu[j] = ws.mesh_hits.u[i];
                     h.bv[j] = ws.mesh_hits.v[i];
                 }
             }
+            // A gathered packet reads a whole batch of ids past the last hit: valid ones.
+            if (gathered) std::fill_n(h.object.begin() + std::ptrdiff_t(hits), simd::kMaxLanes, 0);
         }
         const std::size_t next_before = ws.next.count;
         RayStream& nx = ws.next;
@@ -363,15 +390,26 @@ struct PipelineStages {
         job.prim = h.prim.data();
         job.bu = h.bu.data();
         job.bv = h.bv.data();
-        const ShadeFn fn = kt.shade[(kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0)];
-        for (std::size_t k = 0; k < n_obj; ++k) {
+        const int variant = (kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0);
+        const ShadeFn fn = gathered ? kt.shade_gathered[variant] : kt.shade[variant];
+        if (gathered) {
+            job.ids = h.object.data();
+            job.objects = sc.objects;
+            job.surfaces = sc.surfaces.data();
+        }
+        for (std::size_t k = 0; k < n_keys; ++k) {
             if (h.run_start[k] == h.run_start[k + 1]) continue;
             job.begin = h.run_start[k];
             job.end = h.run_start[k + 1];
-            const SurfaceRecord& sf = sc.surfaces[k];
-            job.object = &sc.objects[k];
-            job.color = {sf.color[0], sf.color[1], sf.color[2]};
-            job.material = &sc.materials[sf.material];
+            if (gathered) {
+                job.material = &sc.materials[k / kShapeKindCount];
+                job.kind = ShapeKind(k % kShapeKindCount);
+            } else {
+                const SurfaceRecord& sf = sc.surfaces[k];
+                job.object = &sc.objects[k];
+                job.color = {sf.color[0], sf.color[1], sf.color[2]};
+                job.material = &sc.materials[sf.material];
+            }
             fn(job);
         }
         for (std::size_t j = 0; j < hits; ++j) add(accum, h.pixel[j], {h.lr[j], h.lg[j], h.lb[j]});
@@ -427,7 +465,7 @@ struct PipelineStages {
 
     static void run_chunk(const StreamScene& sc, const KernelTable& kt, const Tile& tile, int first, int n_pixels,
                           Workspace& ws, float* accum, RayCounts& counts, StreamProfile* profile,
-                          bool scalar_shade) {
+                          ShadeMode shade_mode) {
         const auto fig = [&](Stage s) { return profile ? &profile->stages[int(s)] : nullptr; };
         const std::size_t lights = sc.lights.size();
         {
@@ -448,10 +486,10 @@ struct PipelineStages {
                 // Room for every ray spawning both children and a shadow ray per light.
                 ws.next.reserve(kSecondary ? rays.count * 2 : 0);
                 if constexpr (kShadows) ws.shadows.reserve(rays.count * lights);
-                if (scalar_shade || sc.object_count > kSortedShadeMaxObjects)
+                if (shade_mode == ShadeMode::Scalar)
                     shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, accum, counts);
                 else
-                    shade_sorted(sc, kt, rays, ws.object, depth, ws, accum, counts);
+                    shade_sorted(sc, kt, rays, ws.object, depth, ws, accum, counts, shade_mode == ShadeMode::Gathered);
                 if (profile) {
                     fig(Stage::Shade)->rays_in += rays.count;
                     fig(Stage::Shade)->rays_out += ws.next.count + (kShadows ? ws.shadows.count : 0);

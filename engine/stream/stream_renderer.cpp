@@ -10,8 +10,8 @@
 
 namespace streamrt {
 
-StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, bool scalar_shade)
-    : scene_(scene), kernels_(kernel_table(isa)), tile_fn_(nullptr), scalar_shade_(scalar_shade) {
+StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade)
+    : scene_(scene), kernels_(kernel_table(isa)), tile_fn_(nullptr), shade_mode_(resolve_shade_mode(scene_, shade)) {
     tile_fn_ = select_tile_fn();
 }
 
@@ -26,8 +26,10 @@ std::vector<std::string> StreamRenderer::built_stages() const {
             first = false;
         }
     b.push_back(kernels + "]");
-    const bool sorted = !scalar_shade_ && scene_.object_count <= kSortedShadeMaxObjects;
-    b.push_back(std::string(f.lighting ? "shade(lit" : "shade(flat") + (sorted ? ",simd,sorted)" : ",scalar)"));
+    const char* how = shade_mode_ == ShadeMode::Sorted     ? ",simd,sorted)"
+                      : shade_mode_ == ShadeMode::Gathered ? ",simd,gathered)"
+                                                           : ",scalar)";
+    b.push_back(std::string(f.lighting ? "shade(lit" : "shade(flat") + how);
     if (f.reflect) b.push_back("spawn(reflect)");
     if (f.refract) b.push_back("spawn(refract)");
     if (f.shadows) b.push_back("occlusion(any-hit)");
@@ -49,7 +51,7 @@ void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, f
     for (int first = 0; first < tile_pixels; first += pixels_per_chunk) {
         if (cancel && cancel->cancelled()) return;
         const int n_pixels = std::min(pixels_per_chunk, tile_pixels - first);
-        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile, self.scalar_shade_);
+        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile, self.shade_mode_);
     }
 }
 

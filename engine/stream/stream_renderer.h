@@ -7,15 +7,16 @@
 #include "parallel/parallelism.h"
 #include "render/render_stats.h"
 #include "stream/profile.h"
+#include "stream/shade_mode.h"
 #include "stream/stream_scene.h"
 
 namespace streamrt {
 
 class StreamRenderer {
   public:
-    /// scalar_shade: shade one ray at a time instead of the sorted SIMD shade kernel (kept
-    /// for measurement; see docs/performance.md).
-    StreamRenderer(const Scene& scene, Isa isa, bool scalar_shade = false);
+    /// shade: how the shade stage groups hits for its SIMD kernel (stream/shade_mode.h; Auto
+    /// picks by object count, the others are kept for measurement and tests).
+    StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade = ShadeMode::Auto);
 
     /// Renders the image. With a profile, every stage is timed and counted into it.
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr, StreamProfile* profile = nullptr) const;
@@ -40,7 +41,7 @@ class StreamRenderer {
     StreamScene scene_;
     const KernelTable& kernels_;
     TileFn tile_fn_;
-    bool scalar_shade_;
+    ShadeMode shade_mode_;  ///< resolved for this scene
 };
 
 }  // namespace streamrt

@@ -323,7 +323,7 @@ TEST_CASE("meshes: an OBJ file through the parser, both engines agree, errors ca
         CHECK(d.share_over <= 0.001);
         // The scalar shade stage gives the same picture as the SIMD one.
         EngineOptions opt;
-        opt.scalar_shade = true;
+        opt.shade = ShadeMode::Scalar;
         const ImageDifference ds = compare_images(render_scene(s, EngineKind::Stream, par, nullptr, opt).image, a);
         CHECK(ds.psnr >= 50.0);
     }
