@@ -9,6 +9,7 @@
 
 #include <xsimd/xsimd.hpp>
 
+#include "core/memory_advice.h"
 #include "parallel/parallelism.h"
 
 namespace streamrt::accel {
@@ -314,6 +315,7 @@ Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
     Bvh bvh;
     std::vector<Ref> refs;
     refs.reserve(boxes.size());
+    want_huge_pages(refs.data(), refs.capacity());
     for (std::size_t i = 0; i < boxes.size(); ++i) {
         const Aabb& b = boxes[i];
         if (!b.empty()) refs.push_back({{b.lo[0], b.lo[1], b.lo[2]}, 0.f, {b.hi[0], b.hi[1], b.hi[2]}, std::uint32_t(i)});
@@ -324,6 +326,7 @@ Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
 
     // Worst case 2n - 1 nodes, left unwritten (see BinNode).
     Builder b{refs, std::make_unique_for_overwrite<BinNode[]>(2 * n), {}, options};
+    want_huge_pages(b.nodes.get(), 2 * n);
     Aabb all, call;
     b.bounds_of(0, std::uint32_t(n), all, call);
     const std::uint32_t root = b.alloc();

@@ -8,6 +8,8 @@
 // the shapes of all chunks are parsed in parallel into their final slots of scene.objects.
 #include "scene/parser.h"
 
+#include "core/memory_advice.h"
+
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -473,19 +475,6 @@ class FileText {
     std::size_t size_ = 0;
     std::string owned_;
 };
-
-/// madvise over the whole `block`-aligned blocks inside [begin, end) (none when there are
-/// none; 0: the page size). Used to give parsed text back (MADV_DONTNEED: read again from the
-/// page cache if touched), to ask for huge pages for the object array (MADV_HUGEPAGE: some
-/// hundreds of faults instead of 100 000s) and to fault its slices in from every thread
-/// (MADV_POPULATE_WRITE: zeroing the fresh pages of a million-object array is a large part of
-/// reading a big scene, left to one thread in resize() otherwise).
-void advise_inside(const void* begin, const void* end, int advice, std::uintptr_t block = 0) {
-    if (block == 0) block = std::uintptr_t(::sysconf(_SC_PAGESIZE));
-    const std::uintptr_t b = (std::uintptr_t(begin) + block - 1) & ~(block - 1);
-    const std::uintptr_t e = std::uintptr_t(end) & ~(block - 1);
-    if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, advice);
-}
 
 /// Per-thread lexing scratch: the token and argument lists of the line being read.
 struct Scratch {

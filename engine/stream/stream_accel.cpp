@@ -1,5 +1,6 @@
 #include "stream/stream_accel.h"
 
+#include "core/memory_advice.h"
 #include "mesh/mesh.h"
 #include "parallel/parallelism.h"
 
@@ -39,7 +40,8 @@ StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bv
     bvh_->bvh.prim_index.clear();
     const std::size_t n_bounded = order_.size();
     order_.insert(order_.end(), bvh_->unbounded.begin(), bvh_->unbounded.end());
-    objects_.resize(order_.size());
+    objects_.resize(order_.size());  // unwritten (FillLaterVec): first touched below, in parallel
+    want_huge_pages(objects_.data(), objects_.size());
     parallel_for_index(order_.size(), 4096, [&](std::size_t id) {
         objects_[id] = kernel_object(scene, order_[id], std::int32_t(id), shift);
     });

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "accel/scene_bvh.h"
+#include "core/memory_advice.h"
 #include "parallel/parallelism.h"
 
 namespace streamrt {
@@ -77,6 +78,7 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
     }
     object_count = n;
     surfaces.resize(n);
+    want_huge_pages(surfaces.data(), n);
     parallel_for_index(n, 4096, [&](std::size_t id) {
         const Object& o = scene.objects[accel ? accel->scene_index(std::int32_t(id)) : id];
         surfaces[id] = {{o.color.x, o.color.y, o.color.z}, o.material};
