@@ -180,8 +180,7 @@ ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) 
 Framebuffer RecursiveRenderer::render(Parallelism& par, RenderProgress* progress) const {
     const RenderSettings& s = scene_.settings;
     Framebuffer fb = Framebuffer::uninitialized(s.width, s.height);  // every tile writes its pixels
-    constexpr int kTile = 16;
-    par.for_each_tile(s.width, s.height, kTile, [&](int, Tile tile) {
+    par.for_each_tile(s.width, s.height, kTileSize, [&](int, Tile tile) {
         if (progress && progress->cancelled()) return;
         RayCounts counts;
         for (int y = tile.y0; y < tile.y1; ++y)

@@ -59,9 +59,7 @@ struct Options {
 
 // A missing folder, a read-only folder or the scene file itself are refused before any
 // rendering starts.
-void check_output_path(const std::string& out, const std::string& scene_path) {
-    if (!image_format_for(out))
-        throw UsageError("output '" + out + "': unknown image format (expected .ppm, .png or .pfm)");
+void check_writable_path(const std::string& out, const std::string& scene_path) {
     std::error_code ec;
     const fs::path target = fs::absolute(out, ec);
     if (fs::exists(scene_path, ec) && fs::exists(target, ec) && fs::equivalent(target, scene_path, ec))
@@ -78,6 +76,12 @@ void check_output_path(const std::string& out, const std::string& scene_path) {
         throw UsageError("output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
     ::close(fd);
     ::unlink(probe.c_str());
+}
+
+void check_output_path(const std::string& out, const std::string& scene_path) {
+    if (!image_format_for(out))
+        throw UsageError("output '" + out + "': unknown image format (expected .ppm, .png or .pfm)");
+    check_writable_path(out, scene_path);
 }
 
 std::string format_seconds(double s) {
@@ -192,6 +196,7 @@ int run(int argc, char** argv) {
     if (opt.sampler == "stratified") s.pattern = SamplePattern::Stratified;
     if (!opt.output.empty()) s.output = opt.output;
     check_output_path(s.output, opt.scene_path);
+    if (!opt.profile_json.empty()) check_writable_path(opt.profile_json, opt.scene_path);
     // Refuse, before allocating anything big, a render that cannot fit in this machine.
     const EngineKind engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
     const int jobs = opt.jobs > 0 ? opt.jobs : default_jobs();
@@ -210,6 +215,8 @@ int run(int argc, char** argv) {
     Parallelism par(opt.jobs);
     EngineOptions eo;
     if (!opt.isa.empty()) {
+        if (engine == EngineKind::Recursive && !opt.compare)
+            throw UsageError("--isa chooses the stream engine's kernels; the recursive engine has none (scalar, double)");
         parse_isa(opt.isa, eo.isa);
         if (!isa_supported(eo.isa)) throw UsageError("--isa " + opt.isa + ": this CPU does not support it");
     }
@@ -220,12 +227,21 @@ int run(int argc, char** argv) {
     StreamProfile profile;
     const bool profiling = opt.profile || !opt.profile_json.empty();
     if (profiling) eo.profile = &profile;
-    if (profiling && engine != EngineKind::Stream) throw UsageError("--profile needs the stream engine");
+    if (profiling && engine != EngineKind::Stream && !opt.compare)
+        throw UsageError("--profile needs the stream engine");
+    WriteOptions wo;
+    wo.par = &par;
+    wo.cancel = &g_cancel;
+    // The profile, as text and/or JSON (written like images: whole, or not at all).
+    const auto report_profile = [&] {
+        if (opt.profile) std::printf("%s", profile.text().c_str());
+        if (!opt.profile_json.empty()) write_text_file(opt.profile_json, profile.json());
+    };
 
     const auto render_once = [&](EngineKind which, bool show_progress) {
         RenderProgress progress;
         progress.cancel = &g_cancel;
-        progress.tiles_total = ((s.width + 15) / 16) * ((s.height + 15) / 16);
+        progress.tiles_total = tile_count(s.width, s.height);
         const auto prepared = prepare_render(scene, which, eo);
         // An engine rendering from its own tables no longer needs the scene's object
         // records (128 bytes each; 128 MB at 1e6 objects): give them back before rendering.
@@ -241,9 +257,14 @@ int run(int argc, char** argv) {
     };
 
     if (opt.compare) {
+        // Both engines; the stream engine's picture is the one written, its profile the one
+        // reported.
+        StreamProfile* const stream_profile = eo.profile;
         eo.profile = nullptr;
         const RenderResult base = render_once(EngineKind::Recursive, true);
+        eo.profile = stream_profile;
         const RenderResult str = render_once(EngineKind::Stream, true);
+        if (!write_image(s.output, str.image, s.calibration, wo)) throw Interrupted{};
         const ImageDifference d = compare_images(str.image, base.image);
         std::printf("%s: %dx%d, spp %d, degree %d, -j%d, isa %s\n", opt.scene_path.c_str(), s.width, s.height, s.spp,
                     s.degree, par.jobs(), isa_name(eo.isa));
@@ -255,24 +276,16 @@ int run(int argc, char** argv) {
         std::printf("difference (stream vs recursive, calibrated): max %.5f, rmse %.6f, psnr %.2f dB, "
                     "pixels off by > 1/255: %.4f%%\n",
                     d.max_abs, d.rmse, d.psnr, 100.0 * d.share_over);
+        std::printf("image (stream engine) -> %s\n", s.output.c_str());
+        report_profile();
         return 0;
     }
 
     const RenderResult r = render_once(engine, true);
-    WriteOptions wo;
-    wo.par = &par;
-    wo.cancel = &g_cancel;
     phase_start = Clock::now();
     if (!write_image(s.output, r.image, s.calibration, wo)) throw Interrupted{};
     const double write_seconds = since(phase_start);
-    if (opt.profile) std::printf("%s", profile.text().c_str());
-    if (!opt.profile_json.empty()) {
-        std::FILE* f = std::fopen(opt.profile_json.c_str(), "w");
-        if (!f) throw RenderError(opt.profile_json + ": cannot write the profile");
-        const std::string j = profile.json();
-        std::fwrite(j.data(), 1, j.size(), f);
-        std::fclose(f);
-    }
+    report_profile();
     if (!opt.quiet) {
         const double mrays = r.counts.total() / std::max(r.seconds, 1e-9) / 1e6;
         std::printf("%s: %dx%d, spp %d, degree %d, %s engine, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s"

@@ -323,20 +323,22 @@ bool encode_image(const Framebuffer& fb, ImageFormat format, Calibration how, co
     return true;
 }
 
-bool write_image(const std::string& path, const Framebuffer& fb, Calibration how, const WriteOptions& options) {
-    const auto format = image_format_for(path);
-    if (!format) throw RenderError(path + ": unknown image format (expected .ppm, .png or .pfm)");
-    // Temporary name in the same folder, so the rename is atomic.
+namespace {
+
+/// Through a temporary name in the same folder (so the rename is atomic): fill(sink) writes
+/// the content; whatever stops it (an error, bad_alloc, Ctrl-C: fill returns false) leaves no
+/// temporary behind and no file at `path`.
+template <class Fill>
+bool write_atomically(const std::string& path, Fill&& fill) {
     const fs::path target(path);
     std::string tmp_name = ".";  // appended, not "." + ...: GCC 12 warns falsely on that
     tmp_name += target.filename().string() + ".tmp" + std::to_string(::getpid());
     const fs::path tmp = target.parent_path() / tmp_name;
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0) throw RenderError(path + ": cannot write: " + std::strerror(errno));
-    // Whatever stops the writing (an error, bad_alloc, Ctrl-C) leaves no temporary behind.
     bool written = false;
     try {
-        written = encode_image(fb, *format, how, [fd](std::span<const iovec> p) { write_all(fd, p); }, options);
+        written = fill([fd](std::span<const iovec> p) { write_all(fd, p); });
     } catch (const std::system_error& e) {
         ::close(fd);
         ::unlink(tmp.c_str());
@@ -361,6 +363,22 @@ bool write_image(const std::string& path, const Framebuffer& fb, Calibration how
         throw RenderError(path + ": cannot rename into place: " + std::strerror(err));
     }
     return true;
+}
+
+}  // namespace
+
+bool write_image(const std::string& path, const Framebuffer& fb, Calibration how, const WriteOptions& options) {
+    const auto format = image_format_for(path);
+    if (!format) throw RenderError(path + ": unknown image format (expected .ppm, .png or .pfm)");
+    return write_atomically(path, [&](auto&& sink) { return encode_image(fb, *format, how, sink, options); });
+}
+
+void write_text_file(const std::string& path, std::string_view text) {
+    write_atomically(path, [&](auto&& sink) {
+        const iovec piece{const_cast<char*>(text.data()), text.size()};
+        sink(std::span<const iovec>(&piece, 1));
+        return true;
+    });
 }
 
 namespace {

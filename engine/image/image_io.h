@@ -11,6 +11,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "image/framebuffer.h"
 #include "scene/scene.h"
@@ -60,6 +61,10 @@ bool encode_image(const Framebuffer& fb, ImageFormat format, Calibration how, co
 /// Calibrates and writes; throws RenderError (with the path and the reason) on failure.
 /// Returns false, with no file and no temporary left, when options.cancel was set.
 bool write_image(const std::string& path, const Framebuffer& fb, Calibration how, const WriteOptions& options = {});
+
+/// Writes `text` to `path` the way images are written: a temporary file in the same folder,
+/// renamed into place once complete; on failure, no file and a RenderError naming the path.
+void write_text_file(const std::string& path, std::string_view text);
 
 /// Reads a PPM (P6, 8-bit), PFM or PNG back into [0, 1] floats; throws RenderError.
 Framebuffer read_image(const std::string& path);

@@ -25,6 +25,15 @@
 
 namespace streamrt {
 
+/// Both engines render square tiles of this side (the stream engine's per-tile buffers are
+/// sized by it); the progress display counts them.
+inline constexpr int kTileSize = 16;
+
+/// How many tiles of kTileSize cover a width x height image.
+inline int tile_count(int width, int height) {
+    return ((width + kTileSize - 1) / kTileSize) * ((height + kTileSize - 1) / kTileSize);
+}
+
 /// A rectangle of pixels [x0, x1) x [y0, y1).
 struct Tile {
     int x0, y0, x1, y1;

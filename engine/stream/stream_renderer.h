@@ -25,7 +25,7 @@ class StreamRenderer {
     std::vector<std::string> built_stages() const;
 
     /// Pixels per tile side, and the most primary rays in flight per tile chunk.
-    static constexpr int kTileSize = 16;
+    static constexpr int kTileSize = streamrt::kTileSize;
     static constexpr std::size_t kMaxChunkRays = 4096;
 
   private:

@@ -257,6 +257,40 @@ TEST_CASE("cli: the summary line gives the process's phases; releasing the scene
     CHECK(std::equal(written.rgb.begin(), written.rgb.end(), in_process.rgb.begin()));
 }
 
+TEST_CASE("cli: --compare writes the stream engine's picture and honours --profile; the profile JSON is written whole") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kSmallScene);
+    const fs::path out = d.path / "cmp.pfm", json = d.path / "prof.json";
+    const Run r = run_streamrt("-j2 --compare --profile --profile-json " + q(json) + " " + q(scene) + " -o " + q(out));
+    INFO(r.out, r.err);
+    REQUIRE(r.code == 0);
+    CHECK(r.out.find("speedup:") != std::string::npos);
+    CHECK(r.out.find("stream profile:") != std::string::npos);
+    streamrt::Parallelism par(2);
+    const streamrt::Framebuffer in_process =
+        streamrt::render_scene(streamrt::load_scene(scene.string()), streamrt::EngineKind::Stream, par).image;
+    const streamrt::Framebuffer written = streamrt::read_image(out.string());
+    REQUIRE(written.rgb.size() == in_process.rgb.size());
+    CHECK(std::equal(written.rgb.begin(), written.rgb.end(), in_process.rgb.begin()));
+    const std::string j = slurp(json);
+    CHECK(j.rfind("{", 0) == 0);
+    CHECK(j.find("\"stages\"") != std::string::npos);
+    CHECK(d.files().size() == 3);  // the scene, the image, the profile: no temporary left
+}
+
+TEST_CASE("cli: --isa with the recursive engine and a profile into a missing folder are refused before rendering") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kSmallScene);
+    const Run isa = run_streamrt("--engine recursive --isa sse2 " + q(scene) + " -o " + q(d.path / "a.png"));
+    CHECK(isa.code == 2);
+    check_one_line_error(isa, "--isa");
+    const Run prof = run_streamrt("--profile-json " + q(d.path / "missing" / "p.json") + " " + q(scene) + " -o " +
+                                  q(d.path / "b.png"));
+    CHECK(prof.code == 2);
+    check_one_line_error(prof, "does not exist");
+    CHECK(d.files().size() == 1);  // nothing rendered, nothing written
+}
+
 TEST_CASE("cli: the PNG file's bytes are the same at -j1 and -j2") {
     Dir d;
     const fs::path scene = d.write("s.cfg", kSmallScene);

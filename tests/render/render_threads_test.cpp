@@ -40,3 +40,19 @@ TEST_CASE("render threads: a cancelled render stops early") {
         CHECK(r.counts.total() == 0);
     }
 }
+
+TEST_CASE("render threads: both engines report every tile the progress display counts") {
+    // The display's total (tile_count) and the engines' tiles must be the same tiles, or the
+    // bar never reaches 100 % (48x33 at 16: 3 x 3 tiles; another size would count otherwise).
+    Scene s = parse_scene(kScene, "t.cfg");
+    s.settings.width = 48;
+    s.settings.height = 33;
+    CHECK(tile_count(48, 33) == 9);
+    for (EngineKind e : {EngineKind::Stream, EngineKind::Recursive}) {
+        CAPTURE(engine_name(e));
+        Parallelism par(2);
+        RenderProgress progress;
+        render_scene(s, e, par, &progress);
+        CHECK(progress.tiles_done.load() == tile_count(s.settings.width, s.settings.height));
+    }
+}
