@@ -87,6 +87,17 @@ void check_one_line_error(const Run& r, const std::string& needle) {
     CHECK(r.err.find(needle) != std::string::npos);
 }
 
+/// The PFM the command wrote equals, float for float, the stream engine's render of the
+/// scene in this process (which keeps every table of the scene alive).
+void check_same_as_in_process_stream(const fs::path& scene, const fs::path& out) {
+    streamrt::Parallelism par(2);
+    const streamrt::Framebuffer in_process =
+        streamrt::render_scene(streamrt::load_scene(scene.string()), streamrt::EngineKind::Stream, par).image;
+    const streamrt::Framebuffer written = streamrt::read_image(out.string());
+    REQUIRE(written.rgb.size() == in_process.rgb.size());
+    CHECK(std::equal(written.rgb.begin(), written.rgb.end(), in_process.rgb.begin()));
+}
+
 const char* kSmallScene =
     "image width=32 height=24 spp=1 depth=2 degree=5 output=out.png\n"
     "camera eye=0,1,6 look=0,0,0\n"
@@ -249,12 +260,7 @@ TEST_CASE("cli: the summary line gives the process's phases; releasing the scene
     INFO(r.out, r.err);
     REQUIRE(r.code == 0);
     for (const char* phase : {"(read ", ", set-up ", ", render ", ", write "}) CHECK(r.out.find(phase) != std::string::npos);
-    streamrt::Parallelism par(2);
-    const streamrt::Framebuffer in_process =
-        streamrt::render_scene(streamrt::load_scene(scene.string()), streamrt::EngineKind::Stream, par).image;
-    const streamrt::Framebuffer written = streamrt::read_image(out.string());
-    REQUIRE(written.rgb.size() == in_process.rgb.size());
-    CHECK(std::equal(written.rgb.begin(), written.rgb.end(), in_process.rgb.begin()));
+    check_same_as_in_process_stream(scene, out);
 }
 
 TEST_CASE("cli: --compare writes the stream engine's picture and honours --profile; the profile JSON is written whole") {
@@ -266,12 +272,7 @@ TEST_CASE("cli: --compare writes the stream engine's picture and honours --profi
     REQUIRE(r.code == 0);
     CHECK(r.out.find("speedup:") != std::string::npos);
     CHECK(r.out.find("stream profile:") != std::string::npos);
-    streamrt::Parallelism par(2);
-    const streamrt::Framebuffer in_process =
-        streamrt::render_scene(streamrt::load_scene(scene.string()), streamrt::EngineKind::Stream, par).image;
-    const streamrt::Framebuffer written = streamrt::read_image(out.string());
-    REQUIRE(written.rgb.size() == in_process.rgb.size());
-    CHECK(std::equal(written.rgb.begin(), written.rgb.end(), in_process.rgb.begin()));
+    check_same_as_in_process_stream(scene, out);
     const std::string j = slurp(json);
     CHECK(j.rfind("{", 0) == 0);
     CHECK(j.find("\"stages\"") != std::string::npos);
