@@ -58,10 +58,8 @@ std::unique_ptr<SceneBvh> SceneBvh::build(const Scene& scene, const BuildOptions
         for (int a = 0; a < 3; ++a) lo[a] -= shift[a], hi[a] -= shift[a];
         boxes[i] = conservative_box(lo, hi);
     });
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < n; ++i)
         if (boxes[i].empty()) s->unbounded.push_back(std::uint32_t(i));
-        else ++s->bounded;
-    }
     s->bvh = Bvh::build(std::move(boxes), options);
     return s;
 }

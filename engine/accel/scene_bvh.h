@@ -44,7 +44,6 @@ AccelConfig& accel_config();
 /// The hierarchy over the bounded objects of a scene plus the list of the others.
 struct SceneBvh {
     Bvh bvh;                               ///< prim_index holds object indices
-    std::size_t bounded = 0;               ///< how many objects are in the hierarchy
     std::vector<std::uint32_t> unbounded;  ///< objects tested separately (planes)
 
     /// nullptr when the configuration says this scene is traced flat.

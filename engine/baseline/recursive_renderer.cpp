@@ -12,10 +12,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 inline Vec3d apply_point(const glm::dmat4x3& m, const Vec3d& p) { return to_vec(m * glm::dvec4(to_glm(p), 1.0)); }
 inline Vec3d apply_vector(const glm::dmat4x3& m, const Vec3d& v) { return to_vec(m * glm::dvec4(to_glm(v), 0.0)); }
-/// Mn n, with Mn = (Mi's linear part) transposed: n times that part as a row vector.
-inline Vec3d apply_normal(const glm::dmat4x3& mi, const Vec3d& n) {
-    return normalize(to_vec(to_glm(n) * glm::dmat3(mi)));
-}
 }  // namespace
 
 RecursiveRenderer::RecursiveRenderer(const Scene& scene)
@@ -85,7 +81,7 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
     hit.object = best;
     hit.t = best_t;
     hit.point = apply_point(scene_.objects[std::size_t(best)].md, pc);
-    hit.normal = apply_normal(ob.mi, nc);
+    hit.normal = to_vec(transform_normal(ob.mi, to_glm(nc)));
     return true;
 }
 

@@ -1,26 +1,12 @@
 #pragma once
-// The handout's three homogeneous matrices kept together: Md (canonical -> world),
-// Mi = Md^-1 (world -> canonical) and Mn = (Md^-1)^T restricted to 3x3 (normals).
+// The handout's three homogeneous matrices: Md (canonical -> world), Mi = Md^-1 (world ->
+// canonical) and Mn = (Md^-1)^T restricted to 3x3 (normals). Scenes store Md only; the engines
+// derive Mi once (affine_inverse) and apply Mn as Mi's linear part transposed.
 #include <glm/glm.hpp>
 
 #include "core/vec3.h"
 
 namespace streamrt {
-
-struct Transform {
-    glm::dmat4 md{1.0};  ///< direct: canonical -> world
-    glm::dmat4 mi{1.0};  ///< inverse: world -> canonical
-    glm::dmat3 mn{1.0};  ///< normals: inverse-transpose of Md's linear part
-
-    /// Builds the three from Md; the caller has checked Md is invertible.
-    static Transform from_direct(const glm::dmat4& md) {
-        Transform t;
-        t.md = md;
-        t.mi = glm::inverse(md);
-        t.mn = glm::transpose(glm::dmat3(t.mi));
-        return t;
-    }
-};
 
 inline Vec3d to_vec(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
 inline glm::dvec3 to_glm(const Vec3d& v) { return {v.x, v.y, v.z}; }
@@ -32,8 +18,9 @@ inline glm::dvec3 transform_point(const glm::dmat4& m, const glm::dvec3& p) {
 inline glm::dvec3 transform_vector(const glm::dmat4& m, const glm::dvec3& v) {
     return glm::dmat3(m) * v;
 }
-inline glm::dvec3 transform_normal(const glm::dmat3& mn, const glm::dvec3& n) {
-    return glm::normalize(mn * n);
+/// Mn n = (Mi's linear part)^T n, normalised: n times that part as a row vector.
+inline glm::dvec3 transform_normal(const glm::dmat4x3& mi, const glm::dvec3& n) {
+    return glm::normalize(n * glm::dmat3(mi));
 }
 
 /// The inverse of an affine map stored as its top three rows (glm: 4 columns of 3): the
