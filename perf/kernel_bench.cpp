@@ -30,7 +30,7 @@
 #include "arith_limit.h"
 #include "kernels/kernel_table.h"
 #include "simd/lanes.h"
-#include "stream/ray_stream.h"
+#include "kernels/ray_stream.h"
 
 using namespace streamrt;
 

@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 
 #include "core/vec3.h"
 #include "image/framebuffer.h"

@@ -17,14 +17,14 @@
 #include <thread>
 #include <vector>
 
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 #include "core/error.h"
 #include "image/image_compare.h"
 #include "image/image_io.h"
 #include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
-#include "render/limits.h"
-#include "render/render.h"
+#include "driver/limits.h"
+#include "driver/render.h"
 #include "scene/parser.h"
 
 #ifndef STREAMRT_VERSION

@@ -6,7 +6,7 @@
 // where param is the torus minor radius and unused by the others.
 #include <utility>
 
-#include "scene/scene.h"
+#include "shapes/shape_kind.h"
 #include "shapes/cone_math.h"
 #include "shapes/cube_math.h"
 #include "shapes/cylinder_math.h"

@@ -13,7 +13,7 @@
 #include "render/sampling.h"
 #include "shapes/shapes.h"
 #include "stream/profile.h"
-#include "stream/ray_stream.h"
+#include "kernels/ray_stream.h"
 #include "stream/shade_mode.h"
 #include "stream/stream_scene.h"
 

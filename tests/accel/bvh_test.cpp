@@ -6,7 +6,7 @@
 #include <limits>
 #include <random>
 
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 #include "kernels/accel_kernel_table.h"
 #include "shapes/shapes.h"
 #include "stream/stream_accel.h"

@@ -3,7 +3,7 @@
 #include <doctest/doctest.h>
 
 #include "image/image_io.h"
-#include "render/render.h"
+#include "driver/render.h"
 #include "scene/parser.h"
 #include <signal.h>
 #include <sys/wait.h>

@@ -11,7 +11,7 @@
 #include <cmath>
 #include <string>
 
-#include "render/limits.h"
+#include "driver/limits.h"
 #include "scene/parser.h"
 
 namespace streamrt_fuzz {

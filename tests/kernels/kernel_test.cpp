@@ -37,7 +37,7 @@
 
 #include "kernels/kernel_table.h"
 #include "shapes/shapes.h"
-#include "stream/ray_stream.h"
+#include "kernels/ray_stream.h"
 
 using namespace streamrt;
 

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "render/render.h"
+#include "driver/render.h"
 #include "render/shading.h"
 #include "scene/parser.h"
 

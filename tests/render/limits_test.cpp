@@ -1,11 +1,11 @@
-// The memory estimate and the refusal of renders that cannot fit (render/limits.h).
+// The memory estimate and the refusal of renders that cannot fit (driver/limits.h).
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <string>
 
 #include "core/error.h"
-#include "render/limits.h"
+#include "driver/limits.h"
 #include "scene/parser.h"
 
 using namespace streamrt;

@@ -9,7 +9,7 @@
 
 #include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
-#include "render/render.h"
+#include "driver/render.h"
 #include "scene/parser.h"
 #include "stream/profile.h"
 #include "stream/stream_renderer.h"

@@ -15,7 +15,7 @@
 #include "image/image_compare.h"
 #include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
-#include "render/render.h"
+#include "driver/render.h"
 #include "scene/parser.h"
 
 using namespace streamrt;

@@ -16,7 +16,7 @@
 
 #include "image/image_compare.h"
 #include "parallel/parallelism.h"
-#include "render/render.h"
+#include "driver/render.h"
 #include "scene/parser.h"
 
 using namespace streamrt;

@@ -1,4 +1,4 @@
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "render/render.h"
+#include "driver/render.h"
 
 #include <chrono>
 

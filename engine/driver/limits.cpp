@@ -1,4 +1,4 @@
-#include "render/limits.h"
+#include "driver/limits.h"
 
 #include <unistd.h>
 
