@@ -45,6 +45,7 @@ struct Options {
     int jobs = 0;
     std::string output;
     std::optional<int> spp, width, height, degree, depth;
+    std::optional<double> cutoff;
     std::string engine = "stream";
     std::string accel = "auto";
     std::string isa;
@@ -140,6 +141,10 @@ int run(int argc, char** argv) {
     app.add_option("--height", opt.height, "Image height in pixels")->check(CLI::Range(1, 32768));
     app.add_option("--degree", opt.degree, "Shading degree 0..5 (handout)")->check(CLI::Range(0, 5));
     app.add_option("--depth", opt.depth, "Maximum bounces")->check(CLI::Range(0, 256));
+    app.add_option("--cutoff", opt.cutoff,
+                   "Weight cut-off: reflected and refracted rays worth less than this in every channel are not "
+                   "traced (default 0: all; overrides the scene's image cutoff=)")
+        ->check(CLI::Range(0.0, 1.0));
     app.add_option("--engine", opt.engine, "Renderer: stream (SIMD ray streams) or recursive (the handout's baseline)")
         ->check(CLI::IsMember({"stream", "recursive"}));
     app.add_option("--isa", opt.isa, "Force the stream kernels' level: sse2, sse4.2, avx2 or avx512 (default: best the CPU has)")
@@ -191,6 +196,7 @@ int run(int argc, char** argv) {
     if (opt.height) s.height = *opt.height;
     if (opt.degree) s.degree = *opt.degree;
     if (opt.depth) s.depth = *opt.depth;
+    if (opt.cutoff) s.cutoff = *opt.cutoff;
     if (opt.sampler == "grid") s.pattern = SamplePattern::Grid;
     if (opt.sampler == "random") s.pattern = SamplePattern::Random;
     if (opt.sampler == "stratified") s.pattern = SamplePattern::Stratified;

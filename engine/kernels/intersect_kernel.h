@@ -31,18 +31,15 @@ inline B load_lanes(const float* p) {
     return B::load_aligned(p);  // converts float -> double for double batches
 }
 
-/// World ray -> object's canonical space with Mi (12 broadcast FMAs per component set).
+/// World ray -> object's canonical space with Mi (core/transform.h's helpers, the same
+/// evaluation order as the shade stage and the baseline).
 template <class B, class T>
 inline RayPacket<B> to_canonical(const RayPacket<B>& r, const ObjectXf& ob) {
-    const auto m = [&](int i) { return B(T(ob.m[i])); };
-    RayPacket<B> c;
-    c.o.x = xsimd::fma(m(0), r.o.x, xsimd::fma(m(1), r.o.y, xsimd::fma(m(2), r.o.z, m(3))));
-    c.o.y = xsimd::fma(m(4), r.o.x, xsimd::fma(m(5), r.o.y, xsimd::fma(m(6), r.o.z, m(7))));
-    c.o.z = xsimd::fma(m(8), r.o.x, xsimd::fma(m(9), r.o.y, xsimd::fma(m(10), r.o.z, m(11))));
-    c.d.x = xsimd::fma(m(0), r.d.x, xsimd::fma(m(1), r.d.y, m(2) * r.d.z));
-    c.d.y = xsimd::fma(m(4), r.d.x, xsimd::fma(m(5), r.d.y, m(6) * r.d.z));
-    c.d.z = xsimd::fma(m(8), r.d.x, xsimd::fma(m(9), r.d.y, m(10) * r.d.z));
-    return c;
+    struct Rows {
+        const float* m;
+        B operator[](int i) const { return B(T(m[i])); }
+    } rows{ob.m};
+    return {apply_point(rows, r.o), apply_vector(rows, r.d)};
 }
 
 /// Writes a packet's closest hits back: t into t_max and the object id, for the lanes that

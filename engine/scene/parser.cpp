@@ -315,7 +315,7 @@ const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rota
                                                       "translate"};
 const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
                                                   "depth",  "degree",  "output",
-                                                  "sampler", "calibration"};
+                                                  "sampler", "calibration", "cutoff"};
 const std::vector<std::string_view> kLookAtKeys = {"eye", "look", "up", "fov"};
 const std::vector<std::string_view> kExplicitCameraKeys = {"rx",       "ry",       "df",
                                                            "scale",    "rotate_x", "rotate_y",
@@ -751,6 +751,7 @@ class Parser {
             else if (k == "spp") s.spp = st.integer(a, 1, 65536);
             else if (k == "depth") s.depth = st.integer(a, 0, 256);
             else if (k == "degree") s.degree = st.integer(a, 0, 5);
+            else if (k == "cutoff") s.cutoff = st.in_closed(a, 0.0, 1.0);
             else if (k == "output") s.output = std::string(a.value);
             else if (k == "sampler") {
                 if (a.value == "stratified") s.pattern = SamplePattern::Stratified;

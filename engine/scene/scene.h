@@ -104,6 +104,9 @@ struct RenderSettings {
     int depth = 5;   ///< maximum number of reflection/refraction bounces after the primary hit
     int degree = 5;  ///< 0 flat .. 5 shadows, cumulative (handout)
     double ambient = 0.1;  ///< alpha, the ambient fraction
+    /// Weight cut-off: reflected / refracted rays whose throughput (product of the refl and
+    /// trans weights from the camera) is below this in every channel are not traced; 0 = all.
+    double cutoff = 0.0;
     glm::dvec3 background{0.0, 0.0, 0.0};
     Calibration calibration = Calibration::Clamp;
     SamplePattern pattern = SamplePattern::Stratified;

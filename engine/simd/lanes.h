@@ -59,6 +59,21 @@ template <class B>
     requires is_batch<B>
 inline B max(const B& a, const B& b) { return xsimd::max(a, b); }
 
+/// a * b + c. Scalars: two roundings, as the baseline-flag code computes it (no FMA unit
+/// there). Batches: xsimd::fma, fused on levels with an FMA unit.
+inline float fmadd(float a, float b, float c) { return a * b + c; }
+inline double fmadd(double a, double b, double c) { return a * b + c; }
+template <class B>
+    requires is_batch<B>
+inline B fmadd(const B& a, const B& b, const B& c) { return xsimd::fma(a, b, c); }
+
+/// An unsigned integer below 2^31 as a float (exact below 2^24).
+inline float to_float(std::uint32_t h) { return float(h); }
+template <class A>
+inline xsimd::batch<float, A> to_float(const xsimd::batch<std::uint32_t, A>& h) {
+    return xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int32_t, A>>(h));
+}
+
 template <class T, class A>
 inline xsimd::batch<T, A> sign_of(const xsimd::batch<T, A>& a) {
     return xsimd::copysign(xsimd::batch<T, A>(T(1)), a);

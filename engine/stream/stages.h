@@ -100,19 +100,6 @@ inline ShadeMode resolve_shade_mode(const StreamScene& sc, ShadeMode asked) {
 
 namespace stage_detail {
 
-inline Vec3f apply_point(const float* m, const Vec3f& p) {
-    return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
-            m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
-}
-inline Vec3f apply_vector(const float* m, const Vec3f& v) {
-    return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
-            m[8] * v.x + m[9] * v.y + m[10] * v.z};
-}
-/// Mn n with Mn = (Mi's linear part) transposed, read from Mi's row-major 3x4 rows.
-inline Vec3f apply_normal(const float* mi, const Vec3f& n) {
-    return normalize(Vec3f{mi[0] * n.x + mi[4] * n.y + mi[8] * n.z, mi[1] * n.x + mi[5] * n.y + mi[9] * n.z,
-                           mi[2] * n.x + mi[6] * n.y + mi[10] * n.z});
-}
 inline void add(float* accum, std::int32_t pixel, const ColorT<float>& c) {
     accum[pixel * 3 + 0] += c.x;
     accum[pixel * 3 + 1] += c.y;
@@ -161,7 +148,6 @@ struct PipelineStages {
             }
         }
         rays.count = i;
-        const CameraRays<float>& cam = sc.camera;
         GenerateJob job{n,
                         g.px.data(),
                         g.py.data(),
@@ -173,12 +159,7 @@ struct PipelineStages {
                         kJitter,
                         float(cols),
                         float(spp / cols),
-                        {cam.origin.x, cam.origin.y, cam.origin.z},
-                        {cam.du.x, cam.du.y, cam.du.z},
-                        {cam.dv.x, cam.dv.y, cam.dv.z},
-                        {cam.dback.x, cam.dback.y, cam.dback.z},
-                        cam.inv_width,
-                        cam.inv_height,
+                        &sc.camera,
                         1.f / float(spp),
                         {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(),
                          rays.dz.data(), rays.t_max.data(), rays.wr.data(), rays.wg.data(), rays.wb.data(),
@@ -218,15 +199,57 @@ struct PipelineStages {
         }
     }
 
-    /// shade + spawn: local terms by degree into the tile (or into shadow rays when degree 5
-    /// asks for visibility), reflected and refracted rays appended to `next` (the compaction:
-    /// only surviving rays move on). Misses bring the background.
+    /// The shading rules for rays of generation `depth`. The stream's weights carry the
+    /// sample's 1/spp, so the cut-off (defined on the refl / trans product alone, as in the
+    /// recursive engine) is scaled by it.
+    static ShadeRules<float> shade_rules(const StreamScene& sc, int depth) {
+        const RenderSettings& s = sc.settings;
+        return {s.degree, float(s.ambient), kSecondary && depth < s.depth, float(s.cutoff / s.spp), sc.camera.spread};
+    }
+
+    /// Where shade_hit's results go on the scalar path: the local colour into the tile,
+    /// shadow and child rays appended to their streams.
+    struct ScalarSink {
+        static constexpr bool kTestsShadowsNow = false;
+        float* accum;
+        std::int32_t px;
+        RayStream& next;
+        ShadowStream& shadows;
+        RayCounts& counts;
+
+        void local(const ColorT<float>& c) { stage_detail::add(accum, px, c); }
+        void shadow(bool send, const Vec3f& from, const Vec3f& to, float t_max, const ColorT<float>& c) {
+            if (!send) return;
+            const std::size_t j = shadows.count++;
+            shadows.ox[j] = from.x;
+            shadows.oy[j] = from.y;
+            shadows.oz[j] = from.z;
+            shadows.dx[j] = to.x;
+            shadows.dy[j] = to.y;
+            shadows.dz[j] = to.z;
+            shadows.t_max[j] = t_max;
+            shadows.cr[j] = c.x;
+            shadows.cg[j] = c.y;
+            shadows.cb[j] = c.z;
+            shadows.pixel[j] = px;
+        }
+        void child(bool send, const Vec3f& from, const Vec3f& dir, const ColorT<float>& weight, const ColorT<float>&,
+                   float cone, RayKind kind) {
+            if (!send) return;
+            push(next, next.count++, from, dir, weight, cone, px, kind);
+            ++(kind == RayKind::Reflected ? counts.reflected : counts.refracted);
+        }
+    };
+
+    /// shade + spawn, one ray at a time (shade_hit in render/shading.h with V = float):
+    /// local terms into the tile, shadow rays when degree 5 asks for visibility, reflected
+    /// and refracted rays appended to `next` (only surviving rays move on). Misses bring the
+    /// background.
     static void shade(const StreamScene& sc, const RayStream& rays, const AlignedVec<std::int32_t>& object,
                       const MeshHits& mesh_hits, int depth, RayStream& next, ShadowStream& shadows, float* accum,
                       RayCounts& counts) {
         using namespace stage_detail;
-        const RenderSettings& s = sc.settings;
-        const bool may_spawn = kSecondary && depth < s.depth;
+        const ShadeRules<float> rules = shade_rules(sc, depth);
         // This path serves scenes with many objects, where each hit's records are likely
         // cache misses: fetch them a few rays ahead (in leaf order, neighbouring rays mostly
         // hit objects close in memory).
@@ -260,62 +283,12 @@ struct PipelineStages {
                     ? mesh_normal<float>(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i], mesh_hits.v[i],
                                          ob.xf.param != 0.f)
                     : visit_shape(kind, [&](auto shape) { return shape.template normal<float>(pc, ob.xf.param); });
-            const Vec3f n_out = apply_normal(ob.xf.m, nc);
-            const float cone = rays.cone[i] + sc.camera.spread * t;
-            const ColorT<float> base = surface_color(m, ColorT<float>{sf.color[0], sf.color[1], sf.color[2]}, p, n_out,
-                                                     footprint_width(rays.cone[i], sc.camera.spread, t, dot(d, n_out)));
-            if constexpr (!kLighting) {
-                add(accum, px, mul(w, base));
-                continue;
-            } else {
-                const Vec3f n = dot(n_out, d) < 0.f ? n_out : -n_out;
-                add(accum, px, mul(w, ambient_light(s.degree, float(s.ambient), m, base)));
-                Vec3f shadow_origin{};
-                if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, o);
-                for (const LightT<float>& l : sc.lights) {
-                    const LightSample<float> ls = sample_light(l, p);
-                    const DirectLight<float> dl = direct_light(s.degree, m, base, n, d, l, ls);
-                    if (!dl.lit) continue;
-                    const ColorT<float>& c = dl.color;
-                    if constexpr (kShadows) {
-                        const std::size_t j = shadows.count++;
-                        const Vec3f to = l.kind == LightKind::Directional ? ls.to_light : l.pos - shadow_origin;
-                        shadows.ox[j] = shadow_origin.x;
-                        shadows.oy[j] = shadow_origin.y;
-                        shadows.oz[j] = shadow_origin.z;
-                        shadows.dx[j] = to.x;
-                        shadows.dy[j] = to.y;
-                        shadows.dz[j] = to.z;
-                        shadows.t_max[j] = ls.t_max;
-                        const ColorT<float> wc = mul(w, c);
-                        shadows.cr[j] = wc.x;
-                        shadows.cg[j] = wc.y;
-                        shadows.cb[j] = wc.z;
-                        shadows.pixel[j] = px;
-                    } else {
-                        add(accum, px, mul(w, c));
-                    }
-                }
-                if (!may_spawn) continue;
-                if constexpr (kReflect) {
-                    if (m.refl > 0.f) {
-                        const std::size_t j = next.count++;
-                        const Vec3f r = reflect(d, n);
-                        const Vec3f from = offset_ray_origin(p, n, o);
-                        push(next, j, from, r, w * m.refl, cone, px, RayKind::Reflected);
-                        ++counts.reflected;
-                    }
-                }
-                if constexpr (kRefract) {
-                    if (m.trans > 0.f) {
-                        const std::size_t j = next.count++;
-                        const Vec3f tr = refract(d, n_out, m.ior);
-                        const Vec3f from = offset_ray_origin(p, dot(tr, n_out) > 0.f ? n_out : -n_out, o);
-                        push(next, j, from, tr, w * m.trans, cone, px, RayKind::Refracted);
-                        ++counts.refracted;
-                    }
-                }
-            }
+            const ArrivingRay<float> arriving{o, d, t, rays.cone[i], w, w};
+            ScalarSink sink{accum, px, next, shadows, counts};
+            shade_hit<kLighting, kShadows, kReflect, kRefract>(rules, m, sc.lights.data(), sc.lights.size(), arriving,
+                                                               p, apply_normal(ob.xf.m, nc),
+                                                               ColorT<float>{sf.color[0], sf.color[1], sf.color[2]},
+                                                               true, sink);
         }
     }
 
@@ -380,8 +353,7 @@ struct PipelineStages {
         ShadowStream& sh = ws.shadows;
         ShadeJob job{h.ox.data(), h.oy.data(), h.oz.data(), h.dx.data(), h.dy.data(), h.dz.data(), h.t.data(),
                      h.wr.data(), h.wg.data(), h.wb.data(), h.cone.data(), h.pixel.data(), 0, 0, nullptr, {}, nullptr,
-                     sc.lights.data(), sc.lights.size(), sc.settings.degree, float(sc.settings.ambient),
-                     kSecondary && depth < sc.settings.depth, sc.camera.spread, h.lr.data(), h.lg.data(), h.lb.data(),
+                     sc.lights.data(), sc.lights.size(), shade_rules(sc, depth), h.lr.data(), h.lg.data(), h.lb.data(),
                      {nx.ox.data(), nx.oy.data(), nx.oz.data(), nx.dx.data(), nx.dy.data(), nx.dz.data(),
                       nx.t_max.data(), nx.wr.data(), nx.wg.data(), nx.wb.data(), nx.cone.data(), nx.pixel.data(),
                       nx.kind.data(), &nx.count},
