@@ -39,7 +39,7 @@ import reference_render as rr  # noqa: E402
 
 TOL_ABS = 2e-3
 MAX_SHARE = 0.005
-SHAPES = ("sphere", "cube", "cylinder", "cone", "torus", "plane")
+SHAPES = ("sphere", "cube", "cylinder", "cone", "torus", "plane", "disk")
 
 
 def _scene(name):
