@@ -26,10 +26,29 @@
 
 namespace streamrt {
 
+namespace shape_detail {
+/// Names the first member a would-be shape lacks (a plainer message than the concept's).
+template <class S>
+constexpr bool declares_every_member() {
+    static_assert(requires { S::kind; }, "a canonical shape declares static constexpr ShapeKind kind");
+    static_assert(requires { S::name; }, "a canonical shape declares its scene-format std::string_view name");
+    static_assert(requires { S::param; }, "a canonical shape declares ShapeParam param (or kNoShapeParam)");
+    static_assert(requires(double p) { S::bounds(p); }, "a canonical shape declares CanonicalBounds bounds(param)");
+    static_assert(requires { typename S::Compute; }, "a canonical shape declares using Compute = float or double");
+    static_assert(requires(const Vec3T<double>& v, double x) { S::template hit_t<double>(v, v, x, x, x); },
+                  "a canonical shape declares template <class V> V hit_t(o, d, param, t_min, t_max)");
+    static_assert(requires(const Vec3T<double>& v, double x) { S::template normal<double>(v, x); },
+                  "a canonical shape declares template <class V> Vec3T<V> normal(p, param)");
+    static_assert(CanonicalShape<S>, "a canonical shape's members have the types of shapes/shape_traits.h");
+    return true;
+}
+}  // namespace shape_detail
+
 /// A list of canonical shapes; each must provide every member (CanonicalShape), or the list
-/// does not compile.
-template <CanonicalShape... S>
+/// does not compile: the first missing member is named.
+template <class... S>
 struct ShapeList {
+    static_assert((shape_detail::declares_every_member<S>() && ...));
     static constexpr std::size_t size = sizeof...(S);
     template <std::size_t I>
     using at = std::tuple_element_t<I, std::tuple<S...>>;

@@ -183,7 +183,8 @@ void disk_rays(const Scene& s, std::size_t n, std::uint32_t seed, std::vector<Ve
     const double side = 3.0 * std::cbrt(double(s.objects.size()));
     for (std::size_t i = 0; i < n; ++i) {
         const Object& ob = s.objects[rng() % s.objects.size()];
-        const double a = 3.14159265358979 * u(rng), r = i % 3 == 0 ? std::sqrt(std::abs(u(rng))) : 0.98 + 0.02 * std::abs(u(rng));
+        const double a = 3.14159265358979 * u(rng);
+        const double r = i % 3 == 0 ? std::sqrt(std::abs(u(rng))) : 0.98 + 0.02 * std::abs(u(rng));
         const glm::dvec3 target = ob.md * glm::dvec4(r * std::cos(a), 0, r * std::sin(a), 1);
         glm::dvec3 from{2 * side * u(rng), 2 * side * u(rng), 2 * side * u(rng)};
         if (i % 5 == 0)  // grazing: from a point barely above the disk's plane, far away along it
@@ -223,7 +224,7 @@ TEST_CASE("disk: the hierarchy never culls a disk hit (scalar and SIMD traversal
             int id_a, id_b = -1;
             const double ta = brute_t(s, o[i], d[i], &id_a);
             double tb = kInf;
-            accel::traverse_closest<double>(b->bvh, o[i], d[i], tb, [&](std::uint32_t first, std::uint32_t count, double& tm) {
+            const auto leaf = [&](std::uint32_t first, std::uint32_t count, double& tm) {
                 for (std::uint32_t k = first; k < first + count; ++k) {
                     const std::uint32_t j = b->bvh.prim_index[k];
                     const glm::dmat4 mi(affine_inverse(s.objects[j].md));
@@ -231,7 +232,8 @@ TEST_CASE("disk: the hierarchy never culls a disk hit (scalar and SIMD traversal
                                                              to_vec(transform_vector(mi, to_glm(d[i]))), 0.0, 0.0, tm);
                     if (t < tm) tm = t, id_b = int(j);
                 }
-            });
+            };
+            accel::traverse_closest<double>(b->bvh, o[i], d[i], tb, leaf);
             hits += id_a >= 0;
             CHECK(ta == tb);
             CHECK(id_a == id_b);
@@ -272,7 +274,8 @@ TEST_CASE("disk: the hierarchy never culls a disk hit (scalar and SIMD traversal
                 // Any hit just beyond the closest hit: every ray that hits is blocked.
                 RayStream sh;
                 fill(sh, o, d, 0.f);
-                for (std::size_t i = 0; i < sh.count; ++i) sh.t_max[i] = std::isinf(truth.t_max[i]) ? 1e4f : truth.t_max[i] * 1.001f;
+                for (std::size_t i = 0; i < sh.count; ++i)
+                    sh.t_max[i] = std::isinf(truth.t_max[i]) ? 1e4f : truth.t_max[i] * 1.001f;
                 sa.any(kt, view_of(sh));
                 for (std::size_t i = 0; i < sh.count; ++i) bvh_wrong += (sh.t_max[i] == 0.f) != (id_t[i] >= 0);
                 accel::accel_config() = accel::AccelConfig{};
@@ -319,9 +322,10 @@ TEST_CASE("disk: engines agree on many-disk scenes, flat and through the hierarc
         std::uniform_real_distribution<double> u(-1.0, 1.0);
         for (int i = 0; i < n; ++i)
             text += "disk color=0.8,0.5,0.3 diff=0.8 spec=0.3 refl=" + std::string(i % 3 ? "0" : "0.4") +
-                    " scale=" + std::to_string(0.4 + 0.3 * std::abs(u(rng))) + " rotate_x=" + std::to_string(60 * u(rng)) +
-                    " rotate_z=" + std::to_string(60 * u(rng)) + " translate=" + std::to_string(4 * u(rng)) + "," +
-                    std::to_string(2 * u(rng)) + "," + std::to_string(4 * u(rng)) + "\n";
+                    " scale=" + std::to_string(0.4 + 0.3 * std::abs(u(rng))) +
+                    " rotate_x=" + std::to_string(60 * u(rng)) + " rotate_z=" + std::to_string(60 * u(rng)) +
+                    " translate=" + std::to_string(4 * u(rng)) + "," + std::to_string(2 * u(rng)) + "," +
+                    std::to_string(4 * u(rng)) + "\n";
         const Scene scene = parse_scene(text, "disks.cfg");
         Parallelism par(1);
         const Framebuffer ref = render_scene(scene, EngineKind::Recursive, par).image;

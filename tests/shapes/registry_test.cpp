@@ -3,11 +3,10 @@
 //
 // A shape missing a member does not compile. Shown once by hand (docs/testing.md, faults
 // table) by registering a copy of DiskMath without normal():
-//   using CanonicalShapes = ShapeList<..., DiskWithoutNormal>;
-// GCC 12: "template constraint failure for 'template<class ... S> requires (CanonicalShape<S>
-// && ...) struct streamrt::ShapeList'" ... "the required expression
-// 'S::normal<double>(pd, d)' is invalid". The static_asserts below keep that proof in the
-// suite without a failing build: the concept rejects such a type.
+//   using CanonicalShapes = ShapeList<..., PlaneMath, DiskWithoutNormal>;
+// GCC 12: "shapes/shapes.h: error: static assertion failed: a canonical shape declares
+// template <class V> Vec3T<V> normal(p, param)". The static_asserts below keep that proof in
+// the suite without a failing build: the concept rejects such types.
 #include <doctest/doctest.h>
 
 #include <set>
