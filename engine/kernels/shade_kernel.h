@@ -34,17 +34,9 @@ struct LaneRows {
 
 template <class B>
 inline Vec3T<B> canonical_normal(ShapeKind kind, const Vec3T<B>& p, const B& param) {
-    // One branch per packet (every lane hit the same object), never per ray.
-    switch (kind) {
-        case ShapeKind::Sphere: return SphereMath::normal<B>(p, param);
-        case ShapeKind::Cube: return CubeMath::normal<B>(p, param);
-        case ShapeKind::Cylinder: return CylinderMath::normal<B>(p, param);
-        case ShapeKind::Cone: return ConeMath::normal<B>(p, param);
-        case ShapeKind::Torus: return TorusMath::normal<B>(p, param);
-        case ShapeKind::Plane: break;
-        case ShapeKind::Mesh: break;  // mesh_normals() below
-    }
-    return PlaneMath::normal<B>(p, param);
+    // One branch per packet (every lane hit the same object), never per ray. Meshes take
+    // mesh_normals() below.
+    return visit_shape(kind, [&](auto shape) { return shape.template normal<B>(p, param); });
 }
 
 /// Canonical normals of a mesh's hits, gathered lane by lane from the hit triangles: the face

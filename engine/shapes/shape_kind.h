@@ -5,7 +5,9 @@
 
 namespace streamrt {
 
-/// Canonical shapes (docs/scene-format.md gives each exact definition).
+/// Canonical shapes (docs/scene-format.md gives each exact definition). Each kind but Mesh
+/// is declared by its math file and registered, in this order, in shapes/shapes.h
+/// (CanonicalShapes), which checks at compile time that the two agree.
 enum class ShapeKind : std::uint8_t {
     Sphere,    ///< unit sphere centred at the origin
     Cube,      ///< [-1,1]^3
@@ -13,21 +15,9 @@ enum class ShapeKind : std::uint8_t {
     Cone,      ///< base radius 1 at y=-1, apex at y=+1, base capped
     Torus,     ///< major radius 1 around the y axis in the xz-plane, minor radius per object
     Plane,     ///< y = 0, normal +y, infinite
-    Mesh,      ///< a triangle mesh in its own coordinates (engine/mesh/mesh.h); not closed-form
+    Disk,      ///< x^2 + z^2 <= 1 in the plane y = 0, normal +y
+    Mesh,      ///< a triangle mesh in its own coordinates (engine/mesh/mesh.h); not closed-form; last
 };
-inline constexpr int kShapeKindCount = 7;
-/// The keyword of each kind in the scene format.
-constexpr const char* shape_kind_name(ShapeKind k) {
-    switch (k) {
-        case ShapeKind::Sphere: return "sphere";
-        case ShapeKind::Cube: return "cube";
-        case ShapeKind::Cylinder: return "cylinder";
-        case ShapeKind::Cone: return "cone";
-        case ShapeKind::Torus: return "torus";
-        case ShapeKind::Plane: return "plane";
-        case ShapeKind::Mesh: return "mesh";
-    }
-    return "?";
-}
+inline constexpr int kShapeKindCount = int(ShapeKind::Mesh) + 1;
 
 }  // namespace streamrt

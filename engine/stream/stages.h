@@ -194,7 +194,7 @@ struct PipelineStages {
                 kt.closest[k](view, object.data(), group.data(), group.size());
             if (fig) {
                 fig->lanes_used += rays.count;
-                fig->lanes_total += stage_detail::lanes_for(rays.count, k == int(ShapeKind::Torus) ? kt.float_lanes / 2 : kt.float_lanes);
+                fig->lanes_total += stage_detail::lanes_for(rays.count, shape_computes_in_double(ShapeKind(k)) ? kt.float_lanes / 2 : kt.float_lanes);
             }
         }
     }
@@ -454,7 +454,7 @@ struct PipelineStages {
                 kt.any[k](view_of(shadows), group.data(), group.size());
             if (fig) {
                 fig->lanes_used += shadows.count;
-                fig->lanes_total += stage_detail::lanes_for(shadows.count, k == int(ShapeKind::Torus) ? kt.float_lanes / 2 : kt.float_lanes);
+                fig->lanes_total += stage_detail::lanes_for(shadows.count, shape_computes_in_double(ShapeKind(k)) ? kt.float_lanes / 2 : kt.float_lanes);
             }
         }
         for (std::size_t i = 0; i < shadows.count; ++i)

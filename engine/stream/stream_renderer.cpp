@@ -22,7 +22,7 @@ std::vector<std::string> StreamRenderer::built_stages() const {
     bool first = true;
     for (int k = 0; k < kShapeKindCount; ++k)
         if (!scene_.groups[k].empty()) {
-            kernels += (first ? "" : ",") + std::string(shape_kind_name(ShapeKind(k)));
+            (kernels += first ? "" : ",") += shape_kind_name(ShapeKind(k));
             first = false;
         }
     b.push_back(kernels + "]");
