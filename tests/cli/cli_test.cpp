@@ -575,14 +575,9 @@ TEST_CASE("cli: Ctrl-C while the image is being written: exit 130, no image and 
     CHECK(d.files() == std::vector<std::string>{"flat.cfg"});  // the FIFO (the temporary) is gone
 }
 
-TEST_CASE("cli: Ctrl-C during the last write of an image: exit 130, no image (KNOWN BUG: fails today)" *
-          doctest::should_fail()) {
-    // A user who presses Ctrl-C before the command has finished expects exit 130 and no
-    // image. A PFM is written in one writev with no look at the flag (encode_pfm), and the
-    // command does not look at it after write_image, so an interrupt during the write of a
-    // PFM (or of the last chunk of a PPM/PNG) renames the image into place and exits 0.
-    // should_fail: this test case passes while the bug is there; once the engine checks the
-    // flag before the rename, doctest reports it and the decorator goes (docs/testing.md).
+TEST_CASE("cli: Ctrl-C during the last write of an image: exit 130, no image") {
+    // A PFM is written in one writev with no look at the flag on the way: the writer looks
+    // at it once more before the rename (image_io.cpp, write_atomically).
     Dir d;
     const fs::path out = d.path / "small.pfm";
     std::size_t drained = 0;

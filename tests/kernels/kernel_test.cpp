@@ -27,6 +27,7 @@
 #include "kernels/kernel_table.h"
 #include "kernels/ray_stream.h"
 #include "scene/scene.h"
+#include "shapes/shapes.h"
 
 using namespace streamrt;
 
