@@ -10,6 +10,7 @@
 
 #include "core/vec3.h"
 #include "scene/scene.h"
+#include "simd/isa_namespace.h"
 #include "simd/lanes.h"
 
 namespace streamrt {
@@ -19,6 +20,8 @@ using ColorT = Vec3T<T>;
 
 template <class V>
 using MaskOf = decltype(V() < V());
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 template <class V, class M>
 inline Vec3T<V> select3(const M& m, const Vec3T<V>& a, const Vec3T<V>& b) {
@@ -30,6 +33,8 @@ template <class V, class T>
 inline Vec3T<V> splat(const Vec3T<T>& a) {
     return {V(a.x), V(a.y), V(a.z)};
 }
+
+STREAMRT_ISA_END
 
 /// A material in the engine's precision. The object's own colour (Object::color) is passed
 /// beside it wherever a surface colour is needed.
@@ -68,6 +73,8 @@ struct LightT {
                 T(std::cos(l.angle * 3.14159265358979323846 / 180.0))};
     }
 };
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 namespace detail {
 /// G(x) = integral from 0 to x of [floor(u) is odd] du; G(x + 2) = G(x) + 1.
@@ -248,4 +255,5 @@ inline Vec3T<V> offset_ray_origin(const Vec3T<V>& p, const Vec3T<V>& n, const Ve
     return p + n * step;
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

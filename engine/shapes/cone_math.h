@@ -2,8 +2,10 @@
 // Canonical cone: base radius 1 at y = -1, apex at y = +1, base capped.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct ConeMath {
     /// Side: x^2 + z^2 = (k (1 - y))^2 with k = 1/2, for y in [-1, 1]. A ray parallel to a
@@ -48,4 +50,5 @@ struct ConeMath {
     }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

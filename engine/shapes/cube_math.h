@@ -2,8 +2,10 @@
 // Canonical cube: [-1,1]^3.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct CubeMath {
     /// Slab test (Kay & Kajiya). A zero direction component gives +-inf slab distances; an
@@ -42,4 +44,5 @@ struct CubeMath {
     }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

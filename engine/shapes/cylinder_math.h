@@ -2,8 +2,10 @@
 // Canonical cylinder: radius 1 around the y axis, y in [-1,1], both ends capped.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct CylinderMath {
     template <class V>
@@ -36,4 +38,5 @@ struct CylinderMath {
     }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -2,8 +2,10 @@
 // Canonical plane: y = 0, normal +y, infinite.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct PlaneMath {
     /// A ray parallel to the plane gives t = +-inf (or NaN when it lies in it): both miss.
@@ -19,4 +21,5 @@ struct PlaneMath {
     static Vec3T<V> normal(const Vec3T<V>& /*p*/, V /*param*/) { return {V(0), V(1), V(0)}; }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

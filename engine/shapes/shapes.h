@@ -13,8 +13,10 @@
 #include "shapes/plane_math.h"
 #include "shapes/sphere_math.h"
 #include "shapes/torus_math.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct TorusMath {
     template <class V>
@@ -42,4 +44,5 @@ decltype(auto) visit_shape(ShapeKind k, F&& f) {
     return f(PlaneMath{});
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -2,8 +2,10 @@
 // Canonical sphere: unit radius, centred at the origin.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct SphereMath {
     /// Nearest t in (t_min, t_max) with |o + t d| = 1, or +inf. d need not be unit length.
@@ -28,4 +30,5 @@ struct SphereMath {
     static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) { return p; }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -26,8 +26,10 @@
 
 #include "core/vec3.h"
 #include "simd/lanes.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 namespace torus_detail {
 
@@ -328,4 +330,5 @@ Vec3T<V> torus_normal(const Vec3T<V>& p, V minor) {
     return {p.x - sgn * ux, p.y, p.z - sgn * uz};
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -9,7 +9,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "simd/isa_namespace.h"
+
 namespace streamrt::simd {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 inline float select(bool m, float a, float b) { return m ? a : b; }
 inline double select(bool m, double a, double b) { return m ? a : b; }
@@ -91,12 +94,16 @@ class FlushDenormals {
     unsigned saved_;
 };
 
+STREAMRT_ISA_END
+
 /// Widest batch we build (AVX-512: 16 floats). Streams are padded to it in every build so the
 /// layout is the same at 4, 8 and 16 lanes and aligned loads are always legal.
 inline constexpr std::size_t kMaxLanes = 16;
 inline constexpr std::size_t kAlign = 64;
 template <class T>
 using AlignedVec = std::vector<T, xsimd::aligned_allocator<T, kAlign>>;
+STREAMRT_ISA_BEGIN
 constexpr std::size_t round_up_lanes(std::size_t n) { return (n + kMaxLanes - 1) / kMaxLanes * kMaxLanes; }
+STREAMRT_ISA_END
 
 }  // namespace streamrt::simd
