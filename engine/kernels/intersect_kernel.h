@@ -36,12 +36,12 @@ template <class B, class T>
 inline RayPacket<B> to_canonical(const RayPacket<B>& r, const ObjectXf& ob) {
     const auto m = [&](int i) { return B(T(ob.m[i])); };
     RayPacket<B> c;
-    c.o.x = xsimd::fma(m(0), r.o.x, xsimd::fma(m(1), r.o.y, xsimd::fma(m(2), r.o.z, m(3))));
-    c.o.y = xsimd::fma(m(4), r.o.x, xsimd::fma(m(5), r.o.y, xsimd::fma(m(6), r.o.z, m(7))));
-    c.o.z = xsimd::fma(m(8), r.o.x, xsimd::fma(m(9), r.o.y, xsimd::fma(m(10), r.o.z, m(11))));
-    c.d.x = xsimd::fma(m(0), r.d.x, xsimd::fma(m(1), r.d.y, m(2) * r.d.z));
-    c.d.y = xsimd::fma(m(4), r.d.x, xsimd::fma(m(5), r.d.y, m(6) * r.d.z));
-    c.d.z = xsimd::fma(m(8), r.d.x, xsimd::fma(m(9), r.d.y, m(10) * r.d.z));
+    c.o.x = simd::mul_add(m(0), r.o.x, simd::mul_add(m(1), r.o.y, simd::mul_add(m(2), r.o.z, m(3))));
+    c.o.y = simd::mul_add(m(4), r.o.x, simd::mul_add(m(5), r.o.y, simd::mul_add(m(6), r.o.z, m(7))));
+    c.o.z = simd::mul_add(m(8), r.o.x, simd::mul_add(m(9), r.o.y, simd::mul_add(m(10), r.o.z, m(11))));
+    c.d.x = simd::mul_add(m(0), r.d.x, simd::mul_add(m(1), r.d.y, m(2) * r.d.z));
+    c.d.y = simd::mul_add(m(4), r.d.x, simd::mul_add(m(5), r.d.y, m(6) * r.d.z));
+    c.d.z = simd::mul_add(m(8), r.d.x, simd::mul_add(m(9), r.d.y, m(10) * r.d.z));
     return c;
 }
 

@@ -33,22 +33,22 @@ struct LaneRows {
 
 template <class B, class M>
 inline Vec3T<B> apply_point(const M& m, const Vec3T<B>& p) {
-    return {xsimd::fma(m[0], p.x, xsimd::fma(m[1], p.y, xsimd::fma(m[2], p.z, m[3]))),
-            xsimd::fma(m[4], p.x, xsimd::fma(m[5], p.y, xsimd::fma(m[6], p.z, m[7]))),
-            xsimd::fma(m[8], p.x, xsimd::fma(m[9], p.y, xsimd::fma(m[10], p.z, m[11])))};
+    return {simd::mul_add(m[0], p.x, simd::mul_add(m[1], p.y, simd::mul_add(m[2], p.z, m[3]))),
+            simd::mul_add(m[4], p.x, simd::mul_add(m[5], p.y, simd::mul_add(m[6], p.z, m[7]))),
+            simd::mul_add(m[8], p.x, simd::mul_add(m[9], p.y, simd::mul_add(m[10], p.z, m[11])))};
 }
 template <class B, class M>
 inline Vec3T<B> apply_vector(const M& m, const Vec3T<B>& v) {
-    return {xsimd::fma(m[0], v.x, xsimd::fma(m[1], v.y, m[2] * v.z)),
-            xsimd::fma(m[4], v.x, xsimd::fma(m[5], v.y, m[6] * v.z)),
-            xsimd::fma(m[8], v.x, xsimd::fma(m[9], v.y, m[10] * v.z))};
+    return {simd::mul_add(m[0], v.x, simd::mul_add(m[1], v.y, m[2] * v.z)),
+            simd::mul_add(m[4], v.x, simd::mul_add(m[5], v.y, m[6] * v.z)),
+            simd::mul_add(m[8], v.x, simd::mul_add(m[9], v.y, m[10] * v.z))};
 }
 /// Mn n with Mn = (Mi's linear part) transposed, read from Mi's row-major 3x4 rows.
 template <class B, class M>
 inline Vec3T<B> apply_normal(const M& mi, const Vec3T<B>& n) {
-    return normalize(Vec3T<B>{xsimd::fma(mi[0], n.x, xsimd::fma(mi[4], n.y, mi[8] * n.z)),
-                              xsimd::fma(mi[1], n.x, xsimd::fma(mi[5], n.y, mi[9] * n.z)),
-                              xsimd::fma(mi[2], n.x, xsimd::fma(mi[6], n.y, mi[10] * n.z))});
+    return normalize(Vec3T<B>{simd::mul_add(mi[0], n.x, simd::mul_add(mi[4], n.y, mi[8] * n.z)),
+                              simd::mul_add(mi[1], n.x, simd::mul_add(mi[5], n.y, mi[9] * n.z)),
+                              simd::mul_add(mi[2], n.x, simd::mul_add(mi[6], n.y, mi[10] * n.z))});
 }
 
 template <class B>

@@ -181,12 +181,11 @@ inline DirectLight<V> direct_light(int degree, const MaterialT<T>& m, const Colo
     if (degree == 1) return {base * k, lit};
     ColorT<V> c = base * (V(m.diff) * k);
     if (m.spec > T(0)) {
-        using std::pow;
         const Vec3T<V> r = n * (V(2) * ndotw) - s.w;  // w mirrored about n
         const V rv = -dot(r, view);
         const auto shiny = lit && (rv > zero) && (rv > V(m.spec_cutoff));
         if (any(shiny)) {
-            const V h = select(shiny, V(m.spec) * pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
+            const V h = select(shiny, V(m.spec) * simd::pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
             c = c + ColorT<V>{h, h, h};
         }
     }

@@ -9,7 +9,7 @@ Exits 1 when a picture differs (or a render fails) and 0 when every scene gives 
 at every level.
 
     python3 tests/kernels/isa_pictures.py --streamrt build/streamrt [--width 96 --height 64 --spp 2]
-        [--accel auto|off|packet|single] [--shade ...] [SCENE.cfg ...]
+        [--accel auto|off|packet|single] [--shade ...] [--degree N] [SCENE.cfg ...]
 
 Without scene arguments: every scene in scenes/ (and its sub-folders) and in
 tests/reference/scenes/, except scenes/degrees/common.cfg (the shared part of degree*.cfg,
@@ -57,6 +57,7 @@ def main() -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--accel", default=None, help="passed to streamrt --accel")
     ap.add_argument("--shade", default=None, help="passed to streamrt --shade")
+    ap.add_argument("--degree", default=None, help="passed to streamrt --degree")
     ap.add_argument("scenes", nargs="*")
     args = ap.parse_args()
     scenes = [pathlib.Path(s) for s in args.scenes] or default_scenes()
@@ -77,6 +78,8 @@ def main() -> int:
                     cmd += ["--accel", args.accel]
                 if args.shade:
                     cmd += ["--shade", args.shade]
+                if args.degree:
+                    cmd += ["--degree", args.degree]
                 r = subprocess.run(cmd, capture_output=True, text=True)
                 if r.returncode != 0:
                     print(f"{scene}: --isa {level} failed: {r.stderr.strip()}")
