@@ -8,8 +8,10 @@
 
 #include "scene/scene.h"
 #include "simd/lanes.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 /// A 32-bit integer hash with good avalanche (xor-shift-multiply, "lowbias32" constants).
 /// U is std::uint32_t or an xsimd batch of it.
@@ -74,4 +76,5 @@ inline PixelSample pixel_sample(SamplePattern pattern, int spp, std::uint64_t pi
                           unit_from_hash(h1), unit_from_hash(h2));
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -11,6 +11,7 @@
 #include "core/vec3.h"
 #include "render/render_stats.h"
 #include "scene/scene.h"
+#include "simd/isa_namespace.h"
 #include "simd/lanes.h"
 
 namespace streamrt {
@@ -20,6 +21,8 @@ using ColorT = Vec3T<T>;
 
 template <class V>
 using MaskOf = decltype(V() < V());
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 template <class V, class M>
 inline Vec3T<V> select3(const M& m, const Vec3T<V>& a, const Vec3T<V>& b) {
@@ -31,6 +34,8 @@ template <class V, class T>
 inline Vec3T<V> splat(const Vec3T<T>& a) {
     return {V(a.x), V(a.y), V(a.z)};
 }
+
+STREAMRT_ISA_END
 
 /// A material in the engine's precision. The object's own colour (Object::color) is passed
 /// beside it wherever a surface colour is needed.
@@ -69,6 +74,8 @@ struct LightT {
                 T(std::cos(l.angle * 3.14159265358979323846 / 180.0))};
     }
 };
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 namespace detail {
 /// G(x) = integral from 0 to x of [floor(u) is odd] du; G(x + 2) = G(x) + 1.
@@ -175,12 +182,11 @@ inline DirectLight<V> direct_light(int degree, const MaterialT<T>& m, const Colo
     if (degree == 1) return {base * k, lit};
     ColorT<V> c = base * (V(m.diff) * k);
     if (m.spec > T(0)) {
-        using std::pow;
         const Vec3T<V> r = n * (V(2) * ndotw) - s.w;  // w mirrored about n
         const V rv = -dot(r, view);
         const auto shiny = lit && (rv > zero) && (rv > V(m.spec_cutoff));
         if (any(shiny)) {
-            const V h = select(shiny, V(m.spec) * pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
+            const V h = select(shiny, V(m.spec) * simd::pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
             c = c + ColorT<V>{h, h, h};
         }
     }
@@ -249,7 +255,10 @@ inline Vec3T<V> offset_ray_origin(const Vec3T<V>& p, const Vec3T<V>& n, const Ve
     return p + n * step;
 }
 
-/// What the shading rules take from the render settings, in the engine's precision.
+STREAMRT_ISA_END
+
+/// What the shading rules take from the render settings, in the engine's precision (a data
+/// type the kernels' jobs carry: outside the per-level namespaces).
 template <class T>
 struct ShadeRules {
     int degree;
@@ -275,6 +284,8 @@ struct ArrivingRay {
     /// the cut-off compares.
     ColorT<V> throughput;
 };
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 /// The handout's shading of one hit (or one packet of hits), written once for the recursive
 /// baseline (V = double, one ray), the stream engine's scalar path (float) and its SIMD
@@ -359,4 +370,5 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
     }
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -3,8 +3,10 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct ConeMath {
     static constexpr ShapeKind kind = ShapeKind::Cone;
@@ -56,4 +58,5 @@ struct ConeMath {
     }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -3,8 +3,10 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct CubeMath {
     static constexpr ShapeKind kind = ShapeKind::Cube;
@@ -50,4 +52,5 @@ struct CubeMath {
     }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -3,8 +3,10 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct CylinderMath {
     static constexpr ShapeKind kind = ShapeKind::Cylinder;
@@ -44,4 +46,5 @@ struct CylinderMath {
     }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

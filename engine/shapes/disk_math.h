@@ -4,8 +4,10 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct DiskMath {
     static constexpr ShapeKind kind = ShapeKind::Disk;
@@ -29,4 +31,5 @@ struct DiskMath {
     static Vec3T<V> normal(const Vec3T<V>& /*p*/, V /*param*/) { return {V(0), V(1), V(0)}; }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -23,8 +23,10 @@
 #include "shapes/shape_traits.h"
 #include "shapes/sphere_math.h"
 #include "shapes/torus_math.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 namespace shape_detail {
 /// Names the first member a would-be shape lacks (a plainer message than the concept's).
@@ -168,4 +170,5 @@ constexpr bool shape_computes_in_double(ShapeKind k) {
     return dbl;
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -3,8 +3,10 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct SphereMath {
     static constexpr ShapeKind kind = ShapeKind::Sphere;
@@ -36,4 +38,5 @@ struct SphereMath {
     static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) { return p; }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -27,8 +27,10 @@
 #include "core/vec3.h"
 #include "shapes/shape_traits.h"
 #include "simd/lanes.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 namespace torus_detail {
 
@@ -348,4 +350,5 @@ struct TorusMath {
     static Vec3T<V> normal(const Vec3T<V>& p, V minor) { return torus_normal(p, minor); }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -11,8 +11,8 @@ import sys
 
 # Lowest first. Folders on one line are peers: neither may include the other.
 LAYERS = [
-    ["simd", "parallel"],
-    ["core"],
+    ["simd"],
+    ["core", "parallel"],
     ["shapes"],
     ["accel"],
     ["mesh"],
