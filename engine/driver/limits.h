@@ -19,7 +19,7 @@ struct MemoryEstimate {
     int generations = 0;           ///< stream engine: generations whose rays may be held at once
 };
 
-/// The stream engine traces at most slice = max(4096, spp) rays of a generation at once and
+/// The stream engine traces at most slice = max(16384, spp) rays of a generation at once and
 /// the generations deepest first (stream/stages.h, trace_generation): per thread it holds at
 /// most 2 x slice rays per generation a ray can reach (depth + 2 with mirrors or glass, else 1),
 /// plus a few slice-sized buffers; linear in depth, never 2^depth.

@@ -35,7 +35,7 @@ class StreamRenderer {
     /// Generations are traced deepest first in slices of at most max(kSliceRays, spp) rays
     /// (stages.h, trace_generation): per thread, at most 2 x that many rays are held per
     /// generation reached, whatever the depth.
-    static constexpr std::size_t kSliceRays = 4096;
+    static constexpr std::size_t kSliceRays = 16384;
     /// The slice size used for a scene with `spp` samples per pixel (slice_rays 0).
     static std::size_t default_slice_rays(int spp) { return std::max(kSliceRays, std::size_t(spp)); }
 

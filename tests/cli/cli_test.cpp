@@ -171,7 +171,7 @@ TEST_CASE("cli: absurd scene values are refused with their location") {
 TEST_CASE("cli: a render that cannot fit in memory is refused before it starts") {
     Dir d;
     // Glass that both reflects and transmits at depth 256: the stream engine traces it in
-    // bounded memory (slices of max(4096, spp) rays, about 1.6 GiB a thread at spp 65536),
+    // bounded memory (slices of max(16384, spp) rays, about 1.6 GiB a thread at spp 65536),
     // which 64 threads cannot have on any machine this runs on.
     const fs::path scene = d.write("deep.cfg",
                                    "image width=64 height=64 depth=256 degree=5 spp=65536\n"

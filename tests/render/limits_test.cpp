@@ -18,7 +18,7 @@ TEST_CASE("limits: the estimate counts the framebuffer, the output and the per-t
     // deflate bound 15050 + 16 + 64, one deflate state 270336. PNG needs the most.
     CHECK(e.output_bytes == 600 + 15050 + 15130 + 270336);
     CHECK(e.generations == 1);  // no mirror: one generation, never more
-    CHECK(e.slice_rays == 4096);
+    CHECK(e.slice_rays == 16384);
     CHECK(e.threads == 4);
     CHECK(e.total_bytes == doctest::Approx(e.framebuffer_bytes + e.output_bytes + 4 * e.per_thread_bytes));
 
@@ -36,11 +36,11 @@ TEST_CASE("limits: the stream engine's memory grows linearly with depth, never a
     mirror.settings.degree = 2;  // no reflection below degree 3
     CHECK(estimate_render_memory(mirror, true, 1).generations == 1);
     // Each further level costs at most two slices of rays (49 bytes each), whatever the
-    // materials: 2 x 4096 x 49 bytes per level and thread.
+    // materials: 2 x 16384 x 49 bytes per level and thread.
     glass.settings.depth = 256;
     const MemoryEstimate e256 = estimate_render_memory(glass, true, 1);
-    CHECK(e256.per_thread_bytes - e10.per_thread_bytes == doctest::Approx(246.0 * 2 * 4096 * 49));
-    CHECK(e256.per_thread_bytes < 128.0 * 1024 * 1024);  // depth 256: about 105 MB a thread
+    CHECK(e256.per_thread_bytes - e10.per_thread_bytes == doctest::Approx(246.0 * 2 * 16384 * 49));
+    CHECK(e256.per_thread_bytes < 512.0 * 1024 * 1024);  // depth 256: about 420 MB a thread
     // The recursive engine's memory is its stack.
     CHECK(estimate_render_memory(glass, false, 1).total_bytes < 1e8);
 }
@@ -69,7 +69,7 @@ TEST_CASE("limits: a render above the limit is refused with what it would need")
                                 "light point pos=0,5,5\nlight point pos=3,5,5\n",
                                 "t.cfg");
     CHECK_NOTHROW(check_render_memory(whitted, true, 2));
-    CHECK(estimate_render_memory(whitted, true, 2).total_bytes < 64.0 * 1024 * 1024);
+    CHECK(estimate_render_memory(whitted, true, 2).total_bytes < 80.0 * 1024 * 1024);
     Scene deep = parse_scene("image depth=256\nsphere refl=0.5 trans=0.5\n", "t.cfg");
     CHECK_NOTHROW(check_render_memory(deep, true, 2));
     CHECK_NOTHROW(check_render_memory(deep, false, 1));
