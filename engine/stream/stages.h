@@ -1,6 +1,7 @@
 #pragma once
 // The stages of the stream pipeline, specialised at compile time on the features a scene
-// uses. Read run_chunk() top to bottom: it is the whole algorithm for one chunk of a tile.
+// uses. Read run_chunk(), trace_generation() and trace_slice() top to bottom: they are the
+// whole algorithm for one chunk of a tile.
 #include <algorithm>
 #include <cstdint>
 #include <limits>
@@ -82,8 +83,8 @@ struct Workspace {
     }
     void give(RayStream&& r) { spare.push_back(std::move(r)); }
     std::vector<std::uint32_t> pixel_rays, pixel_slice;  ///< per tile pixel (cut_into_slices)
-    AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of `current`
-    MeshHits mesh_hits;               ///< triangle and barycentrics per ray of `current` (mesh hits)
+    AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of the slice traced
+    MeshHits mesh_hits;               ///< triangle and barycentrics per ray of the slice (mesh hits)
     ShadowStream shadows, shadows_in_pixel_order;
     SortedHits sorted;
     std::vector<std::uint32_t> slot;

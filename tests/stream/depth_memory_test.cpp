@@ -134,10 +134,10 @@ TEST_CASE("depth: slices smaller than a pixel's rays stay deterministic and clos
     CHECK(d.max_abs < 1e-5);
 }
 
-TEST_CASE("depth: Whitted at depth 16 and 32 renders and matches the recursive baseline") {
-    for (int depth : {16, 32}) {
+TEST_CASE("depth: Whitted at depth 16, 32 and 256 renders and matches the recursive baseline") {
+    for (int depth : {16, 32, 256}) {
         CAPTURE(depth);
-        const Scene s = whitted(96, 72, 2, depth);
+        const Scene s = depth <= 32 ? whitted(96, 72, 2, depth) : whitted(48, 36, 1, depth);
         const Framebuffer stream = render_with(s, EngineKind::Stream, 2);
         const Framebuffer recursive = render_with(s, EngineKind::Recursive, 2);
         const ImageDifference d = compare_images(stream, recursive);
