@@ -51,8 +51,9 @@ bool same_bits(const Framebuffer& a, const Framebuffer& b) {
 }
 
 /// Peak resident memory (KiB, VmHWM) of one `streamrt` run with these arguments, which must
-/// succeed. Read when the child is about to exit (ptrace's exit stop, its memory still
-/// mapped): wait4's ru_maxrss would not do, Linux carries the parent's peak across the exec.
+/// succeed; -1 where this process may not trace its children. Read when the child is about
+/// to exit (ptrace's exit stop, its memory still mapped): wait4's ru_maxrss would not do,
+/// Linux carries the parent's peak across the exec.
 long child_peak_rss_kib(const std::vector<std::string>& args) {
     std::vector<char*> argv{const_cast<char*>(STREAMRT_BINARY)};
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
@@ -60,12 +61,13 @@ long child_peak_rss_kib(const std::vector<std::string>& args) {
     const pid_t pid = ::fork();
     REQUIRE(pid >= 0);
     if (pid == 0) {
-        ::ptrace(PTRACE_TRACEME, 0, nullptr, nullptr);
+        if (::ptrace(PTRACE_TRACEME, 0, nullptr, nullptr) != 0) ::_exit(126);  // not allowed here
         ::execv(STREAMRT_BINARY, argv.data());
         ::_exit(127);
     }
     int status = 0;
     REQUIRE(::waitpid(pid, &status, 0) == pid);  // stopped at the exec
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 126) return -1;
     REQUIRE(WIFSTOPPED(status));
     REQUIRE(::ptrace(PTRACE_SETOPTIONS, pid, nullptr, reinterpret_cast<void*>(long(PTRACE_O_TRACEEXIT))) == 0);
     long peak = -1;
@@ -155,6 +157,10 @@ TEST_CASE("depth: peak memory at depth 16 and 32 stays within a few MB of depth 
                                    std::to_string(depth), "-j", "2", "-q", "-o", out.string()});
     };
     const long d5 = peak(5), d16 = peak(16), d32 = peak(32);
+    if (d5 < 0) {
+        WARN_MESSAGE(false, "ptrace(PTRACE_TRACEME) is not allowed here: peak memory not measured");
+        return;
+    }
     MESSAGE("peak RSS, KiB: depth 5 " << d5 << ", depth 16 " << d16 << ", depth 32 " << d32);
     CHECK(d16 - d5 < 3 * 1024);
     CHECK(d32 - d5 < 3 * 1024);
