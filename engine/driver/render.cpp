@@ -27,7 +27,7 @@ class PreparedRecursive final : public PreparedRender {
 class PreparedStream final : public PreparedRender {
   public:
     PreparedStream(const Scene& scene, const EngineOptions& options)
-        : renderer_(scene, options.isa, options.shade), profile_(options.profile) {}
+        : renderer_(scene, options.isa, options.shade, options.slice_rays), profile_(options.profile) {}
     Framebuffer render(Parallelism& par, RenderProgress* progress) override {
         return renderer_.render(par, progress, profile_);
     }

@@ -1,5 +1,6 @@
 #pragma once
 // One entry point for both engines, used by the command line, the tests and perf/.
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -27,6 +28,7 @@ struct EngineOptions {
     Isa isa = best_isa();               ///< stream engine: kernel level
     StreamProfile* profile = nullptr;   ///< stream engine: per-stage figures, when wanted
     ShadeMode shade = ShadeMode::Auto;  ///< stream engine: how the shade stage groups hits
+    std::size_t slice_rays = 0;         ///< stream engine: most rays traced at once (0: default; tests)
 };
 
 /// An engine with its set-up done (tables, hierarchy), ready to render.

@@ -1018,10 +1018,13 @@ class Parser {
 Scene load_scene(const std::string& path, const ReadOptions& options) {
     FileText text;
     if (!text.open(fs::path(path))) throw SceneError(SourceLoc{path, 0, 0}, "cannot open scene file");
-    Parser p(options);
-    p.scene.path = path;
-    p.read_top(text.text(), path, identity_of(path), text.mapped());
-    return std::move(p.scene);
+    // Everything reading starts (meshes, their hierarchies) runs in options.jobs threads.
+    return Parallelism(options.jobs).run([&] {
+        Parser p(options);
+        p.scene.path = path;
+        p.read_top(text.text(), path, identity_of(path), text.mapped());
+        return std::move(p.scene);
+    });
 }
 
 Scene load_scene(const std::string& path, int jobs) {
@@ -1031,10 +1034,12 @@ Scene load_scene(const std::string& path, int jobs) {
 }
 
 Scene parse_scene(std::string_view text, const std::string& name, const ReadOptions& options) {
-    Parser p(options);
-    p.scene.path = name;
-    p.read_top(text, name, identity_of(name.empty() ? fs::path("<memory>") : fs::path(name)), false);
-    return std::move(p.scene);
+    return Parallelism(options.jobs).run([&] {
+        Parser p(options);
+        p.scene.path = name;
+        p.read_top(text, name, identity_of(name.empty() ? fs::path("<memory>") : fs::path(name)), false);
+        return std::move(p.scene);
+    });
 }
 
 Scene parse_scene(std::string_view text, const std::string& name) { return parse_scene(text, name, ReadOptions{}); }

@@ -1,6 +1,7 @@
 #pragma once
 // The stages of the stream pipeline, specialised at compile time on the features a scene
-// uses. Read run_chunk() top to bottom: it is the whole algorithm for one chunk of a tile.
+// uses. Read run_chunk(), trace_generation() and trace_slice() top to bottom: they are the
+// whole algorithm for one chunk of a tile.
 #include <algorithm>
 #include <cstdint>
 #include <limits>
@@ -67,9 +68,23 @@ struct GenerateScratch {
 /// Per-thread buffers, reused from chunk to chunk.
 struct Workspace {
     GenerateScratch generate;
-    RayStream current, next;
-    AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of `current`
-    MeshHits mesh_hits;               ///< triangle and barycentrics per ray of `current` (mesh hits)
+    RayStream current;  ///< camera rays
+    RayStream next;     ///< the rays a slice spawns (swapped in and out around the shade stage)
+    /// Buffers of generations no longer in use (PipelineStages::trace_generation takes and
+    /// gives back), so a thread holds as many as were ever in use at once.
+    std::vector<RayStream> spare;
+    RayStream regroup;  ///< a generation regrouped into slices (cut_into_slices)
+    RayStream take() {
+        if (spare.empty()) return RayStream{};
+        RayStream r = std::move(spare.back());
+        spare.pop_back();
+        r.count = 0;
+        return r;
+    }
+    void give(RayStream&& r) { spare.push_back(std::move(r)); }
+    std::vector<std::uint32_t> pixel_rays, pixel_slice;  ///< per tile pixel (cut_into_slices)
+    AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of the slice traced
+    MeshHits mesh_hits;               ///< triangle and barycentrics per ray of the slice (mesh hits)
     ShadowStream shadows, shadows_in_pixel_order;
     SortedHits sorted;
     std::vector<std::uint32_t> slot;
@@ -107,6 +122,68 @@ inline void add(float* accum, std::int32_t pixel, const ColorT<float>& c) {
 }
 inline std::uint64_t lanes_for(std::size_t n, int width) {
     return (std::uint64_t(n) + std::uint64_t(width) - 1) / std::uint64_t(width) * std::uint64_t(width);
+}
+
+/// Copies rays [from, from + n) of `src` into `dst` (which then holds exactly them).
+inline void copy_rays(const RayStream& src, std::size_t from, std::size_t n, RayStream& dst) {
+    dst.reserve(n);
+    for (auto a : {&RayStream::ox, &RayStream::oy, &RayStream::oz, &RayStream::dx, &RayStream::dy, &RayStream::dz,
+                   &RayStream::t_max, &RayStream::wr, &RayStream::wg, &RayStream::wb, &RayStream::cone})
+        std::copy_n((src.*a).begin() + std::ptrdiff_t(from), n, (dst.*a).begin());
+    std::copy_n(src.pixel.begin() + std::ptrdiff_t(from), n, dst.pixel.begin());
+    std::copy_n(src.kind.begin() + std::ptrdiff_t(from), n, dst.kind.begin());
+    dst.count = n;
+}
+
+/// Cuts a generation of more than `cap` rays into slices of at most `cap` rays that each
+/// hold all the rays of their pixels (pixels in order, as many whole pixels as fit), and
+/// regroups `gen` so each slice is contiguous, keeping the rays' order within a slice. A
+/// pixel with more than `cap` rays alone is cut, in stream order, into slices of its own.
+/// Returns the slices' bounds in `gen` (first 0, last gen.count). `scratch` ends holding the
+/// generation's former buffer.
+inline std::vector<std::size_t> cut_into_slices(RayStream& gen, RayStream& scratch, std::size_t cap,
+                                                std::size_t tile_pixels, std::vector<std::uint32_t>& pixel_rays,
+                                                std::vector<std::uint32_t>& pixel_slice) {
+    pixel_rays.assign(tile_pixels, 0);
+    for (std::size_t i = 0; i < gen.count; ++i) ++pixel_rays[std::size_t(gen.pixel[i])];
+    // Each pixel's first slice: pixels are packed greedily, in pixel order.
+    pixel_slice.assign(tile_pixels, 0);
+    std::vector<std::size_t> size;  // rays per slice
+    std::size_t fill = cap;         // rays in the last slice (cap: full, open a new one)
+    for (std::size_t p = 0; p < tile_pixels; ++p) {
+        const std::size_t n = pixel_rays[p];
+        if (n == 0) continue;
+        if (n > cap) {
+            pixel_slice[p] = std::uint32_t(size.size());
+            for (std::size_t left = n; left > 0; left -= std::min(left, cap)) size.push_back(std::min(left, cap));
+            fill = cap;
+            continue;
+        }
+        if (fill + n > cap) size.push_back(0), fill = 0;
+        pixel_slice[p] = std::uint32_t(size.size() - 1);
+        size.back() += n;
+        fill += n;
+    }
+    std::vector<std::size_t> bounds(size.size() + 1, 0);
+    for (std::size_t k = 0; k < size.size(); ++k) bounds[k + 1] = bounds[k] + size[k];
+    // A stable counting sort by slice; a cut pixel's k-th ray goes to its slice k / cap.
+    std::vector<std::size_t> at(bounds.begin(), bounds.end() - 1);
+    pixel_rays.assign(tile_pixels, 0);  // now: the pixel's rays placed so far
+    scratch.reserve(gen.count);
+    for (std::size_t i = 0; i < gen.count; ++i) {
+        const std::size_t p = std::size_t(gen.pixel[i]);
+        const std::size_t j = at[pixel_slice[p] + pixel_rays[p]++ / cap]++;
+        scratch.ox[j] = gen.ox[i], scratch.oy[j] = gen.oy[i], scratch.oz[j] = gen.oz[i];
+        scratch.dx[j] = gen.dx[i], scratch.dy[j] = gen.dy[i], scratch.dz[j] = gen.dz[i];
+        scratch.t_max[j] = gen.t_max[i];
+        scratch.wr[j] = gen.wr[i], scratch.wg[j] = gen.wg[i], scratch.wb[j] = gen.wb[i];
+        scratch.cone[j] = gen.cone[i];
+        scratch.pixel[j] = gen.pixel[i];
+        scratch.kind[j] = gen.kind[i];
+    }
+    scratch.count = gen.count;
+    std::swap(gen, scratch);
+    return bounds;
 }
 
 }  // namespace stage_detail
@@ -461,54 +538,116 @@ struct PipelineStages {
             if (shadows.t_max[i] > 0.f) stage_detail::add(accum, shadows.pixel[i], {shadows.cr[i], shadows.cg[i], shadows.cb[i]});
     }
 
+    /// What the stages of one chunk share.
+    struct Chunk {
+        const StreamScene& sc;
+        const KernelTable& kt;
+        const Tile& tile;
+        Workspace& ws;
+        float* accum;
+        RayCounts& counts;
+        StreamProfile* profile;
+        ShadeMode shade_mode;
+        std::size_t slice_rays;  ///< the most rays traced at once
+        StageFigures* fig(Stage s) const { return profile ? &profile->stages[int(s)] : nullptr; }
+    };
+
+    /// One slice of generation `depth`: intersect, shade, occlusion; the rays it spawns (at
+    /// most two per ray) go to `spawned`.
+    static void trace_slice(const Chunk& c, int depth, RayStream& rays, RayStream& spawned) {
+        const StreamScene& sc = c.sc;
+        Workspace& ws = c.ws;
+        std::swap(ws.next, spawned);  // the shade stage appends to ws.next
+        {
+            StageTimer timer(c.fig(Stage::Intersect));
+            intersect(sc, c.kt, rays, ws.object, ws.mesh_hits, c.fig(Stage::Intersect));
+            if (c.profile) c.fig(Stage::Intersect)->rays_in += rays.count, c.fig(Stage::Intersect)->rays_out += rays.count;
+        }
+        {
+            StageTimer timer(c.fig(Stage::Shade));
+            // Room for every ray spawning both children and a shadow ray per light.
+            ws.next.reserve(kSecondary ? rays.count * 2 : 0);
+            if constexpr (kShadows) ws.shadows.reserve(rays.count * sc.lights.size());
+            if (c.shade_mode == ShadeMode::Scalar)
+                shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, c.accum, c.counts);
+            else
+                shade_sorted(sc, c.kt, rays, ws.object, depth, ws, c.accum, c.counts, c.shade_mode == ShadeMode::Gathered);
+            if (kShadows && c.shade_mode == ShadeMode::Gathered)
+                order_shadows_by_pixel(ws, std::size_t(c.tile.width() * c.tile.height()));
+            if (c.profile) {
+                c.fig(Stage::Shade)->rays_in += rays.count;
+                c.fig(Stage::Shade)->rays_out += ws.next.count + (kShadows ? ws.shadows.count : 0);
+            }
+        }
+        if constexpr (kShadows) {
+            StageTimer timer(c.fig(Stage::Occlusion));
+            c.counts.shadow += ws.shadows.count;
+            occlusion(sc, c.kt, ws.shadows, c.accum, c.fig(Stage::Occlusion));
+            if (c.profile) {
+                c.fig(Stage::Occlusion)->rays_in += ws.shadows.count;
+                for (std::size_t i = 0; i < ws.shadows.count; ++i) c.fig(Stage::Occlusion)->rays_out += ws.shadows.t_max[i] > 0.f;
+            }
+        }
+        std::swap(ws.next, spawned);
+        rays.count = 0;  // traced
+    }
+
+    /// Traces generation `depth` and everything it spawns, deepest first: a generation of
+    /// more than slice_rays rays is cut into slices, and each slice's descendants are traced
+    /// before the next slice. A slice spawns at most twice its rays, so the rays held are at
+    /// most 2 x slice_rays for each generation on the way down, whatever the depth, instead
+    /// of 2^depth; a generation traced whole gives its buffer back before its children are
+    /// traced, so chains of such generations reuse the same few buffers.
+    /// The slices hold whole pixels (cut_into_slices) and pixels do not interact, so each
+    /// pixel gets the same terms as when every generation is traced whole; one ray at a time
+    /// (scalar shading) in the same order, bit for bit. Only a pixel with more than
+    /// slice_rays rays in one generation is cut itself. Either way, the order is fixed by the
+    /// tile's content: the same picture for every -j.
+    static void trace_generation(const Chunk& c, int depth, RayStream&& rays) {
+        Workspace& ws = c.ws;
+        RayStream gen = std::move(rays);
+        if (gen.count <= c.slice_rays) {  // whole: no copy
+            RayStream spawned = ws.take();
+            trace_slice(c, depth, gen, spawned);
+            ws.give(std::move(gen));
+            descend(c, depth, std::move(spawned));
+            return;
+        }
+        const std::vector<std::size_t> bounds =
+            stage_detail::cut_into_slices(gen, ws.regroup, c.slice_rays, std::size_t(c.tile.width() * c.tile.height()),
+                                          ws.pixel_rays, ws.pixel_slice);
+        for (std::size_t k = 0; k + 1 < bounds.size(); ++k) {
+            RayStream slice = ws.take(), spawned = ws.take();
+            stage_detail::copy_rays(gen, bounds[k], bounds[k + 1] - bounds[k], slice);
+            trace_slice(c, depth, slice, spawned);
+            ws.give(std::move(slice));
+            descend(c, depth, std::move(spawned));
+        }
+        gen.count = 0;
+        ws.give(std::move(gen));
+    }
+
+    /// The rays generation `depth` spawned: traced, or (none) their buffer given back.
+    static void descend(const Chunk& c, int depth, RayStream&& spawned) {
+        if (kSecondary && spawned.count > 0) trace_generation(c, depth + 1, std::move(spawned));
+        else c.ws.give(std::move(spawned));
+    }
+
+    /// The whole algorithm for one chunk of a tile: camera rays, then every generation they
+    /// spawn (trace_generation). slice_rays: the most rays traced at once.
     static void run_chunk(const StreamScene& sc, const KernelTable& kt, const Tile& tile, int first, int n_pixels,
                           Workspace& ws, float* accum, RayCounts& counts, StreamProfile* profile,
-                          ShadeMode shade_mode) {
-        const auto fig = [&](Stage s) { return profile ? &profile->stages[int(s)] : nullptr; };
-        const std::size_t lights = sc.lights.size();
+                          ShadeMode shade_mode, std::size_t slice_rays) {
+        const Chunk c{sc, kt, tile, ws, accum, counts, profile, shade_mode, std::max<std::size_t>(1, slice_rays)};
         {
-            StageTimer timer(fig(Stage::Generate));
+            StageTimer timer(c.fig(Stage::Generate));
             generate(sc, kt, tile, first, n_pixels, ws);
             counts.primary += ws.current.count;
-            if (profile) fig(Stage::Generate)->rays_out += ws.current.count, fig(Stage::Generate)->rays_in += std::uint64_t(n_pixels);
+            if (profile) c.fig(Stage::Generate)->rays_out += ws.current.count, c.fig(Stage::Generate)->rays_in += std::uint64_t(n_pixels);
         }
-        for (int depth = 0; ws.current.count > 0; ++depth) {
-            RayStream& rays = ws.current;
-            {
-                StageTimer timer(fig(Stage::Intersect));
-                intersect(sc, kt, rays, ws.object, ws.mesh_hits, fig(Stage::Intersect));
-                if (profile) fig(Stage::Intersect)->rays_in += rays.count, fig(Stage::Intersect)->rays_out += rays.count;
-            }
-            {
-                StageTimer timer(fig(Stage::Shade));
-                // Room for every ray spawning both children and a shadow ray per light.
-                ws.next.reserve(kSecondary ? rays.count * 2 : 0);
-                if constexpr (kShadows) ws.shadows.reserve(rays.count * lights);
-                if (shade_mode == ShadeMode::Scalar)
-                    shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, accum, counts);
-                else
-                    shade_sorted(sc, kt, rays, ws.object, depth, ws, accum, counts, shade_mode == ShadeMode::Gathered);
-                if (kShadows && shade_mode == ShadeMode::Gathered) order_shadows_by_pixel(ws, std::size_t(tile.width() * tile.height()));
-                if (profile) {
-                    fig(Stage::Shade)->rays_in += rays.count;
-                    fig(Stage::Shade)->rays_out += ws.next.count + (kShadows ? ws.shadows.count : 0);
-                }
-            }
-            if constexpr (kShadows) {
-                StageTimer timer(fig(Stage::Occlusion));
-                counts.shadow += ws.shadows.count;
-                occlusion(sc, kt, ws.shadows, accum, fig(Stage::Occlusion));
-                if (profile) {
-                    fig(Stage::Occlusion)->rays_in += ws.shadows.count;
-                    for (std::size_t i = 0; i < ws.shadows.count; ++i) fig(Stage::Occlusion)->rays_out += ws.shadows.t_max[i] > 0.f;
-                }
-            }
-            if constexpr (kSecondary) {
-                std::swap(ws.current, ws.next);
-            } else {
-                ws.current.count = 0;
-            }
-        }
+        RayStream primary = ws.take();
+        std::swap(primary, ws.current);
+        trace_generation(c, 0, std::move(primary));
     }
 };
 

@@ -10,8 +10,12 @@
 
 namespace streamrt {
 
-StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade)
-    : scene_(scene), kernels_(kernel_table(isa)), tile_fn_(nullptr), shade_mode_(resolve_shade_mode(scene_, shade)) {
+StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade, std::size_t slice_rays)
+    : scene_(scene),
+      kernels_(kernel_table(isa)),
+      tile_fn_(nullptr),
+      shade_mode_(resolve_shade_mode(scene_, shade)),
+      slice_rays_(slice_rays > 0 ? slice_rays : default_slice_rays(scene_.settings.spp)) {
     tile_fn_ = select_tile_fn();
 }
 
@@ -51,7 +55,8 @@ void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, f
     for (int first = 0; first < tile_pixels; first += pixels_per_chunk) {
         if (cancel && cancel->cancelled()) return;
         const int n_pixels = std::min(pixels_per_chunk, tile_pixels - first);
-        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile, self.shade_mode_);
+        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile, self.shade_mode_,
+                          self.slice_rays_);
     }
 }
 

@@ -174,22 +174,24 @@ TEST_CASE("cli: absurd scene values are refused with their location") {
 
 TEST_CASE("cli: a render that cannot fit in memory is refused before it starts") {
     Dir d;
-    // Glass that both reflects and transmits at depth 256: up to 2^256 rays per primary ray.
+    // Glass that both reflects and transmits at depth 256: the stream engine traces it in
+    // bounded memory (slices of max(16384, spp) rays, about 1.6 GiB a thread at spp 65536),
+    // which 64 threads cannot have on any machine this runs on.
     const fs::path scene = d.write("deep.cfg",
-                                   "image width=64 height=64 depth=256 degree=5\n"
+                                   "image width=64 height=64 depth=256 degree=5 spp=65536\n"
                                    "material glass refl=0.5 trans=0.5 ior=1.5\nsphere material=glass\n");
-    const Run r = run_streamrt(q(scene) + " -o " + q(d.path / "deep.png"));
+    const Run r = run_streamrt(q(scene) + " -j 64 -o " + q(d.path / "deep.png"));
     CHECK(r.code == 2);
     check_one_line_error(r, "would need about");
-    CHECK(r.err.find("2^256") != std::string::npos);
+    CHECK(r.err.find("64 threads x") != std::string::npos);
     CHECK(r.err.find("but this machine has") != std::string::npos);
     CHECK(!fs::exists(d.path / "deep.png"));
-    // The same scene is fine for the recursive engine (its memory does not grow with 2^depth)...
-    const Run rec = run_streamrt("--check --engine recursive " + q(scene) + " -o " + q(d.path / "deep.png"));
+    // The same scene is fine for the recursive engine (its memory is its stack)...
+    const Run rec = run_streamrt("--check --engine recursive -j 64 " + q(scene) + " -o " + q(d.path / "deep.png"));
     CHECK(rec.code == 0);
-    // ...and for the stream engine at a sane depth.
-    const Run shallow = run_streamrt("--check --depth 5 " + q(scene) + " -o " + q(d.path / "deep.png"));
-    CHECK(shallow.code == 0);
+    // ...and for the stream engine at depth 256 with fewer samples (once refused: 2^256 rays).
+    const Run deep = run_streamrt("--check --spp 4 -j 2 " + q(scene) + " -o " + q(d.path / "deep.png"));
+    CHECK(deep.code == 0);
 }
 
 TEST_CASE("cli: output path mistakes are caught before rendering, nothing is created") {
