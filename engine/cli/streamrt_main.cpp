@@ -284,6 +284,7 @@ int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBund
     const MpiSchedule schedule = opt.mpi_schedule == "static" ? MpiSchedule::Static : MpiSchedule::Dynamic;
     if (!rank0) {
         mpi_render_tiles(*mpi, *prepared, par, {}, schedule, [](const TileOutput&) {}, progress, job.profile.get());
+        if (g_cancel.load()) throw Interrupted{};
         return 0;
     }
     TileFileHeader header;
@@ -389,6 +390,10 @@ int run_mpi(const Options& opt, int argc, char** argv) {
         }
         Parallelism par(opt.jobs);
         return render_tiled(opt, *job, par, bundle, &mpi);
+    } catch (const Interrupted&) {
+        // Every rank was told to stop and has returned: the job ends together, no image.
+        if (rank0) std::fprintf(stderr, "streamrt: interrupted, no image written\n");
+        return 130;
     } catch (...) {
         // Past the common start, a failure on one rank ends the job.
         const std::exception_ptr error = std::current_exception();
@@ -396,9 +401,9 @@ int run_mpi(const Options& opt, int argc, char** argv) {
         try {
             std::rethrow_exception(error);
         } catch (const std::exception& e) {
-            std::fprintf(stderr, "streamrt: rank %d: %s\n", mpi.rank(), code == 130 ? "interrupted, no image written" : e.what());
+            std::fprintf(stderr, "streamrt: rank %d: %s\n", mpi.rank(), e.what());
         } catch (...) {
-            std::fprintf(stderr, "streamrt: rank %d: interrupted, no image written\n", mpi.rank());
+            std::fprintf(stderr, "streamrt: rank %d: failed\n", mpi.rank());
         }
         mpi.abort(code);
     }

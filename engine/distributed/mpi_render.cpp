@@ -178,10 +178,6 @@ std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& pr
     int working = mpi.size() - 1;
     std::vector<char> buffer;
     while (working > 0) {
-        if (progress.cancelled()) {
-            std::fprintf(stderr, "streamrt: interrupted, no image written\n");
-            mpi.abort(130);
-        }
         MPI_Status status;
         int flag = 0;
         MPI_Iprobe(MPI_ANY_SOURCE, kTagResult, MPI_COMM_WORLD, &flag, &status);
@@ -193,6 +189,8 @@ std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& pr
         const int from = status.MPI_SOURCE;
         std::int32_t jobs = 1;
         std::memcpy(&jobs, msg.data(), sizeof jobs);
+        // A rank that was interrupted (its own Ctrl-C or SIGTERM) stops the whole job.
+        if (jobs <= 0 && progress.cancel) progress.cancel->store(true);
         const std::string_view records(msg.data() + sizeof jobs, msg.size() - sizeof jobs);
         RankStats& theirs = stats[std::size_t(from)];
         read_tile_records(records, prepared.width, prepared.height, [&](const TileOutput& t) {
@@ -200,15 +198,13 @@ std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& pr
             progress.add(t.counts);
             ++theirs.tiles;
         });
-        const std::vector<std::int32_t> chunk = queue.take(from, queue.chunk(jobs));
+        // Once interrupted, every rank is told "no more" and the job winds down together.
+        const std::vector<std::int32_t> chunk =
+            progress.cancelled() ? std::vector<std::int32_t>() : queue.take(from, queue.chunk(jobs));
         send_bytes(chunk.data(), chunk.size() * sizeof(std::int32_t), from, kTagAssign, mine.bytes_sent);
         if (chunk.empty()) --working;
     }
     local.join();
-    if (progress.cancelled()) {
-        std::fprintf(stderr, "streamrt: interrupted, no image written\n");
-        mpi.abort(130);
-    }
     for (int r = 1; r < mpi.size(); ++r) {
         const std::vector<FinalMessage> f = receive<FinalMessage>(r, kTagFinal);
         const std::uint64_t tiles_seen = stats[std::size_t(r)].tiles;
@@ -233,7 +229,8 @@ void render_as_worker(const MpiSession& mpi, PreparedRender& prepared, Paralleli
     const std::int32_t jobs = par.jobs();
     std::mutex mutex;
     for (;;) {
-        msg.insert(0, reinterpret_cast<const char*>(&jobs), sizeof jobs);
+        const std::int32_t asking = progress.cancelled() ? 0 : jobs;  // 0: interrupted
+        msg.insert(0, reinterpret_cast<const char*>(&asking), sizeof asking);
         send_bytes(msg.data(), msg.size(), 0, kTagResult, final.stats.bytes_sent);
         msg.clear();
         const std::vector<std::int32_t> chunk = receive<std::int32_t>(0, kTagAssign);
@@ -247,10 +244,6 @@ void render_as_worker(const MpiSession& mpi, PreparedRender& prepared, Paralleli
                      },
                      &progress);
         final.stats.busy_seconds += since(t0);
-        if (progress.cancelled()) {
-            std::fprintf(stderr, "streamrt: rank %d interrupted\n", mpi.rank());
-            mpi.abort(130);
-        }
     }
     final.stats.idle_seconds = std::max(0.0, since(start) - final.stats.busy_seconds);
     final.stats.tiles = std::uint64_t(progress.tiles_done.load());

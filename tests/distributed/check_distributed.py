@@ -4,7 +4,7 @@ for byte (PFM) with the single-process render of the same settings.
 
     check_distributed.py --streamrt BIN [--mpirun MPIRUN] GROUP
 
-GROUP: usage | shard | checkpoint | mpi-usage | mpi-scenes | mpi-ranks | mpi-kill
+GROUP: usage | shard | checkpoint | mpi-usage | mpi-scenes | mpi-ranks | mpi-faults
 Exits 1 with one line per failure; 0 when everything holds.
 """
 import argparse
@@ -61,8 +61,8 @@ def scenes():
     return sorted(SCENES.glob("*.cfg")) + [SCENES / "meshes" / "mesh.cfg", SCENES / "degrees" / "degree5.cfg"]
 
 
-def reference(args, scene, out, extra=(), size=SIZE):
-    r = run([args.streamrt, "-j2", scene, "-o", out, *size, "--spp", "2", "-q", *extra])
+def reference(args, scene, out, extra=(), size=SIZE, spp="2"):
+    r = run([args.streamrt, "-j2", scene, "-o", out, *size, "--spp", spp, "-q", *extra])
     check(r.returncode == 0, f"{scene.name}: single-process render failed: {r.stderr.strip()}")
     return out.read_bytes() if out.exists() else b""
 
@@ -223,7 +223,7 @@ def group_mpi_ranks(args, tmp):
     check(len(rows) == 2 and sum(int(row[1]) for row in rows) == 12, f"per-rank tiles: {rows}")
 
 
-def group_mpi_kill(args, tmp):
+def group_mpi_faults(args, tmp):
     scene = SCENES / "whitted.cfg"
     out = tmp / "killed.pfm"
     cmd = mpirun(args, 3) + ["--mpi", "-j1", scene, "-o", out, "--width", "640", "--height", "480", "--spp", "64", "-q"]
@@ -250,6 +250,29 @@ def group_mpi_kill(args, tmp):
     leftovers = [f.name for f in tmp.iterdir() if f.name.startswith(".killed")]
     check(not leftovers, f"a killed rank: temporary files left: {leftovers}")
 
+    # Ctrl-C reaches the ranks (a terminal sends it to the whole foreground group): the job
+    # winds down together, exit 130, no image; the journal is resumed by 3 ranks, same bytes.
+    big = ["--width", "640", "--height", "480", "--spp", "128", "-q"]
+    want = reference(args, scene, tmp / "ref_big.pfm", size=big[:4], spp="128")
+    journal, out = tmp / "mpi.journal", tmp / "interrupted.pfm"
+    cmd = mpirun(args, 2) + ["--mpi", "-j1", scene, "-o", out, *big, "--checkpoint", journal]
+    p = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=e)
+    time.sleep(2.5)
+    for child in subprocess.run(["pgrep", "-P", str(p.pid)], capture_output=True, text=True).stdout.split():
+        os.kill(int(child), signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    if p.returncode == 0:
+        print("note: the MPI render finished before the interrupt")
+        return
+    check(p.returncode == 130, f"Ctrl-C under MPI: exit {p.returncode}: {err.strip()!r}")
+    check(len([line for line in err.splitlines() if line.startswith("streamrt")]) == 1,
+          f"Ctrl-C under MPI: want one line from streamrt: {err.strip()!r}")
+    check(not out.exists(), "Ctrl-C under MPI: an image was written")
+    check(journal.exists(), "Ctrl-C under MPI: no journal")
+    r = run(mpirun(args, 3) + ["--mpi", "-j1", scene, "-o", out, *big, "--checkpoint", journal, "--resume"], timeout=90)
+    check(r.returncode == 0, f"MPI resume failed: {r.stderr.strip()!r}")
+    check(out.exists() and out.read_bytes() == want, "the MPI render resumed by 3 ranks differs from the one-process one")
+
 
 def main():
     ap = argparse.ArgumentParser()
@@ -259,7 +282,7 @@ def main():
     args = ap.parse_args()
     groups = {"usage": group_usage, "shard": group_shard, "checkpoint": group_checkpoint,
               "mpi-usage": group_mpi_usage, "mpi-scenes": group_mpi_scenes, "mpi-ranks": group_mpi_ranks,
-              "mpi-kill": group_mpi_kill}
+              "mpi-faults": group_mpi_faults}
     start = time.time()
     with tempfile.TemporaryDirectory(prefix="streamrt_dist_") as d:
         groups[args.group](args, pathlib.Path(d))
