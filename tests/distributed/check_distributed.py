@@ -41,10 +41,31 @@ def run(cmd, env=None, timeout=60):
     return subprocess.run([str(c) for c in cmd], capture_output=True, text=True, env=e, timeout=timeout)
 
 
+def is_mpich(args):
+    r = subprocess.run([str(args.mpirun), "--version"], capture_output=True, text=True)
+    return "HYDRA" in r.stdout or "MPICH" in r.stdout
+
+
 def mpirun(args, n):
-    # Loopback TCP only, so it works in a bare container; more ranks than cores is fine.
+    if args.mpich:  # MPICH's Hydra: shared memory on one host, no options needed
+        return [args.mpirun, "-np", str(n), args.streamrt]
+    # Open MPI: loopback TCP only, so it works in a bare container; more ranks than cores.
     return [args.mpirun, "--oversubscribe", "-np", str(n), "--mca", "btl", "self,tcp",
             "--mca", "btl_tcp_if_include", "lo", "--mca", "oob_tcp_if_include", "lo", args.streamrt]
+
+
+def rank_pids(pid):
+    """The streamrt processes below a launcher (Open MPI: children; MPICH: grandchildren)."""
+    found, todo = [], [str(pid)]
+    while todo:
+        children = subprocess.run(["pgrep", "-P", todo.pop()], capture_output=True, text=True).stdout.split()
+        for c in children:
+            try:
+                comm = pathlib.Path(f"/proc/{c}/comm").read_text().strip()
+            except OSError:
+                continue
+            (found if comm == "streamrt" else todo).append(c)
+    return sorted(found, key=int)
 
 
 def one_line(r):
@@ -231,7 +252,7 @@ def group_mpi_faults(args, tmp):
     p = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=e)
     time.sleep(2.0)
     # The ranks are mpirun's children running streamrt; kill the last one.
-    victims = subprocess.run(["pgrep", "-P", str(p.pid)], capture_output=True, text=True).stdout.split()
+    victims = rank_pids(p.pid)
     check(len(victims) == 3, f"expected 3 rank processes under mpirun, found {victims}")
     if victims:
         os.kill(int(victims[-1]), signal.SIGKILL)
@@ -258,7 +279,7 @@ def group_mpi_faults(args, tmp):
     cmd = mpirun(args, 2) + ["--mpi", "-j1", scene, "-o", out, *big, "--checkpoint", journal]
     p = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=e)
     time.sleep(2.5)
-    for child in subprocess.run(["pgrep", "-P", str(p.pid)], capture_output=True, text=True).stdout.split():
+    for child in rank_pids(p.pid):
         os.kill(int(child), signal.SIGINT)
     _, err = p.communicate(timeout=60)
     if p.returncode == 0:
@@ -280,6 +301,7 @@ def main():
     ap.add_argument("--mpirun", default="mpirun")
     ap.add_argument("group")
     args = ap.parse_args()
+    args.mpich = args.group.startswith("mpi") and is_mpich(args)
     groups = {"usage": group_usage, "shard": group_shard, "checkpoint": group_checkpoint,
               "mpi-usage": group_mpi_usage, "mpi-scenes": group_mpi_scenes, "mpi-ranks": group_mpi_ranks,
               "mpi-faults": group_mpi_faults}
