@@ -54,7 +54,7 @@ def main():
         runs.append(("2 ranks x -j1, static", MPIRUN + ["-np", "2", args.streamrt, "--mpi", "-j1",
                                                          "--mpi-schedule", "static"]))
         print(f"load average at start: {os.getloadavg()[0]:.1f}; {args.scene} {args.size}, spp {args.spp}, "
-              f"best of {args.repeat}")
+              f"best of {args.repeat}\n")
         print("| run | wall s (whole process) | render s | CPU s | Mrays/s (render) | same bytes |")
         print("|---|---|---|---|---|---|")
         for name, cmd in runs:
