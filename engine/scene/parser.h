@@ -10,15 +10,15 @@
 
 namespace streamrt {
 
-/// How a large text is read: cut into chunks at line ends, shapes of the chunks parsed in
-/// parallel (docs/architecture.md, "Scene reading"). The Scene and the error are the same
-/// for every setting.
 /// A file the reader read, and its bytes (ReadOptions::copies).
 struct FileCopy {
     std::string path;  ///< as the reader named it (relative to the working folder or absolute)
     std::string bytes;
 };
 
+/// How a large text is read: cut into chunks at line ends, shapes of the chunks parsed in
+/// parallel (docs/architecture.md, "Scene reading"). The Scene and the error are the same
+/// for every setting.
 struct ReadOptions {
     int jobs = 0;                          ///< threads; <= 0: all cores
     std::size_t chunk_bytes = 1u << 20;    ///< a chunk's size, extended to the next line end
