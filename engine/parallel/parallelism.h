@@ -45,6 +45,15 @@ struct Tile {
     int height() const { return y1 - y0; }
 };
 
+/// Tile number `index` of a width x height image cut into kTileSize squares, numbered row by
+/// row from the top-left (the numbering of for_each_tile).
+inline Tile tile_rect(int width, int height, int index) {
+    const int nx = (width + kTileSize - 1) / kTileSize;
+    const int tx = index % nx, ty = index / nx;
+    return Tile{tx * kTileSize, ty * kTileSize, std::min(width, (tx + 1) * kTileSize),
+                std::min(height, (ty + 1) * kTileSize)};
+}
+
 /// The number of threads "all cores" means.
 inline int default_jobs() {
 #if STREAMRT_STD_THREADS

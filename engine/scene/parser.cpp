@@ -977,6 +977,7 @@ class Parser {
         std::error_code ec;
         if (!fs::is_regular_file(target, ec))
             st.fail(a.value_col, "cannot open mesh file " + quote(target.string()));
+        if (options_.copies) copy_file(target);
         try {
             auto mesh = load_obj_mesh(target.string());
             const auto index = std::uint32_t(scene.meshes.size());
@@ -986,6 +987,11 @@ class Parser {
         } catch (const std::exception& e) {
             st.fail(a.value_col, quote(target.string()) + ": " + e.what());
         }
+    }
+
+    void copy_file(const fs::path& p) {
+        FileText text;
+        options_.copies->push_back(FileCopy{p.string(), text.open(p) ? std::string(text.text()) : std::string()});
     }
 
     void include(Statement& st, const std::vector<Token>& toks, int depth) {
@@ -1009,6 +1015,7 @@ class Parser {
             st.fail(t.column, "include cycle: " + quote(shown) + " is already being read");
         FileText text;
         if (!text.open(target)) st.fail(t.column, "cannot open included file " + quote(shown));
+        if (options_.copies) options_.copies->push_back(FileCopy{shown, std::string(text.text())});
         read_text(text.text(), shown, id, depth + 1);
     }
 };
@@ -1018,6 +1025,7 @@ class Parser {
 Scene load_scene(const std::string& path, const ReadOptions& options) {
     FileText text;
     if (!text.open(fs::path(path))) throw SceneError(SourceLoc{path, 0, 0}, "cannot open scene file");
+    if (options.copies) options.copies->push_back(FileCopy{path, std::string(text.text())});
     // Everything reading starts (meshes, their hierarchies) runs in options.jobs threads.
     return Parallelism(options.jobs).run([&] {
         Parser p(options);

@@ -81,6 +81,25 @@ StreamRenderer::TileFn StreamRenderer::select_tile_fn() const {
     return table[key];
 }
 
+void StreamRenderer::render_one_tile(const Tile& tile, float* rgb, RayCounts& counts, StreamProfile* profile,
+                                     const RenderProgress* cancel) const {
+    // Tile-local accumulation in a fixed order: the result cannot depend on scheduling.
+    float accum[kTileSize * kTileSize * 3] = {};
+    tile_fn_(*this, tile, accum, counts, profile, cancel);
+    const int pixels = tile.width() * tile.height();
+    StageTimer timer(profile ? &profile->stages[int(Stage::Accumulate)] : nullptr);
+    std::copy_n(accum, pixels * 3, rgb);
+    if (profile) profile->stages[int(Stage::Accumulate)].rays_in += std::uint64_t(pixels);
+}
+
+void StreamRenderer::describe(StreamProfile& profile, double wall_seconds, int threads) const {
+    profile.wall_seconds = wall_seconds;
+    profile.threads = threads;
+    profile.isa = kernels_.name;
+    profile.lanes = kernels_.float_lanes;
+    profile.built = built_stages();
+}
+
 Framebuffer StreamRenderer::render(Parallelism& par, RenderProgress* progress, StreamProfile* profile) const {
     const RenderSettings& s = scene_.settings;
     Framebuffer fb = Framebuffer::uninitialized(s.width, s.height);  // every tile writes its pixels
@@ -90,29 +109,22 @@ Framebuffer StreamRenderer::render(Parallelism& par, RenderProgress* progress, S
         if (progress && progress->cancelled()) return;
         RayCounts counts;
         StreamProfile local;
-        // Tile-local accumulation in a fixed order: the result cannot depend on scheduling.
-        float accum[kTileSize * kTileSize * 3] = {};
-        tile_fn_(*this, tile, accum, counts, profile ? &local : nullptr, progress);
+        float rgb[kTileSize * kTileSize * 3];
+        render_one_tile(tile, rgb, counts, profile ? &local : nullptr, progress);
         {
             StageTimer timer(profile ? &local.stages[int(Stage::Accumulate)] : nullptr);
             for (int y = tile.y0; y < tile.y1; ++y)
-                std::copy_n(&accum[((y - tile.y0) * tile.width()) * 3], tile.width() * 3, fb.pixel(tile.x0, y));
+                std::copy_n(&rgb[((y - tile.y0) * tile.width()) * 3], tile.width() * 3, fb.pixel(tile.x0, y));
         }
         if (profile) {
-            local.stages[int(Stage::Accumulate)].rays_in += std::uint64_t(tile.width() * tile.height());
             std::lock_guard<std::mutex> lock(profile_mutex);
             *profile += local;
             profile->counts += counts;
         }
         if (progress) progress->add(counts);
     });
-    if (profile) {
-        profile->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        profile->threads = par.jobs();
-        profile->isa = kernels_.name;
-        profile->lanes = kernels_.float_lanes;
-        profile->built = built_stages();
-    }
+    if (profile)
+        describe(*profile, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), par.jobs());
     return fb;
 }
 

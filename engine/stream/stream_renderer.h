@@ -26,6 +26,15 @@ class StreamRenderer {
     /// Renders the image. With a profile, every stage is timed and counted into it.
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr, StreamProfile* profile = nullptr) const;
 
+    /// Renders one tile into `rgb` (tile.width() x tile.height() pixels, 3 floats each, row by
+    /// row): the values render() gives those pixels, whichever thread or process runs it.
+    /// With a profile, the stages are timed and counted into it.
+    void render_one_tile(const Tile& tile, float* rgb, RayCounts& counts, StreamProfile* profile = nullptr,
+                         const RenderProgress* cancel = nullptr) const;
+
+    /// Fills the profile's description of the run: wall time, threads, kernels and stages.
+    void describe(StreamProfile& profile, double wall_seconds, int threads) const;
+
     /// Names of the stages and kernels this scene's pipeline is built from.
     std::vector<std::string> built_stages() const;
 

@@ -21,6 +21,7 @@ LAYERS = [
     ["kernels"],
     ["stream", "baseline"],
     ["driver"],
+    ["distributed"],
     ["cli"],
 ]
 LEVEL = {folder: i for i, peers in enumerate(LAYERS) for folder in peers}
