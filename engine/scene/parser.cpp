@@ -276,6 +276,11 @@ class Statement {
         if (!(c.x >= 0.0 && c.y >= 0.0 && c.z >= 0.0))
             fail(a.value_col, "colour components of " + quote(a.key) + " must be >= 0, got " +
                                   quote(a.value));
+        // Colours are single precision in the scene records and the stream engine.
+        constexpr double kMaxColour = std::numeric_limits<float>::max();
+        if (!(c.x <= kMaxColour && c.y <= kMaxColour && c.z <= kMaxColour))
+            fail(a.value_col, "colour components of " + quote(a.key) + " must be at most 3.4e38, got " +
+                                  quote(a.value));
         return c;
     }
     glm::dvec3 direction(const Arg& a) const {

@@ -399,6 +399,10 @@ TEST_CASE("parser: errors carry the exact line and column") {
         expect_error("plane checker=-1,0,0", 1, 15, "must be >= 0");
         expect_error("background 0,0,-1", 1, 12, "must be >= 0");
         expect_error("light point pos=0,0,0 color=-1,1,1", 1, 29, "must be >= 0");
+        // Colours are stored in single precision: 1e39 would become +inf (a fuzz finding).
+        expect_error("sphere color=1,1e39,1", 1, 14, "at most 3.4e38");
+        expect_error("light point pos=0,0,0 color=1e300,1,1", 1, 29, "at most 3.4e38");
+        expect_error("plane checker=0,0,4e38", 1, 15, "at most 3.4e38");
         expect_error("camera rx=0", 1, 11, "'rx' must be > 0");
         expect_error("camera df=-1", 1, 11, "'df' must be > 0");
     }
