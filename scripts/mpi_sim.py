@@ -12,8 +12,12 @@ render; the picture's layout scales with the image).
 What is modelled, as the code does it:
 - rank 0 hands out tiles from one row-major list; `dynamic`: a worker that returns a chunk
   gets the next chunk, of clamp(left / (2 N), j, 8 j) tiles; `static`: rank r gets list
-  positions r, r + N, ..., in chunks of 4 j. A worker asks again only once its chunk is
-  rendered and sent (no prefetch), so it idles for a round trip per chunk.
+  positions r, r + N, ..., in chunks of 4 j. In these two a worker asks again only once its
+  chunk is rendered and sent (no prefetch), so it idles for a round trip per chunk: the worker
+  before commit 319af69. `prefetch` models the worker since then (a local queue refilled while
+  j tiles are still queued), with dynamic hand-out; renaming it `dynamic` (and the old one
+  `dynamic-barrier`) and giving `static` the local queue too is still to do, with the tables
+  and plots of docs/distributed.md that would change with it.
 - rank 0's j threads render too, taking one tile at a time from the same list (static: from
   rank 0's positions); its main thread polls for messages every 200 us when none is waiting.
 - a message costs latency + bytes / bandwidth; the results of a tile are 256 x 3 floats plus a
@@ -96,7 +100,7 @@ def simulate_prefetch(costs, ranks, jobs, latency, bandwidth, speed=1.0):
     """Dynamic scheduling where a worker's threads take tiles one at a time from a local queue
     and the worker asks for its next chunk (sending the tiles finished so far) as soon as
     fewer than `jobs` tiles are left queued, so no thread waits for a round trip or for the
-    slowest tile of a chunk. (A proposed design: the model's answer to the measured barrier.)"""
+    slowest tile of a chunk. (The worker in engine/distributed/mpi_render.cpp since 319af69.)"""
     costs = [c / speed for c in costs]
     n = len(costs)
     msg = lambda nbytes: latency + nbytes / bandwidth
