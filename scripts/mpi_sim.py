@@ -10,15 +10,18 @@ the density at its position x 256 pixels x spp (a ray costs what it cost in the 
 render; the picture's layout scales with the image).
 
 What is modelled, as the code does it:
-- rank 0 hands out tiles from one row-major list; `dynamic`: a worker that returns a chunk
-  gets the next chunk, of clamp(left / (2 N), j, 8 j) tiles; `static`: rank r gets list
-  positions r, r + N, ..., in chunks of 4 j. A worker asks again only once its chunk is
-  rendered and sent (no prefetch), so it idles for a round trip per chunk.
+- rank 0 hands out tiles from one row-major list; `dynamic`: a worker that asks gets the next
+  chunk, of clamp(left / (2 N), j, 8 j) tiles; `static`: rank r gets list positions
+  r, r + N, ..., in chunks of 4 j. A worker's j threads take tiles one at a time from its
+  local queue and it asks again (sending the tiles finished so far) as soon as fewer than j
+  tiles wait to be started; after "no more" it finishes its tiles and sends them with one
+  last request. `dynamic-barrier`, `static-barrier`: the worker before commit 319af69, which
+  asked again only once its whole chunk was rendered and sent, idling for a round trip and
+  for the chunk's slowest tile each time.
 - rank 0's j threads render too, taking one tile at a time from the same list (static: from
   rank 0's positions); its main thread polls for messages every 200 us when none is waiting.
 - a message costs latency + bytes / bandwidth; the results of a tile are 256 x 3 floats plus a
   64-byte record head; rank 0's incoming link is shared by every worker (served in turn).
-- a rank's j threads take its chunk's tiles one at a time (oneTBB, grain 1).
 Not modelled: memory-bandwidth contention inside a node, stragglers, the scene broadcast and
 the image write (the same for every schedule, and measured separately).
 
@@ -46,6 +49,9 @@ NETWORKS = {
 }
 POLL = 200e-6          # rank 0's sleep between polls when no message waits
 TILE_BYTES = TILE * TILE * 3 * 4 + 64
+# `dynamic`, `static`: the worker as it is (a local queue); `-barrier`: the worker before
+# commit 319af69, which asked again only once its whole chunk was rendered and sent.
+SCHEDULES = ("dynamic", "static", "dynamic-barrier", "static-barrier")
 
 
 def read_costs(path, measure="rays"):
@@ -92,121 +98,132 @@ def run_threads(start, costs, jobs):
     return max(free)
 
 
-def simulate_prefetch(costs, ranks, jobs, latency, bandwidth, speed=1.0):
-    """Dynamic scheduling where a worker's threads take tiles one at a time from a local queue
-    and the worker asks for its next chunk (sending the tiles finished so far) as soon as
-    fewer than `jobs` tiles are left queued, so no thread waits for a round trip or for the
-    slowest tile of a chunk. (A proposed design: the model's answer to the measured barrier.)"""
+class Handout:
+    """Rank 0's TileQueue: `dynamic` hands out the next list positions to whoever asks, in
+    chunks of clamp(left / (2 N), j, 8 j); `static` gives rank r positions r, r + N, ...,
+    4 j at a time."""
+
+    def __init__(self, n, ranks, jobs, schedule):
+        self.n, self.ranks, self.jobs, self.schedule = n, ranks, jobs, schedule
+        self.cursor = 0
+        self.own = {r: list(range(r, n, ranks)) for r in range(ranks)}
+        self.own_next = {r: 0 for r in range(ranks)}
+
+    def take(self, rank, k):
+        if self.schedule == "dynamic":
+            out = list(range(self.cursor, min(self.n, self.cursor + k)))
+            self.cursor += len(out)
+            return out
+        p = self.own_next[rank]
+        out = self.own[rank][p:p + k]
+        self.own_next[rank] = p + len(out)
+        return out
+
+    def chunk(self):
+        if self.schedule == "static":
+            return 4 * self.jobs
+        return max(self.jobs, min(8 * self.jobs, (self.n - self.cursor) // (2 * self.ranks)))
+
+
+def simulate_queue(costs, ranks, jobs, schedule, latency, bandwidth, speed=1.0):
+    """The worker as it is: its threads take tiles one at a time from a local queue, and it
+    asks for its next chunk (sending the tiles finished so far) as soon as fewer than `jobs`
+    tiles wait to be started, so no thread waits for a round trip or for the slowest tile of
+    a chunk. "No more" while tiles are still out: the worker finishes them, then sends them
+    with one last request, which rank 0 answers with "no more" again."""
     costs = [c / speed for c in costs]
     n = len(costs)
     msg = lambda nbytes: latency + nbytes / bandwidth
-    cursor = 0
+    handout = Handout(n, ranks, jobs, schedule)
+    take, chunk = handout.take, handout.chunk
     queue = {r: [] for r in range(ranks)}
     asking = {r: False for r in range(ranks)}
-    finished = {r: 0 for r in range(ranks)}
+    state = {r: "work" for r in range(ranks)}                    # work, drain, done
+    finished = {r: 0 for r in range(ranks)}                      # rendered, not yet sent
+    idle = {r: 0 for r in range(ranks)}                          # threads waiting for tiles
     events = []
-    link_free = 0.0
+    link_free = 0.0   # rank 0's incoming link
     master_free = 0.0
     end = 0.0
-
-    def chunk():
-        return max(jobs, min(8 * jobs, (n - cursor) // (2 * ranks)))
 
     def ask(r, t):
         nonlocal link_free
         asking[r] = True
-        arrive = max(t + latency, link_free) + finished[r] * TILE_BYTES / bandwidth
+        arrive = max(t + latency, link_free) + (8 + finished[r] * TILE_BYTES) / bandwidth
         link_free = arrive
         finished[r] = 0
         heapq.heappush(events, (arrive, 1, "request", r))
 
+    def maybe_ask(r, t):
+        if asking[r]:
+            return
+        if state[r] == "work" and len(queue[r]) < jobs:
+            ask(r, t)
+        elif state[r] == "drain" and idle[r] == jobs:
+            ask(r, t)
+
     for r in range(1, ranks):
         ask(r, 0.0)
     for r in range(ranks):
-        for k in range(jobs):
-            heapq.heappush(events, (0.0, 0, "thread", r))
+        for _ in range(jobs):
+            heapq.heappush(events, (0.0, 0, "thread", (r, False)))
     while events:
-        t, _, kind, r = heapq.heappop(events)
+        t, _, kind, who = heapq.heappop(events)
         if kind == "request":
+            # Polling: a message that finds rank 0 idle waits half a poll on average.
             start = max(t, master_free)
             if start == t:
                 start += POLL / 2
             master_free = start + 2e-6
-            k = chunk()
-            tiles = list(range(cursor, min(n, cursor + k)))
-            cursor += len(tiles)
-            heapq.heappush(events, (master_free + msg(4 * len(tiles)), 1, "reply", (r, tiles)))
+            tiles = take(who, chunk()) if state[who] == "work" else []
+            heapq.heappush(events, (master_free + msg(4 * len(tiles)), 1, "reply", (who, tiles)))
         elif kind == "reply":
-            r, tiles = r
+            r, tiles = who
             asking[r] = False
-            queue[r].extend(tiles)
             if tiles:
-                # Wake the threads that found the queue empty.
-                for _ in range(len(tiles)):
-                    heapq.heappush(events, (t, 0, "wake", r))
+                queue[r].extend(tiles)
+                for _ in range(min(idle[r], len(tiles))):
+                    idle[r] -= 1
+                    heapq.heappush(events, (t, 0, "thread", (r, False)))
+            elif idle[r] == jobs and not queue[r] and finished[r] == 0:
+                state[r] = "done"
+                end = max(end, t)
+                continue
             else:
-                asking[r] = None  # no more work for this rank
-                end = max(end, t + msg(finished[r] * TILE_BYTES))
-        elif kind in ("thread", "wake"):
-            if kind == "wake" and r in idle and idle[r] > 0:
-                idle[r] -= 1
-            elif kind == "wake":
-                continue
-            if r == 0:
-                if cursor < n:
-                    i = cursor
-                    cursor += 1
-                    heapq.heappush(events, (t + costs[i], 0, "thread", 0))
-                    end = max(end, t + costs[i])
-                continue
-            if kind == "thread" and t > 0:
+                state[r] = "drain"
+            maybe_ask(r, t)
+        else:  # a thread of rank r is free (after a tile, when `rendered`)
+            r, rendered = who
+            if rendered and r > 0:
                 finished[r] += 1
+            if r == 0:
+                tiles = take(0, 1)
+                if tiles:
+                    heapq.heappush(events, (t + costs[tiles[0]], 0, "thread", (0, True)))
+                else:
+                    end = max(end, t)
+                continue
             if queue[r]:
                 i = queue[r].pop(0)
-                heapq.heappush(events, (t + costs[i], 0, "thread", r))
-                end = max(end, t + costs[i])
-                if len(queue[r]) < jobs and asking[r] is False:
-                    ask(r, t)
+                heapq.heappush(events, (t + costs[i], 0, "thread", (r, True)))
             else:
-                idle[r] = idle.get(r, 0) + 1
-                if asking[r] is False:
-                    ask(r, t)
+                idle[r] += 1
+            maybe_ask(r, t)
     return end
-
-
-idle = {}
 
 
 def simulate(costs, ranks, jobs, schedule, latency, bandwidth, speed=1.0):
     """Wall time of one render on `ranks` ranks of `jobs` threads (speed < 1: shared cores)."""
-    if schedule == "prefetch" and ranks > 1:
-        idle.clear()
-        return simulate_prefetch(costs, ranks, jobs, latency, bandwidth, speed)
+    if schedule in ("dynamic", "static") and ranks > 1:
+        return simulate_queue(costs, ranks, jobs, schedule, latency, bandwidth, speed)
+    schedule = schedule.replace("-barrier", "")
     costs = [c / speed for c in costs]
     n = len(costs)
     if ranks == 1:
         return run_threads(0.0, costs, jobs)
     msg = lambda nbytes: latency + nbytes / bandwidth
-    cursor = 0                       # dynamic: next list position
-    own = {r: list(range(r, n, ranks)) for r in range(ranks)}  # static positions
-    own_next = {r: 0 for r in range(ranks)}
-
-    def take(rank, k):
-        nonlocal cursor
-        if schedule == "dynamic":
-            out = list(range(cursor, min(n, cursor + k)))
-            cursor += len(out)
-            return out
-        p = own_next[rank]
-        out = own[rank][p:p + k]
-        own_next[rank] = p + len(out)
-        return out
-
-    def chunk():
-        if schedule == "static":
-            return 4 * jobs
-        left = n - cursor
-        return max(jobs, min(8 * jobs, left // (2 * ranks)))
+    handout = Handout(n, ranks, jobs, schedule)
+    take, chunk = handout.take, handout.chunk
 
     # Rank 0's threads: one tile at a time, interleaved with the workers' requests in time.
     events = []  # (time, kind, rank, payload)
@@ -262,6 +279,7 @@ def main():
     ap.add_argument("--network", default="25gbe", help=",".join(NETWORKS))
     ap.add_argument("--validate", help="measured wall seconds here, 'N:s,N:s,...' (same size as --costs)")
     ap.add_argument("--cores", type=int, default=2, help="cores of this machine (for --validate)")
+    ap.add_argument("--schedule", default="dynamic", choices=SCHEDULES, help="the schedule --validate models")
     ap.add_argument("--plot")
     ap.add_argument("--csv")
     a = ap.parse_args()
@@ -274,8 +292,8 @@ def main():
             n, sec = item.split(":")
             n, sec = int(n), float(sec)
             speed = min(1.0, a.cores / (n * a.jobs))
-            model = simulate(costs, n, a.jobs, "dynamic", lat, bw, speed)
-            print(f"{n:5d}  dynamic   {sec:10.3f}  {model:7.3f}  {model / sec:6.2f}")
+            model = simulate(costs, n, a.jobs, a.schedule, lat, bw, speed)
+            print(f"{n:5d}  {a.schedule:8s}  {sec:10.3f}  {model:7.3f}  {model / sec:6.2f}")
         return 0
     costs = target_costs(tiles, src_w, src_h, a.source_spp, a.width, a.height, a.spp)
     ranks = [int(r) for r in a.ranks.split(",")]
@@ -283,16 +301,16 @@ def main():
     rows = []
     t1 = simulate(costs, 1, a.jobs, "dynamic", 0, 1)
     print(f"{len(costs)} tiles, {sum(costs):.1f} s of one thread; one rank of {a.jobs} threads: {t1:.2f} s")
-    print("network  schedule  " + "  ".join(f"{r:>6d}" for r in ranks) + "   (parallel efficiency)")
+    print("network  schedule         " + "  ".join(f"{r:>6d}" for r in ranks) + "   (parallel efficiency)")
     for net in nets:
         lat, bw, _ = NETWORKS[net]
-        for schedule in ("dynamic", "static", "prefetch"):
+        for schedule in SCHEDULES:
             effs = []
             for r in ranks:
                 tn = simulate(costs, r, a.jobs, schedule, lat, bw)
                 effs.append(t1 / (r * tn))
                 rows.append({"network": net, "schedule": schedule, "ranks": r, "seconds": tn, "efficiency": t1 / (r * tn)})
-            print(f"{net:8s} {schedule:8s}  " + "  ".join(f"{e * 100:5.1f}%" for e in effs))
+            print(f"{net:8s} {schedule:15s}  " + "  ".join(f"{e * 100:5.1f}%" for e in effs))
     if a.csv:
         with open(a.csv, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(rows[0]))
@@ -303,10 +321,11 @@ def main():
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots(figsize=(6, 3.6))
-        colors = {"dynamic": "tab:blue", "static": "tab:red", "prefetch": "tab:green"}
+        colors = {"dynamic": "tab:green", "static": "tab:red", "dynamic-barrier": "tab:blue",
+                  "static-barrier": "tab:orange"}
         styles = ["-", "--", ":", "-."]
         for k, net in enumerate(nets):
-            for schedule in ("dynamic", "static", "prefetch"):
+            for schedule in SCHEDULES:
                 pts = [(r["ranks"], r["efficiency"]) for r in rows if r["network"] == net and r["schedule"] == schedule]
                 ax.plot([p[0] for p in pts], [p[1] * 100 for p in pts], styles[k % 4], color=colors[schedule],
                         marker="o", ms=3, label=f"{schedule}, {NETWORKS[net][2]}")

@@ -4,11 +4,15 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
+#include <functional>
 #include <mutex>
 #include <thread>
+#include <utility>
 
 #include "core/error.h"
 #include "distributed/tile_file.h"
@@ -176,7 +180,9 @@ std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& pr
         local_done = true;
     });
     int working = mpi.size() - 1;
-    std::vector<char> buffer;
+    // Tiles handed to each worker and not yet back: a worker that gets "no more" while it
+    // still renders some sends them with one more request, and is done once it has none.
+    std::vector<std::uint64_t> out(std::size_t(mpi.size()), 0);
     while (working > 0) {
         MPI_Status status;
         int flag = 0;
@@ -197,12 +203,15 @@ std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& pr
             sink(t);
             progress.add(t.counts);
             ++theirs.tiles;
+            --out[std::size_t(from)];
         });
         // Once interrupted, every rank is told "no more" and the job winds down together.
         const std::vector<std::int32_t> chunk =
             progress.cancelled() ? std::vector<std::int32_t>() : queue.take(from, queue.chunk(jobs));
         send_bytes(chunk.data(), chunk.size() * sizeof(std::int32_t), from, kTagAssign, mine.bytes_sent);
-        if (chunk.empty()) --working;
+        out[std::size_t(from)] += chunk.size();
+        // An interrupted worker renders nothing more: it is done whatever it still had.
+        if (chunk.empty() && (out[std::size_t(from)] == 0 || jobs <= 0)) --working;
     }
     local.join();
     for (int r = 1; r < mpi.size(); ++r) {
@@ -220,31 +229,115 @@ std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& pr
     return stats;
 }
 
+/// A worker's tiles between rank 0 and its render threads: the threads take them one at a
+/// time (blocking while none is queued) and append each finished tile's record to a buffer;
+/// the main thread pushes chunks in and sends the records out (it alone calls MPI).
+class LocalTiles {
+  public:
+    /// The next tile to render; waits while none is queued; negative: closed.
+    int take() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        threads_wake_.wait(lock, [&] { return !tiles_.empty() || closed_; });
+        if (tiles_.empty()) return -1;
+        const int tile = tiles_.front();
+        tiles_.pop_front();
+        ++rendering_;
+        main_wake_.notify_one();
+        return tile;
+    }
+    void finished(const TileOutput& t) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        append_tile_record(records_, t);
+        ++record_count_;
+        --rendering_;
+        if (tiles_.empty() && rendering_ == 0) {
+            busy_seconds_ += since(busy_since_);
+            main_wake_.notify_one();
+        }
+    }
+    void push(const std::vector<std::int32_t>& chunk) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (tiles_.empty() && rendering_ == 0) busy_since_ = Clock::now();
+        tiles_.insert(tiles_.end(), chunk.begin(), chunk.end());
+        threads_wake_.notify_all();
+    }
+    /// Stops the render threads once the queue is empty (at once when cancelled: they
+    /// check the flag before each tile).
+    void close() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        closed_ = true;
+        threads_wake_.notify_all();
+    }
+    /// Waits (checking `stop` now and then) until fewer than `queued` tiles wait to be
+    /// started, or, with `queued` 0, until every tile is rendered.
+    void wait_below(std::size_t queued, const std::function<bool()>& stop) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        const auto ready = [&] { return queued > 0 ? tiles_.size() < queued : tiles_.empty() && rendering_ == 0; };
+        while (!ready() && !stop()) main_wake_.wait_for(lock, std::chrono::milliseconds(20));
+    }
+    /// The records finished since the last call, and how many tiles they hold.
+    std::pair<std::string, std::int64_t> take_records() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        std::pair<std::string, std::int64_t> out{std::move(records_), record_count_};
+        records_.clear();
+        record_count_ = 0;
+        return out;
+    }
+    double busy_seconds() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        return busy_seconds_ + (tiles_.empty() && rendering_ == 0 ? 0.0 : since(busy_since_));
+    }
+
+  private:
+    std::mutex mutex_;
+    std::condition_variable threads_wake_, main_wake_;
+    std::deque<int> tiles_;
+    int rendering_ = 0;  ///< tiles taken, not finished
+    bool closed_ = false;
+    std::string records_;
+    std::int64_t record_count_ = 0;
+    Clock::time_point busy_since_{};
+    double busy_seconds_ = 0;  ///< time with tiles queued or rendering
+};
+
+/// A worker: its render threads take tiles one at a time from a local queue, and the main
+/// thread asks rank 0 for the next chunk (sending the tiles finished so far) as soon as fewer
+/// than one tile per thread waits to be started, so the threads never wait for the slowest
+/// tile of a chunk or for the round trip. An empty reply while tiles are still out: the
+/// worker finishes them and sends them with one more request; rank 0 lets a worker go once
+/// it has every tile back (or the worker was interrupted).
 void render_as_worker(const MpiSession& mpi, PreparedRender& prepared, Parallelism& par, RenderProgress& progress,
                       StreamProfile* profile) {
     const auto start = Clock::now();
     FinalMessage final{};
     final.stats.rank = mpi.rank();
-    std::string msg;
     const std::int32_t jobs = par.jobs();
-    std::mutex mutex;
+    LocalTiles local;
+    std::thread render([&] {
+        render_tiles(prepared, par, [&] { return local.take(); }, [&](const TileOutput& t) { local.finished(t); },
+                     &progress);
+    });
+    std::int64_t out = 0;  // tiles received from rank 0 and not yet sent back
+    bool draining = false;  // rank 0 has no more: finish the tiles here, then send them
     for (;;) {
+        local.wait_below(draining ? 0 : std::size_t(jobs), [&] { return progress.cancelled(); });
+        auto [msg, count] = local.take_records();
+        out -= count;
         const std::int32_t asking = progress.cancelled() ? 0 : jobs;  // 0: interrupted
         msg.insert(0, reinterpret_cast<const char*>(&asking), sizeof asking);
         send_bytes(msg.data(), msg.size(), 0, kTagResult, final.stats.bytes_sent);
-        msg.clear();
         const std::vector<std::int32_t> chunk = receive<std::int32_t>(0, kTagAssign);
-        if (chunk.empty()) break;
-        const auto t0 = Clock::now();
-        const std::vector<int> list(chunk.begin(), chunk.end());
-        render_tiles(prepared, par, std::span<const int>(list),
-                     [&](const TileOutput& t) {
-                         std::lock_guard<std::mutex> lock(mutex);
-                         append_tile_record(msg, t);
-                     },
-                     &progress);
-        final.stats.busy_seconds += since(t0);
+        if (chunk.empty()) {
+            if (out == 0 || asking == 0) break;
+            draining = true;
+            continue;
+        }
+        out += std::int64_t(chunk.size());
+        local.push(chunk);
     }
+    local.close();
+    render.join();
+    final.stats.busy_seconds = local.busy_seconds();
     final.stats.idle_seconds = std::max(0.0, since(start) - final.stats.busy_seconds);
     final.stats.tiles = std::uint64_t(progress.tiles_done.load());
     if (profile) {
