@@ -35,8 +35,12 @@ case "$kind" in
     # engine/image/image_io.cpp) with TSan's function entry hook, and the resolver runs while
     # the program is relocated, before the TSan runtime is set up: every TSan binary died with
     # SIGSEGV before main. So TSan builds compile that function once, for the baseline ISA
-    # (what its "default" clone is), kept out of line like the clones.
-    flags="'-Dtarget_clones(...)=noinline'"
+    # (what its "default" clone is), kept out of line like the clones, by a header included
+    # before every source (no header of the system or of a dependency names target_clones).
+    mkdir -p "$dir"
+    printf '%s\n' '// Written by scripts/sanitize.sh: no load-time resolvers under ThreadSanitizer.' \
+      '#define target_clones(...) noinline' >"$dir/tsan_no_clones.h"
+    flags="-include $PWD/$dir/tsan_no_clones.h"
     extra=(-DCMAKE_CXX_FLAGS="$flags")
     # Suppressions (each with its reason) live in tests/tsan.supp.
     export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/tsan.supp"
