@@ -4,9 +4,9 @@
 #                                               into build-asan/, every test
 #   scripts/sanitize.sh tsan [ctest args]      ThreadSanitizer into build-tsan/, against a
 #                                               oneTBB built with -fsanitize=thread from
-#                                               Debian's source package (below): the tests
-#                                               that run threads (renders, the command line,
-#                                               the parallel BVH build)
+#                                               Debian's source package (below), every test;
+#                                               the threaded ones alone (quicker):
+#                                               -R "render threads|cli:|bit-identical|BVH"
 #   scripts/sanitize.sh tsan-std [ctest args]  fallback for a machine that cannot fetch the
 #                                               source package: ThreadSanitizer into
 #                                               build-tsan-std/ with the loops on std::thread
@@ -44,7 +44,7 @@ case "$kind" in
     extra=(-DCMAKE_CXX_FLAGS="$flags")
     # Suppressions (each with its reason) live in tests/tsan.supp.
     export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/tsan.supp"
-    filter=(-R "render threads|cli:|bit-identical|BVH")
+    filter=()
     ;;
   *) echo "usage: scripts/sanitize.sh asan|tsan|tsan-std [ctest args]" >&2; exit 2 ;;
 esac
