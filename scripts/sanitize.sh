@@ -81,13 +81,18 @@ SOURCES
     apt_opts=(-qq -o Dir::Etc::SourceList=/dev/null -o Dir::Etc::SourceParts="$apt_dir/sources.list.d"
               -o Dir::State::Lists="$apt_dir/lists" -o Dir::Cache="$apt_dir/cache"
               -o Debug::NoLocking=1 -o APT::Sandbox::User=root)
-    apt-get "${apt_opts[@]}" update
     # --no-check as apt-get source itself does: apt checked every file against the signed index.
-    (cd "$dir/onetbb-src" && apt-get "${apt_opts[@]}" source --download-only "onetbb=$tbb_version" \
-      && dpkg-source --no-check -x ./*.dsc tree >/dev/null)
-    # TBB_SANITIZE=thread is oneTBB's own TSan build option (it also turns on oneTBB's
-    # sanitizer mode, __TBB_USE_THREAD_SANITIZER). The same compiler as the project (its
-    # libtsan). No tests, examples, Python, tbbmalloc or hwloc binding: streamrt links TBB::tbb.
+    apt-get "${apt_opts[@]}" update && (cd "$dir/onetbb-src" \
+      && apt-get "${apt_opts[@]}" source --download-only "onetbb=$tbb_version" \
+      && dpkg-source --no-check -x ./*.dsc tree >/dev/null) || {
+      echo "sanitize.sh: could not fetch Debian's onetbb $tbb_version source package; without" \
+        "it, scripts/sanitize.sh tsan-std checks the loops on std::thread instead" >&2
+      exit 1
+    }
+    # TBB_SANITIZE=thread is oneTBB's own option for a TSan build (its -fsanitize=thread also
+    # turns on oneTBB's sanitizer mode, __TBB_USE_THREAD_SANITIZER). The project's compiler
+    # (the same libtsan). No tests, examples, Python, tbbmalloc or hwloc binding: streamrt
+    # links TBB::tbb alone.
     cmake -S "$dir/onetbb-src/tree" -B "$dir/onetbb-build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
       -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DTBB_SANITIZE=thread -DTBB_TEST=OFF \
       -DTBB_EXAMPLES=OFF -DTBB4PY_BUILD=OFF -DTBBMALLOC_BUILD=OFF -DTBB_STRICT=OFF \
