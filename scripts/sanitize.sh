@@ -118,9 +118,10 @@ if [[ $kind == tsan ]]; then
   # The test binary and the streamrt binary (the cli tests) must load the instrumented
   # library, not /usr/lib's.
   for exe in "$dir/tests/streamrt_tests" "$dir/engine/streamrt"; do
-    if ! ldd "$exe" | grep -q "libtbb.so.12 => $tbb_prefix/lib/"; then
+    libs=$(ldd "$exe")  # not piped into grep -q: with pipefail, ldd's SIGPIPE fails the test
+    if [[ $libs != *"libtbb.so.12 => $tbb_prefix/lib/libtbb.so.12 "* ]]; then
       echo "sanitize.sh: $exe does not load $tbb_prefix/lib/libtbb.so.12" >&2
-      ldd "$exe" | grep tbb >&2
+      grep tbb <<<"$libs" >&2
       exit 1
     fi
   done
