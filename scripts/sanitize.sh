@@ -37,9 +37,15 @@ case "$kind" in
     # SIGSEGV before main. So TSan builds compile that function once, for the baseline ISA
     # (what its "default" clone is), kept out of line like the clones, by a header included
     # before every source (no header of the system or of a dependency names target_clones).
+    # Rewritten only when it changes: a new date would rebuild every file.
     mkdir -p "$dir"
     printf '%s\n' '// Written by scripts/sanitize.sh: no load-time resolvers under ThreadSanitizer.' \
-      '#define target_clones(...) noinline' >"$dir/tsan_no_clones.h"
+      '#define target_clones(...) noinline' >"$dir/tsan_no_clones.h.new"
+    if cmp -s "$dir/tsan_no_clones.h.new" "$dir/tsan_no_clones.h"; then
+      rm "$dir/tsan_no_clones.h.new"
+    else
+      mv "$dir/tsan_no_clones.h.new" "$dir/tsan_no_clones.h"
+    fi
     flags="-include $PWD/$dir/tsan_no_clones.h"
     extra=(-DCMAKE_CXX_FLAGS="$flags")
     # Suppressions (each with its reason) live in tests/tsan.supp.
