@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 #include "kernels/accel_kernel_table.h"
 #include "parallel/parallelism.h"
 #include "render/camera_rays.h"
-#include "render/render.h"
+#include "driver/render.h"
 #include "stream/stream_accel.h"
 #include "stream/stream_renderer.h"
 

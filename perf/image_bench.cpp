@@ -28,7 +28,7 @@
 
 #include "image/image_io.h"
 #include "parallel/parallelism.h"
-#include "render/render.h"
+#include "driver/render.h"
 #include "scene/parser.h"
 
 using namespace streamrt;

@@ -20,6 +20,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -29,8 +30,9 @@
 
 #include "arith_limit.h"
 #include "kernels/kernel_table.h"
+#include "shapes/shapes.h"
 #include "simd/lanes.h"
-#include "stream/ray_stream.h"
+#include "kernels/ray_stream.h"
 
 using namespace streamrt;
 
@@ -88,18 +90,15 @@ Fixture make_fixture(ShapeKind kind, std::size_t n_rays, std::size_t n_objs) {
     f.t_max0.assign(f.rays.t_max.begin(), f.rays.t_max.end());
     f.object.assign(f.rays.capacity(), -1);
     for (std::size_t k = 0; k < n_objs; ++k) {
-        // Mi of "scale 0.5, translate (cx, 0, 0)" (a plane: the xz plane tilted to face the rays).
+        // Mi of "scale 0.5, translate (cx, 0, 0)"; a flat shape (no canonical y extent: the
+        // plane, the disk) also rotate_x 90 first, so that its xz plane faces the rays.
         const float cx = -half + 0.5f + float(k);
+        const CanonicalBounds b = canonical_bounds(kind, 0.3);
+        const float upright[12] = {2, 0, 0, -2 * cx, 0, 2, 0, 0, 0, 0, 2, 0};
+        const float facing[12] = {2, 0, 0, -2 * cx, 0, 0, 2, 0, 0, -2, 0, 0};  // canonical y = world z
         ObjectXf o{};
-        if (kind == ShapeKind::Plane) {
-            // rotate_x 90: canonical y = world z
-            const float m[12] = {1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0};
-            std::copy(m, m + 12, o.m);
-        } else {
-            const float m[12] = {2, 0, 0, -2 * cx, 0, 2, 0, 0, 0, 0, 2, 0};
-            std::copy(m, m + 12, o.m);
-        }
-        o.param = 0.3f;  // torus minor radius
+        std::copy_n(b.lo[1] == b.hi[1] ? facing : upright, 12, o.m);
+        o.param = 0.3f;  // the torus's minor radius (unused by the others)
         o.id = std::int32_t(k);
         f.objs.push_back(o);
     }
@@ -172,18 +171,19 @@ void register_all() {
     for (const auto& l : levels) {
         if (!isa_supported(l.isa)) continue;
         const std::string isa = isa_name(l.isa);
-        for (int k = 0; k < kShapeKindCount; ++k)
+        // Every registered canonical shape (shapes/shapes.h). Meshes have their own benchmark
+        // (perf/mesh_bench.cpp): their kernel walks a per-mesh hierarchy rather than testing one
+        // closed-form shape.
+        CanonicalShapes::for_each([&](auto shape) {
             for (bool closest : {true, false}) {
-                // Meshes have their own benchmark (perf/mesh_bench.cpp): their kernel walks a
-                // per-mesh hierarchy rather than testing one closed-form shape.
-                if (ShapeKind(k) == ShapeKind::Mesh) continue;
                 const std::string name =
-                    std::string("BM_kernel/") + shape_kind_name(ShapeKind(k)) + (closest ? "/closest/" : "/any/") + isa;
-                auto* b = benchmark::RegisterBenchmark(name.c_str(), BM_kernel, l.isa, ShapeKind(k), closest);
+                    std::string("BM_kernel/") + std::string(shape.name) + (closest ? "/closest/" : "/any/") + isa;
+                auto* b = benchmark::RegisterBenchmark(name.c_str(), BM_kernel, l.isa, shape.kind, closest);
                 for (int rays : {16, 64, 256, 1024, 4096})
                     for (int objs : {1, 8}) b->Args({rays, objs});
                 b->ArgNames({"rays", "objs"});
             }
+        });
     }
 }
 

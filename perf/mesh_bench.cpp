@@ -14,7 +14,7 @@
 
 #include "mesh/mesh.h"
 #include "parallel/parallelism.h"
-#include "render/render.h"
+#include "driver/render.h"
 
 using namespace streamrt;
 

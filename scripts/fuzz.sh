@@ -17,13 +17,13 @@ mkdir -p "$out/corpus" "$out/artifacts"
 # tinyobjloader; the memory estimate (limits.cpp) asks the image writer (image_io.cpp, zlib,
 # stb) for its buffer size.
 sources=(tests/fuzz/scene_fuzz.cpp engine/scene/parser.cpp engine/scene/scene.cpp
-         engine/core/transform.cpp engine/render/limits.cpp engine/mesh/mesh.cpp
+         engine/core/transform.cpp engine/driver/limits.cpp engine/mesh/mesh.cpp
          engine/accel/bvh.cpp engine/image/image_io.cpp)
 bin="$out/scene_fuzz"
 # Rebuild when a source is newer than the binary.
 rebuild=0
 [[ -x $bin ]] || rebuild=1
-for s in "${sources[@]}" engine/scene/*.h engine/core/*.h engine/render/limits.h engine/mesh/*.h \
+for s in "${sources[@]}" engine/scene/*.h engine/core/*.h engine/driver/limits.h engine/mesh/*.h \
          engine/accel/*.h engine/image/*.h engine/parallel/*.h tests/fuzz/*.h; do
   [[ $s -nt $bin ]] && rebuild=1
 done

@@ -5,7 +5,7 @@
 // one SIMD operation tests a ray against all of them (kernels/accel_kernel.h), or one child
 // against a packet of rays.
 //
-// The hierarchy knows only boxes and primitive indices (the scene's objects, accel/scene_bvh.h;
+// The hierarchy knows only boxes and primitive indices (the scene's objects, scene/scene_bvh.h;
 // a mesh's triangles could be primitives of another).
 #include <cmath>
 #include <cstddef>

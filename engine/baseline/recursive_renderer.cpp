@@ -10,8 +10,28 @@ namespace streamrt {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
-inline Vec3d apply_point(const glm::dmat4x3& m, const Vec3d& p) { return to_vec(m * glm::dvec4(to_glm(p), 1.0)); }
-inline Vec3d apply_vector(const glm::dmat4x3& m, const Vec3d& v) { return to_vec(m * glm::dvec4(to_glm(v), 0.0)); }
+
+/// Where shade_hit's results go in the recursive engine: shadow rays are answered at once,
+/// children traced at once and their colour brought back times their weight.
+struct RecursiveSink {
+    static constexpr bool kTestsShadowsNow = true;
+    const RecursiveRenderer& renderer;
+    int depth;
+    RayCounts& counts;
+    ColorT<double> color{0, 0, 0};
+
+    void local(const ColorT<double>& c) { color = c; }
+    bool occluded(const Vec3d& from, const Vec3d& to, double t_max) {
+        ++counts.shadow;
+        return renderer.occluded({from, to}, t_max);
+    }
+    void child(bool send, const Vec3d& from, const Vec3d& dir, const ColorT<double>& weight,
+               const ColorT<double>& throughput, double cone, RayKind kind) {
+        if (!send) return;
+        ++(kind == RayKind::Reflected ? counts.reflected : counts.refracted);
+        color = color + mul(renderer.trace({from, dir, cone, throughput}, depth + 1, counts), weight);
+    }
+};
 }  // namespace
 
 RecursiveRenderer::RecursiveRenderer(const Scene& scene)
@@ -28,8 +48,8 @@ RecursiveRenderer::RecursiveRenderer(const Scene& scene)
 bool RecursiveRenderer::test_object(std::size_t i, const RayD& ray, double t_min, double& t_max,
                                     Candidate& c) const {
     const PreparedObject& ob = objects_[i];
-    const Vec3d oc = apply_point(ob.mi, ray.origin);
-    const Vec3d dc = apply_vector(ob.mi, ray.dir);
+    const Vec3d oc = apply_point(RowsOf{ob.mi}, ray.origin);
+    const Vec3d dc = apply_vector(RowsOf{ob.mi}, ray.dir);
     if (ob.kind == ShapeKind::Mesh) {
         if (!ob.mesh) return false;
         // The mesh's own hierarchy, walked in its canonical space (t is the world ray's t).
@@ -80,8 +100,8 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
                          : visit_shape(ob.kind, [&](auto shape) { return shape.template normal<double>(pc, ob.param); });
     hit.object = best;
     hit.t = best_t;
-    hit.point = apply_point(scene_.objects[std::size_t(best)].md, pc);
-    hit.normal = to_vec(transform_normal(ob.mi, to_glm(nc)));
+    hit.point = apply_point(RowsOf{scene_.objects[std::size_t(best)].md}, pc);
+    hit.normal = apply_normal(RowsOf{ob.mi}, nc);
     return true;
 }
 
@@ -92,8 +112,8 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
         const PreparedObject& ob = objects_[i];
         if (ob.kind != ShapeKind::Mesh) return test_object(i, ray, 0.0, tm, o);
         if (!ob.mesh) return false;
-        return mesh_any(ob.mesh->view(), ob.mesh->bvh, apply_point(ob.mi, ray.origin), apply_vector(ob.mi, ray.dir),
-                        0.0, tm);
+        return mesh_any(ob.mesh->view(), ob.mesh->bvh, apply_point(RowsOf{ob.mi}, ray.origin),
+                        apply_vector(RowsOf{ob.mi}, ray.dir), 0.0, tm);
     };
     if (bvh_) {
         for (std::uint32_t i : bvh_->unbounded) {
@@ -118,45 +138,19 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     if (!closest_hit(ray, 0.0, kInf, hit)) return {s.background.x, s.background.y, s.background.z};
 
     const Object& object = scene_.objects[std::size_t(hit.object)];
-    const MaterialT<double>& m = materials_[object.material];
+    const ShadeRules<double> rules{s.degree, s.ambient, depth < s.depth, s.cutoff, camera_.spread};
+    // Weight 1: the caller multiplies what this ray brings back by its weight.
+    const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
     const ColorT<double> object_color{object.color.x, object.color.y, object.color.z};
-    const Vec3d n_out = hit.normal;
-    const double cone = ray.cone + camera_.spread * hit.t;
-    const ColorT<double> base = surface_color(m, object_color, hit.point, n_out,
-                                              footprint_width(ray.cone, camera_.spread, hit.t, dot(ray.dir, n_out)));
-    if (s.degree == 0) return base;
-
-    // Light on the side the ray arrives from (a camera inside a room or a sphere sees the
-    // inner faces lit).
-    const Vec3d n = dot(n_out, ray.dir) < 0 ? n_out : -n_out;
-    ColorT<double> color = ambient_light(s.degree, s.ambient, m, base);
-    for (const LightT<double>& l : lights_) {
-        const LightSample<double> ls = sample_light(l, hit.point);
-        const DirectLight<double> dl = direct_light(s.degree, m, base, n, ray.dir, l, ls);
-        if (!dl.lit) continue;
-        const ColorT<double>& c = dl.color;
-        if (s.degree >= 5) {
-            const Vec3d from = offset_ray_origin(hit.point, n, ray.origin);
-            const Vec3d to = l.kind == LightKind::Directional ? ls.to_light : l.pos - from;
-            ++counts.shadow;
-            if (occluded({from, to}, ls.t_max)) continue;
-        }
-        color = color + c;
-    }
-    if (depth >= s.depth) return color;
-
-    if (s.degree >= 3 && m.refl > 0) {
-        const Vec3d r = reflect(ray.dir, n);
-        ++counts.reflected;
-        color = color + trace({offset_ray_origin(hit.point, n, ray.origin), r, cone}, depth + 1, counts) * m.refl;
-    }
-    if (s.degree >= 4 && m.trans > 0) {
-        const Vec3d t = refract(ray.dir, n_out, m.ior);
-        const Vec3d side = dot(t, n_out) > 0 ? n_out : -n_out;
-        ++counts.refracted;
-        color = color + trace({offset_ray_origin(hit.point, side, ray.origin), t, cone}, depth + 1, counts) * m.trans;
-    }
-    return color;
+    RecursiveSink sink{*this, depth, counts};
+    const auto shade = [&]<bool kLit, bool kShadows>() {
+        shade_hit<kLit, kShadows, true, true>(rules, materials_[object.material], lights_.data(), lights_.size(),
+                                              arriving, hit.point, hit.normal, object_color, true, sink);
+    };
+    if (s.degree == 0) shade.template operator()<false, false>();
+    else if (s.degree < 5) shade.template operator()<true, false>();
+    else shade.template operator()<true, true>();
+    return sink.color;
 }
 
 ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) const {
@@ -166,7 +160,7 @@ ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) 
     ColorT<double> sum{0, 0, 0};
     for (int k = 0; k < s.spp; ++k) {
         const PixelSample ps = pixel_sample(s.pattern, s.spp, pixel, k);
-        const RayD ray{cam.origin, cam.direction(x + ps.x, y + ps.y), 0.0};
+        const RayD ray{cam.origin, cam.direction(double(x + ps.x), double(y + ps.y)), 0.0};
         ++counts.primary;
         sum = sum + trace(ray, 0, counts);
     }

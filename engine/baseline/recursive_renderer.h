@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 
 #include "core/vec3.h"
 #include "image/framebuffer.h"
@@ -21,6 +21,7 @@ namespace streamrt {
 struct RayD {
     Vec3d origin, dir;  ///< world space; dir is unit for camera, reflected and refracted rays
     double cone = 0;    ///< footprint width at the origin (ray cone), for texture filtering
+    ColorT<double> throughput{1, 1, 1};  ///< product of the refl / trans weights from the camera (the cut-off)
 };
 
 /// The ray's "memory" of its closest hit (handout): object, distance, point and normal.

@@ -11,20 +11,27 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <exception>
 #include <filesystem>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 #include "core/error.h"
+#include "distributed/mpi_render.h"
+#include "distributed/scene_bundle.h"
+#include "distributed/tile_file.h"
 #include "image/image_compare.h"
 #include "image/image_io.h"
 #include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
-#include "render/limits.h"
-#include "render/render.h"
+#include "driver/limits.h"
+#include "driver/render.h"
 #include "scene/parser.h"
 
 #ifndef STREAMRT_VERSION
@@ -45,6 +52,7 @@ struct Options {
     int jobs = 0;
     std::string output;
     std::optional<int> spp, width, height, degree, depth;
+    std::optional<double> cutoff;
     std::string engine = "stream";
     std::string accel = "auto";
     std::string isa;
@@ -55,7 +63,24 @@ struct Options {
     std::string sampler;
     bool quiet = false;
     bool check_only = false;
+    bool mpi = false;
+    std::string mpi_schedule = "dynamic";
+    std::string shard;
+    int shard_k = -1, shard_n = 0;
+    std::string checkpoint;
+    bool resume = false;
+    std::string tile_costs;
+    /// Rendered tile by tile (render_tiles) rather than as one image.
+    bool tiled() const { return mpi || shard_n > 0 || !checkpoint.empty() || !tile_costs.empty(); }
 };
+
+/// This process's rank when an MPI launcher started it (0 otherwise): messages that every
+/// rank would print alike are printed by rank 0 only.
+int launcher_rank() {
+    for (const char* v : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
+        if (const char* r = std::getenv(v)) return std::atoi(r);
+    return 0;
+}
 
 // A missing folder, a read-only folder or the scene file itself are refused before any
 // rendering starts.
@@ -129,9 +154,298 @@ class ProgressDisplay {
     std::thread thread_;
 };
 
+/// Prints the error being handled (one line) and gives its exit status: 2 bad usage or bad
+/// scene, 1 render or I/O failure, 130 interrupted. `quiet`: the status only.
+int report_error(std::exception_ptr error, bool quiet = false) {
+    const auto say = [&](const std::string& text) {
+        if (!quiet) std::fprintf(stderr, "streamrt: %s\n", text.c_str());
+    };
+    try {
+        std::rethrow_exception(error);
+    } catch (const Interrupted&) {
+        say("interrupted, no image written");
+        return 130;
+    } catch (const SceneError& e) {
+        say(e.what());
+        return 2;
+    } catch (const UsageError& e) {
+        say(e.what());
+        return 2;
+    } catch (const RenderError& e) {
+        say(e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        say("out of memory");
+        return 1;
+    } catch (const std::exception& e) {
+        say(e.what());
+        return 1;
+    }
+}
+
+/// A render ready to go: the scene with the command line's settings, the engine's options.
+struct Job {
+    Scene scene;
+    EngineKind engine = EngineKind::Stream;
+    EngineOptions eo;
+    std::unique_ptr<StreamProfile> profile;  ///< when profiling (eo.profile points to it)
+    double read_seconds = 0;
+};
+
+/// Applies the command line to a loaded scene and checks everything before rendering.
+/// `writes`: this process writes the output (false on MPI ranks other than 0).
+/// `check_isa`: --isa must be supported here (MPI ranks agree on it together instead).
+Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
+    Job job;
+    job.scene = std::move(scene);
+    RenderSettings& s = job.scene.settings;
+    if (opt.spp) s.spp = *opt.spp;
+    if (opt.width) s.width = *opt.width;
+    if (opt.height) s.height = *opt.height;
+    if (opt.degree) s.degree = *opt.degree;
+    if (opt.depth) s.depth = *opt.depth;
+    if (opt.cutoff) s.cutoff = *opt.cutoff;
+    if (opt.sampler == "grid") s.pattern = SamplePattern::Grid;
+    if (opt.sampler == "random") s.pattern = SamplePattern::Random;
+    if (opt.sampler == "stratified") s.pattern = SamplePattern::Stratified;
+    if (!opt.output.empty()) s.output = opt.output;
+    if (writes) {
+        // A shard part is a tile file (docs/distributed.md), whatever its name.
+        if (opt.shard_n > 0) check_writable_path(s.output, opt.scene_path);
+        else check_output_path(s.output, opt.scene_path);
+        if (!opt.profile_json.empty()) check_writable_path(opt.profile_json, opt.scene_path);
+        if (!opt.tile_costs.empty()) check_writable_path(opt.tile_costs, opt.scene_path);
+    }
+    // Refuse, before allocating anything big, a render that cannot fit in this machine.
+    job.engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
+    const int jobs = opt.jobs > 0 ? opt.jobs : default_jobs();
+    check_render_memory(job.scene, job.engine == EngineKind::Stream || opt.compare, jobs);
+    accel::accel_config().mode = opt.accel == "bvh"    ? accel::AccelMode::Bvh
+                                 : opt.accel == "flat" ? accel::AccelMode::Flat
+                                                       : accel::AccelMode::Auto;
+    if (!opt.isa.empty()) {
+        if (job.engine == EngineKind::Recursive && !opt.compare)
+            throw UsageError("--isa chooses the stream engine's kernels; the recursive engine has none (scalar, double)");
+        parse_isa(opt.isa, job.eo.isa);
+        if (check_isa && !isa_supported(job.eo.isa))
+            throw UsageError("--isa " + opt.isa + ": this CPU does not support it");
+    }
+    job.eo.shade = opt.shade == "scalar"     ? ShadeMode::Scalar
+                   : opt.shade == "sorted"   ? ShadeMode::Sorted
+                   : opt.shade == "gathered" ? ShadeMode::Gathered
+                                             : ShadeMode::Auto;
+    if (opt.profile || !opt.profile_json.empty()) {
+        if (job.engine != EngineKind::Stream && !opt.compare) throw UsageError("--profile needs the stream engine");
+        job.profile = std::make_unique<StreamProfile>();
+        job.eo.profile = job.profile.get();
+    }
+    return job;
+}
+
+/// The engine's set-up; the scene's object records are released when the engine renders
+/// from its own tables (128 bytes each; 128 MB at 1e6 objects).
+std::unique_ptr<PreparedRender> prepare(Job& job, EngineKind which, bool keep_objects) {
+    auto prepared = prepare_render(job.scene, which, job.eo);
+    if (!prepared->reads_scene_objects() && !keep_objects) {
+        std::vector<Object>().swap(job.scene.objects);
+        std::vector<ObjectLoc>().swap(job.scene.object_locs);
+    }
+    return prepared;
+}
+
+void report_profile(const Options& opt, const StreamProfile* profile) {
+    if (!profile) return;
+    if (opt.profile) std::printf("%s", profile->text().c_str());
+    if (!opt.profile_json.empty()) write_text_file(opt.profile_json, profile->json());
+}
+
+/// The summary line.
+void print_summary(const Options& opt, const Job& job, int jobs, const std::string& how, double seconds,
+                   const RayCounts& counts, double setup_seconds, double write_seconds) {
+    if (opt.quiet) return;
+    const RenderSettings& s = job.scene.settings;
+    const double mrays = counts.total() / std::max(seconds, 1e-9) / 1e6;
+    std::printf("%s: %dx%d, spp %d, degree %d, %s engine%s, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s"
+                " (read %.3f s, set-up %.3f s, render %.3f s, write %.3f s)\n",
+                opt.scene_path.c_str(), s.width, s.height, s.spp, s.degree, engine_name(job.engine), how.c_str(), jobs,
+                seconds, static_cast<unsigned long long>(counts.total()), mrays, setup_seconds, s.output.c_str(),
+                job.read_seconds, setup_seconds, seconds, write_seconds);
+}
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// Renders tile by tile: shards, checkpoints, tile costs, and MPI (`mpi` set). On MPI ranks
+/// other than 0, renders what rank 0 hands out and returns.
+int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle, const MpiSession* mpi) {
+    const RenderSettings& s = job.scene.settings;
+    const bool rank0 = !mpi || mpi->rank() == 0;
+    const auto prepared = prepare(job, job.engine, false);
+    RenderProgress progress;
+    progress.cancel = &g_cancel;
+    const MpiSchedule schedule = opt.mpi_schedule == "static" ? MpiSchedule::Static : MpiSchedule::Dynamic;
+    if (!rank0) {
+        mpi_render_tiles(*mpi, *prepared, par, {}, schedule, [](const TileOutput&) {}, progress, job.profile.get());
+        if (g_cancel.load()) throw Interrupted{};
+        return 0;
+    }
+    TileFileHeader header;
+    header.scene = bundle.content_hash();
+    header.settings = render_settings_token(s, job.engine, job.eo, opt.accel);
+    header.width = s.width;
+    header.height = s.height;
+    header.tiles = tile_count(s.width, s.height);
+    header.shard = opt.shard_n > 0 ? opt.shard_k : -1;
+    header.shards = opt.shard_n;
+    TileAssembly assembly(s.width, s.height);
+    std::optional<TileJournal> journal;
+    if (!opt.checkpoint.empty()) journal.emplace(opt.checkpoint, header, opt.resume, assembly);
+    const std::vector<int> mine = opt.shard_n > 0 ? shard_tiles(header.tiles, opt.shard_k, opt.shard_n)
+                                                  : shard_tiles(header.tiles, 0, 1);
+    std::vector<int> todo;
+    for (const int i : mine)
+        if (!assembly.has(i)) todo.push_back(i);
+    progress.tiles_total = int(mine.size());
+    progress.tiles_done = int(mine.size() - todo.size());
+    const TileSink sink = [&](const TileOutput& t) {
+        if (assembly.place(t) && journal) journal->append(t);
+    };
+    std::vector<RankStats> ranks;
+    const auto start = Clock::now();
+    {
+        ProgressDisplay display(progress, !opt.quiet && ::isatty(2));
+        if (mpi) ranks = mpi_render_tiles(*mpi, *prepared, par, todo, schedule, sink, progress, job.profile.get());
+        else render_tiles(*prepared, par, std::span<const int>(todo), sink, &progress);
+    }
+    const double seconds = since(start);
+    if (g_cancel.load()) throw Interrupted{};  // the journal keeps what is done
+    if (journal) journal->sync();
+    const auto write_start = Clock::now();
+    if (opt.shard_n > 0) {
+        write_text_file(s.output, header.line() + "\n" + assembly.records(mine));
+    } else {
+        WriteOptions wo;
+        wo.par = &par;
+        wo.cancel = &g_cancel;
+        if (!write_image(s.output, assembly.image(), s.calibration, wo)) throw Interrupted{};
+    }
+    const double write_seconds = since(write_start);
+    if (!opt.tile_costs.empty()) write_text_file(opt.tile_costs, assembly.costs_csv());
+    if (journal) journal->remove();
+    if (job.profile && mpi) job.profile->threads = par.jobs();
+    report_profile(opt, job.profile.get());
+    if (opt.profile && mpi) std::printf("%s", rank_stats_text(ranks).c_str());
+    std::string how = job.engine == EngineKind::Stream ? std::string(", isa ") + isa_name(job.eo.isa) : "";
+    if (mpi)
+        how += ", " + std::to_string(mpi->size()) + (mpi->size() == 1 ? " rank" : " ranks") + " (" +
+               opt.mpi_schedule + ")";
+    if (opt.shard_n > 0) how += ", shard " + opt.shard;
+    if (journal && journal->resumed() > 0) how += ", " + std::to_string(journal->resumed()) + " tiles resumed";
+    print_summary(opt, job, par.jobs(), how, seconds, assembly.counts(), prepared->setup_seconds, write_seconds);
+    return 0;
+}
+
+/// streamrt --mpi: rank 0 reads and checks the scene and tells everyone; the others read
+/// rank 0's copy; all agree on one kernel level, then render together.
+int run_mpi(const Options& opt, int argc, char** argv) {
+    MpiSession mpi(argc, argv);
+    const bool rank0 = mpi.rank() == 0;
+    SceneBundle bundle;
+    std::optional<Job> job;
+    int status = 0;
+    if (rank0) {
+        try {
+            const auto start = Clock::now();
+            Scene scene = load_scene_bundled(opt.scene_path, opt.jobs, bundle);
+            const double read_seconds = since(start);
+            job.emplace(make_job(opt, std::move(scene), true, false));
+            job->read_seconds = read_seconds;
+        } catch (...) {
+            status = report_error(std::current_exception());
+        }
+    }
+    if ((status = mpi.broadcast_status(status)) != 0) return status;
+    mpi.broadcast_bundle(bundle);
+    try {
+        if (!rank0) {
+            const auto start = Clock::now();
+            job.emplace(make_job(opt, load_scene_from_bundle(bundle, opt.jobs), false, false));
+            job->read_seconds = since(start);
+        }
+        // One kernel level for all: the one asked for if every rank has it, else the best
+        // every rank has (float results differ in the last bits between levels).
+        if (job->engine == EngineKind::Stream) {
+            if (!opt.isa.empty()) {
+                if (mpi.min_over_ranks(isa_supported(job->eo.isa) ? 1 : 0) == 0) {
+                    if (rank0) std::fprintf(stderr, "streamrt: --isa %s: not every rank's CPU supports it\n", opt.isa.c_str());
+                    return 2;
+                }
+            } else {
+                job->eo.isa = Isa(mpi.min_over_ranks(int(best_isa())));
+            }
+        }
+        if (opt.check_only) {
+            if (rank0 && !opt.quiet)
+                std::printf("%s: ok (%zu objects, %zu lights, %d ranks)\n", opt.scene_path.c_str(),
+                            job->scene.objects.size(), job->scene.lights.size(), mpi.size());
+            return 0;
+        }
+        Parallelism par(opt.jobs);
+        return render_tiled(opt, *job, par, bundle, &mpi);
+    } catch (const Interrupted&) {
+        // Every rank was told to stop and has returned: the job ends together, no image.
+        if (rank0) std::fprintf(stderr, "streamrt: interrupted, no image written\n");
+        return 130;
+    } catch (...) {
+        // Past the common start, a failure on one rank ends the job.
+        const std::exception_ptr error = std::current_exception();
+        const int code = report_error(error, true);
+        try {
+            std::rethrow_exception(error);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "streamrt: rank %d: %s\n", mpi.rank(), e.what());
+        } catch (...) {
+            std::fprintf(stderr, "streamrt: rank %d: failed\n", mpi.rank());
+        }
+        mpi.abort(code);
+    }
+}
+
+/// streamrt merge PART... -o OUT: the image from shard parts.
+int run_merge(int argc, char** argv) {
+    CLI::App app{"streamrt merge: puts the parts of a sharded render (streamrt --shard K/N) together", "streamrt merge"};
+    std::vector<std::string> parts;
+    std::string output;
+    bool quiet = false;
+    app.add_option("parts", parts, "The parts (all N of them)")->required();
+    app.add_option("-o,--output", output, "Output image (.ppm, .png or .pfm)")->required();
+    app.add_flag("-q,--quiet", quiet, "No summary line");
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        if (e.get_exit_code() == 0) return app.exit(e);
+        std::fprintf(stderr, "streamrt merge: %s (see --help)\n", e.what());
+        return 2;
+    }
+    check_output_path(output, "");
+    TileFileHeader header;
+    const Framebuffer image = merge_parts(parts, header);
+    const Calibration how = header.setting("calibration") == "normalize" ? Calibration::Normalize : Calibration::Clamp;
+    Parallelism par(0);
+    WriteOptions wo;
+    wo.par = &par;
+    if (!write_image(output, image, how, wo)) throw Interrupted{};
+    if (!quiet)
+        std::printf("merged %zu parts (%dx%d, %d tiles, scene %s) -> %s\n", parts.size(), header.width, header.height,
+                    header.tiles, header.scene.c_str(), output.c_str());
+    return 0;
+}
+
 int run(int argc, char** argv) {
+    if (argc >= 2 && std::string(argv[1]) == "merge") return run_merge(argc - 1, argv + 1);
     Options opt;
     CLI::App app{"streamrt: a SIMD ray-stream ray tracer for .cfg scenes (see docs/scene-format.md)", "streamrt"};
+    app.footer("Also: streamrt merge PART... -o OUT (the parts of --shard renders)");
     app.add_option("scene", opt.scene_path, "Scene file (.cfg)")->required();
     app.add_option("-j,--jobs", opt.jobs, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
     app.add_option("-o,--output", opt.output, "Output image (.ppm, .png or .pfm); overrides the scene's");
@@ -140,6 +454,10 @@ int run(int argc, char** argv) {
     app.add_option("--height", opt.height, "Image height in pixels")->check(CLI::Range(1, 32768));
     app.add_option("--degree", opt.degree, "Shading degree 0..5 (handout)")->check(CLI::Range(0, 5));
     app.add_option("--depth", opt.depth, "Maximum bounces")->check(CLI::Range(0, 256));
+    app.add_option("--cutoff", opt.cutoff,
+                   "Weight cut-off: reflected and refracted rays worth less than this in every channel are not "
+                   "traced (default 0: all; overrides the scene's image cutoff=)")
+        ->check(CLI::Range(0.0, 1.0));
     app.add_option("--engine", opt.engine, "Renderer: stream (SIMD ray streams) or recursive (the handout's baseline)")
         ->check(CLI::IsMember({"stream", "recursive"}));
     app.add_option("--isa", opt.isa, "Force the stream kernels' level: sse2, sse4.2, avx2 or avx512 (default: best the CPU has)")
@@ -159,6 +477,15 @@ int run(int argc, char** argv) {
         ->check(CLI::IsMember({"stratified", "grid", "random"}));
     app.add_flag("-q,--quiet", opt.quiet, "No progress bar and no summary line");
     app.add_flag("--check", opt.check_only, "Validate the scene and the output path, render nothing");
+    app.add_flag("--mpi", opt.mpi, "Render with the ranks of an MPI job: mpirun -np N streamrt --mpi ...");
+    app.add_option("--mpi-schedule", opt.mpi_schedule,
+                   "How rank 0 hands out tiles: dynamic (chunks to whoever asks, default) or static (interleaved)")
+        ->check(CLI::IsMember({"dynamic", "static"}));
+    app.add_option("--shard", opt.shard,
+                   "Render the K-th (from 0) of N interleaved tile sets into a part file; see 'streamrt merge'");
+    app.add_option("--checkpoint", opt.checkpoint, "Journal finished tiles to FILE (removed once the image is written)");
+    app.add_flag("--resume", opt.resume, "Continue the render journaled in --checkpoint FILE");
+    app.add_option("--tile-costs", opt.tile_costs, "Write each tile's rays and seconds to FILE (CSV)");
     app.set_version_flag("--version", std::string("streamrt ") + STREAMRT_VERSION);
     // "--profile=json FILE" is the documented spelling; CLI11 sees it as --profile-json FILE.
     std::vector<std::string> args;
@@ -170,85 +497,59 @@ int run(int argc, char** argv) {
         app.parse(args);
     } catch (const CLI::ParseError& e) {
         if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-        // One line, like every other error (CLI11's own report adds a second line).
-        std::fprintf(stderr, "streamrt: %s (see --help)\n", e.what());
+        // One line, like every other error (CLI11's own report adds a second line); under
+        // an MPI launcher, from rank 0 only.
+        if (launcher_rank() == 0) std::fprintf(stderr, "streamrt: %s (see --help)\n", e.what());
         return 2;
     }
+    if (!opt.shard.empty()) parse_shard(opt.shard, opt.shard_k, opt.shard_n);
+    const char* launcher = mpi_launcher_variable();
+    if (launcher && !opt.mpi)
+        throw UsageError(std::string("started by an MPI launcher (") + launcher +
+                         " is set) without --mpi: every rank would render and write the same image");
+    if (opt.mpi && !mpi_available())
+        throw UsageError("--mpi: this streamrt was built without MPI support (cmake -DSTREAMRT_MPI=ON)");
+    if (opt.mpi && !launcher && !std::getenv("OMPI_COMM_WORLD_SIZE") && !std::getenv("PMI_SIZE"))
+        throw UsageError("--mpi: not started by an MPI launcher (mpirun -np N streamrt --mpi ...)");
+    if (opt.resume && opt.checkpoint.empty()) throw UsageError("--resume needs --checkpoint FILE");
+    if (opt.compare && opt.tiled())
+        throw UsageError("--compare renders whole images: not with --mpi, --shard, --checkpoint or --tile-costs");
+    if (opt.mpi && opt.shard_n > 0) throw UsageError("--shard splits a render without MPI: not with --mpi");
     // From here on Ctrl-C (or SIGTERM) asks the render to stop; nothing is written then.
     std::signal(SIGINT, on_sigint);
     std::signal(SIGTERM, on_sigint);
+    if (opt.mpi) return run_mpi(opt, argc, argv);
 
     // The whole process's phases, reported on the summary line: reading, set-up (inside
     // render_once), rendering and writing.
-    using Clock = std::chrono::steady_clock;
-    const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     auto phase_start = Clock::now();
-    Scene scene = load_scene(opt.scene_path, opt.jobs);
+    SceneBundle bundle;
+    Scene loaded = opt.tiled() ? load_scene_bundled(opt.scene_path, opt.jobs, bundle)
+                               : load_scene(opt.scene_path, opt.jobs);
     const double read_seconds = since(phase_start);
-    RenderSettings& s = scene.settings;
-    if (opt.spp) s.spp = *opt.spp;
-    if (opt.width) s.width = *opt.width;
-    if (opt.height) s.height = *opt.height;
-    if (opt.degree) s.degree = *opt.degree;
-    if (opt.depth) s.depth = *opt.depth;
-    if (opt.sampler == "grid") s.pattern = SamplePattern::Grid;
-    if (opt.sampler == "random") s.pattern = SamplePattern::Random;
-    if (opt.sampler == "stratified") s.pattern = SamplePattern::Stratified;
-    if (!opt.output.empty()) s.output = opt.output;
-    check_output_path(s.output, opt.scene_path);
-    if (!opt.profile_json.empty()) check_writable_path(opt.profile_json, opt.scene_path);
-    // Refuse, before allocating anything big, a render that cannot fit in this machine.
-    const EngineKind engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
-    const int jobs = opt.jobs > 0 ? opt.jobs : default_jobs();
-    check_render_memory(scene, engine == EngineKind::Stream || opt.compare, jobs);
+    Job job = make_job(opt, std::move(loaded), true, true);
+    job.read_seconds = read_seconds;
+    const RenderSettings& s = job.scene.settings;
     if (opt.check_only) {
         if (!opt.quiet)
             std::printf("%s: ok (%zu objects, %zu lights, %dx%d, spp %d, degree %d)\n", opt.scene_path.c_str(),
-                        scene.objects.size(), scene.lights.size(), s.width, s.height, s.spp, s.degree);
+                        job.scene.objects.size(), job.scene.lights.size(), s.width, s.height, s.spp, s.degree);
         return 0;
     }
-
-    accel::accel_config().mode = opt.accel == "bvh"    ? accel::AccelMode::Bvh
-                                 : opt.accel == "flat" ? accel::AccelMode::Flat
-                                                       : accel::AccelMode::Auto;
     if (g_cancel.load()) throw Interrupted{};
     Parallelism par(opt.jobs);
-    EngineOptions eo;
-    if (!opt.isa.empty()) {
-        if (engine == EngineKind::Recursive && !opt.compare)
-            throw UsageError("--isa chooses the stream engine's kernels; the recursive engine has none (scalar, double)");
-        parse_isa(opt.isa, eo.isa);
-        if (!isa_supported(eo.isa)) throw UsageError("--isa " + opt.isa + ": this CPU does not support it");
-    }
-    eo.shade = opt.shade == "scalar"     ? ShadeMode::Scalar
-               : opt.shade == "sorted"   ? ShadeMode::Sorted
-               : opt.shade == "gathered" ? ShadeMode::Gathered
-                                         : ShadeMode::Auto;
-    StreamProfile profile;
-    const bool profiling = opt.profile || !opt.profile_json.empty();
-    if (profiling) eo.profile = &profile;
-    if (profiling && engine != EngineKind::Stream && !opt.compare)
-        throw UsageError("--profile needs the stream engine");
+    if (opt.tiled()) return render_tiled(opt, job, par, bundle, nullptr);
+    const EngineKind engine = job.engine;
+    EngineOptions& eo = job.eo;
     WriteOptions wo;
     wo.par = &par;
     wo.cancel = &g_cancel;
-    // The profile, as text and/or JSON (written like images: whole, or not at all).
-    const auto report_profile = [&] {
-        if (opt.profile) std::printf("%s", profile.text().c_str());
-        if (!opt.profile_json.empty()) write_text_file(opt.profile_json, profile.json());
-    };
 
     const auto render_once = [&](EngineKind which, bool show_progress) {
         RenderProgress progress;
         progress.cancel = &g_cancel;
         progress.tiles_total = tile_count(s.width, s.height);
-        const auto prepared = prepare_render(scene, which, eo);
-        // An engine rendering from its own tables no longer needs the scene's object
-        // records (128 bytes each; 128 MB at 1e6 objects): give them back before rendering.
-        if (!prepared->reads_scene_objects() && !opt.compare) {
-            std::vector<Object>().swap(scene.objects);
-            std::vector<ObjectLoc>().swap(scene.object_locs);
-        }
+        const auto prepared = prepare(job, which, opt.compare);
         ProgressDisplay display(progress, show_progress && !opt.quiet && ::isatty(2));
         RenderResult r = render_prepared(*prepared, par, &progress);
         display.stop();
@@ -277,7 +578,7 @@ int run(int argc, char** argv) {
                     "pixels off by > 1/255: %.4f%%\n",
                     d.max_abs, d.rmse, d.psnr, 100.0 * d.share_over);
         std::printf("image (stream engine) -> %s\n", s.output.c_str());
-        report_profile();
+        report_profile(opt, job.profile.get());
         return 0;
     }
 
@@ -285,15 +586,8 @@ int run(int argc, char** argv) {
     phase_start = Clock::now();
     if (!write_image(s.output, r.image, s.calibration, wo)) throw Interrupted{};
     const double write_seconds = since(phase_start);
-    report_profile();
-    if (!opt.quiet) {
-        const double mrays = r.counts.total() / std::max(r.seconds, 1e-9) / 1e6;
-        std::printf("%s: %dx%d, spp %d, degree %d, %s engine, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s"
-                    " (read %.3f s, set-up %.3f s, render %.3f s, write %.3f s)\n",
-                    opt.scene_path.c_str(), s.width, s.height, s.spp, s.degree, engine_name(engine), par.jobs(),
-                    r.seconds, static_cast<unsigned long long>(r.counts.total()), mrays, r.setup_seconds,
-                    s.output.c_str(), read_seconds, r.setup_seconds, r.seconds, write_seconds);
-    }
+    report_profile(opt, job.profile.get());
+    print_summary(opt, job, par.jobs(), "", r.seconds, r.counts, r.setup_seconds, write_seconds);
     return 0;
 }
 
@@ -302,23 +596,8 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
     try {
         return run(argc, argv);
-    } catch (const Interrupted&) {
-        std::fprintf(stderr, "streamrt: interrupted, no image written\n");
-        return 130;
-    } catch (const SceneError& e) {
-        std::fprintf(stderr, "streamrt: %s\n", e.what());
-        return 2;
-    } catch (const UsageError& e) {
-        std::fprintf(stderr, "streamrt: %s\n", e.what());
-        return 2;
-    } catch (const RenderError& e) {
-        std::fprintf(stderr, "streamrt: %s\n", e.what());
-        return 1;
-    } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "streamrt: out of memory\n");
-        return 1;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "streamrt: %s\n", e.what());
-        return 1;
+    } catch (...) {
+        // Under an MPI launcher every rank would say the same: rank 0 speaks for them.
+        return report_error(std::current_exception(), launcher_rank() != 0);
     }
 }

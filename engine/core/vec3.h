@@ -3,12 +3,16 @@
 // shading) and xsimd batches (kernels). Only the operations the shape math needs.
 #include <cmath>
 
+#include "simd/isa_namespace.h"
+
 namespace streamrt {
 
 template <class V>
 struct Vec3T {
     V x, y, z;
 };
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 template <class V>
 inline Vec3T<V> operator+(const Vec3T<V>& a, const Vec3T<V>& b) {
@@ -52,12 +56,17 @@ inline Vec3T<V> normalize(const Vec3T<V>& a) {
     return a * (V(1) / length(a));
 }
 
+STREAMRT_ISA_END
+
 using Vec3d = Vec3T<double>;
 using Vec3f = Vec3T<float>;
+
+STREAMRT_ISA_BEGIN
 
 template <class To, class From>
 inline Vec3T<To> vec_cast(const Vec3T<From>& a) {
     return {To(a.x), To(a.y), To(a.z)};
 }
+STREAMRT_ISA_END
 
 }  // namespace streamrt

@@ -327,9 +327,10 @@ namespace {
 
 /// Through a temporary name in the same folder (so the rename is atomic): fill(sink) writes
 /// the content; whatever stops it (an error, bad_alloc, Ctrl-C: fill returns false) leaves no
-/// temporary behind and no file at `path`.
+/// temporary behind and no file at `path`. `cancel` is looked at once more after the last
+/// byte: a Ctrl-C that arrives during the final write still leaves no file.
 template <class Fill>
-bool write_atomically(const std::string& path, Fill&& fill) {
+bool write_atomically(const std::string& path, const std::atomic<bool>* cancel, Fill&& fill) {
     const fs::path target(path);
     std::string tmp_name = ".";  // appended, not "." + ...: GCC 12 warns falsely on that
     tmp_name += target.filename().string() + ".tmp" + std::to_string(::getpid());
@@ -353,7 +354,7 @@ bool write_atomically(const std::string& path, Fill&& fill) {
         ::unlink(tmp.c_str());
         throw RenderError(path + ": write failed: " + std::strerror(err));
     }
-    if (!written) {
+    if (!written || (cancel && cancel->load())) {
         ::unlink(tmp.c_str());
         return false;
     }
@@ -370,11 +371,11 @@ bool write_atomically(const std::string& path, Fill&& fill) {
 bool write_image(const std::string& path, const Framebuffer& fb, Calibration how, const WriteOptions& options) {
     const auto format = image_format_for(path);
     if (!format) throw RenderError(path + ": unknown image format (expected .ppm, .png or .pfm)");
-    return write_atomically(path, [&](auto&& sink) { return encode_image(fb, *format, how, sink, options); });
+    return write_atomically(path, options.cancel, [&](auto&& sink) { return encode_image(fb, *format, how, sink, options); });
 }
 
 void write_text_file(const std::string& path, std::string_view text) {
-    write_atomically(path, [&](auto&& sink) {
+    write_atomically(path, nullptr, [&](auto&& sink) {
         const iovec piece{const_cast<char*>(text.data()), text.size()};
         sink(std::span<const iovec>(&piece, 1));
         return true;

@@ -48,7 +48,7 @@ struct WriteOptions {
 int png_band_rows(int width);
 
 /// Bytes the writer holds besides the framebuffer while writing a width x height image
-/// (the largest of the formats; render/limits.cpp adds it to the estimate).
+/// (the largest of the formats; driver/limits.cpp adds it to the estimate).
 double image_write_buffer_bytes(int width, int height);
 
 /// Receives the encoded file in order, a few large pieces at a time.

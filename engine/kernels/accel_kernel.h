@@ -74,18 +74,11 @@ inline void push_sorted(StackEntry* stack, int& sp, StackEntry* hits, int nh) {
     for (int k = 0; k < nh; ++k) stack[sp++] = hits[k];
 }
 
-/// Runs f(ShapeMath{}) for a stored kind.
+/// Runs f(ShapeMath{}) for a stored kind (shapes/shapes.h's generated switch). Meshes are
+/// not closed-form: the leaf loops call the mesh walk instead, before this.
 template <class F>
 inline void with_shape(std::uint32_t kind, F&& f) {
-    switch (ShapeKind(kind)) {
-        case ShapeKind::Sphere: f(SphereMath{}); break;
-        case ShapeKind::Cube: f(CubeMath{}); break;
-        case ShapeKind::Cylinder: f(CylinderMath{}); break;
-        case ShapeKind::Cone: f(ConeMath{}); break;
-        case ShapeKind::Torus: f(TorusMath{}); break;
-        case ShapeKind::Plane: f(PlaneMath{}); break;
-        case ShapeKind::Mesh: break;  // not closed-form: the leaf loops call the mesh walk instead
-    }
+    visit_shape(ShapeKind(kind), f);
 }
 
 /// A mesh object in a leaf: the packet at `base` into the mesh's canonical space, then its

@@ -6,7 +6,7 @@
 
 #include "accel/bvh.h"
 #include "kernels/kernel_table.h"
-#include "stream/ray_stream.h"
+#include "kernels/ray_stream.h"
 
 namespace streamrt {
 

@@ -14,12 +14,10 @@
 
 namespace streamrt::STREAMRT_ISA_NAMESPACE {
 
-/// The precision each shape is solved in: float, except the torus, whose quartic needs
-/// double lanes (8 per AVX-512 register instead of 16).
+/// The precision each shape is solved in, as it declares (Shape::Compute): float, except the
+/// torus, whose quartic needs double lanes (8 per AVX-512 register instead of 16).
 template <class Shape>
-struct ComputeType { using type = float; };
-template <>
-struct ComputeType<TorusMath> { using type = double; };
+struct ComputeType { using type = typename Shape::Compute; };
 
 template <class B>
 struct RayPacket {
@@ -31,18 +29,15 @@ inline B load_lanes(const float* p) {
     return B::load_aligned(p);  // converts float -> double for double batches
 }
 
-/// World ray -> object's canonical space with Mi (12 broadcast FMAs per component set).
+/// World ray -> object's canonical space with Mi (core/transform.h's helpers, the same
+/// evaluation order as the shade stage and the baseline).
 template <class B, class T>
 inline RayPacket<B> to_canonical(const RayPacket<B>& r, const ObjectXf& ob) {
-    const auto m = [&](int i) { return B(T(ob.m[i])); };
-    RayPacket<B> c;
-    c.o.x = xsimd::fma(m(0), r.o.x, xsimd::fma(m(1), r.o.y, xsimd::fma(m(2), r.o.z, m(3))));
-    c.o.y = xsimd::fma(m(4), r.o.x, xsimd::fma(m(5), r.o.y, xsimd::fma(m(6), r.o.z, m(7))));
-    c.o.z = xsimd::fma(m(8), r.o.x, xsimd::fma(m(9), r.o.y, xsimd::fma(m(10), r.o.z, m(11))));
-    c.d.x = xsimd::fma(m(0), r.d.x, xsimd::fma(m(1), r.d.y, m(2) * r.d.z));
-    c.d.y = xsimd::fma(m(4), r.d.x, xsimd::fma(m(5), r.d.y, m(6) * r.d.z));
-    c.d.z = xsimd::fma(m(8), r.d.x, xsimd::fma(m(9), r.d.y, m(10) * r.d.z));
-    return c;
+    struct Rows {
+        const float* m;
+        B operator[](int i) const { return B(T(m[i])); }
+    } rows{ob.m};
+    return {apply_point(rows, r.o), apply_vector(rows, r.d)};
 }
 
 /// Writes a packet's closest hits back: t into t_max and the object id, for the lanes that
@@ -212,24 +207,17 @@ void mesh_any_culled(RayView rays, const ObjectXf* objs, const ObjectBounds*, st
 
 #define SHADE_VARIANT(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8), false>
 #define SHADE_GATHERED(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8), true>
-template <class Arch>
-KernelTable make_table(Isa isa, const char* name) {
+/// The per-kind columns come from the registry (shapes/shapes.h): the canonical shapes in
+/// ShapeKind order, then the mesh kernels (Mesh is the last kind).
+template <class Arch, class... S>
+KernelTable make_table(Isa isa, const char* name, ShapeList<S...>) {
     return KernelTable{isa,
                        name,
                        int(xsimd::batch<float, Arch>::size),
-                       {&closest_hit<Arch, SphereMath>, &closest_hit<Arch, CubeMath>, &closest_hit<Arch, CylinderMath>,
-                        &closest_hit<Arch, ConeMath>, &closest_hit<Arch, TorusMath>, &closest_hit<Arch, PlaneMath>,
-                        &mesh_closest_hit<Arch>},
-                       {&any_hit<Arch, SphereMath>, &any_hit<Arch, CubeMath>, &any_hit<Arch, CylinderMath>,
-                        &any_hit<Arch, ConeMath>, &any_hit<Arch, TorusMath>, &any_hit<Arch, PlaneMath>,
-                        &mesh_any_hit<Arch>},
-                       {&closest_hit_impl<Arch, SphereMath>, &closest_hit_impl<Arch, CubeMath>,
-                        &closest_hit_impl<Arch, CylinderMath>, &closest_hit_impl<Arch, ConeMath>,
-                        &closest_hit_impl<Arch, TorusMath>, &closest_hit_impl<Arch, PlaneMath>,
-                        &mesh_closest_culled<Arch>},
-                       {&any_hit_impl<Arch, SphereMath>, &any_hit_impl<Arch, CubeMath>, &any_hit_impl<Arch, CylinderMath>,
-                        &any_hit_impl<Arch, ConeMath>, &any_hit_impl<Arch, TorusMath>, &any_hit_impl<Arch, PlaneMath>,
-                        &mesh_any_culled<Arch>},
+                       {&closest_hit<Arch, S>..., &mesh_closest_hit<Arch>},
+                       {&any_hit<Arch, S>..., &mesh_any_hit<Arch>},
+                       {&closest_hit_impl<Arch, S>..., &mesh_closest_culled<Arch>},
+                       {&any_hit_impl<Arch, S>..., &mesh_any_culled<Arch>},
                        {SHADE_VARIANT(0), SHADE_VARIANT(1), SHADE_VARIANT(2), SHADE_VARIANT(3), SHADE_VARIANT(4),
                         SHADE_VARIANT(5), SHADE_VARIANT(6), SHADE_VARIANT(7), SHADE_VARIANT(8), SHADE_VARIANT(9),
                         SHADE_VARIANT(10), SHADE_VARIANT(11), SHADE_VARIANT(12), SHADE_VARIANT(13), SHADE_VARIANT(14),
@@ -239,6 +227,11 @@ KernelTable make_table(Isa isa, const char* name) {
                         SHADE_GATHERED(8), SHADE_GATHERED(9), SHADE_GATHERED(10), SHADE_GATHERED(11),
                         SHADE_GATHERED(12), SHADE_GATHERED(13), SHADE_GATHERED(14), SHADE_GATHERED(15)},
                        &generate_rays<Arch>};
+}
+
+template <class Arch>
+KernelTable make_table(Isa isa, const char* name) {
+    return make_table<Arch>(isa, name, CanonicalShapes{});
 }
 
 #undef SHADE_VARIANT

@@ -5,7 +5,8 @@
 namespace streamrt::isa_kernels {
 
 const AccelKernelTable& avx512_accel() {
-    // Packets as wide as the level's float registers; node tests 8 lanes at once with AVX2 batches (isa_avx2*.cpp link first, so the linker keeps their copies of xsimd's AVX2 helpers).
+    // Packets as wide as the level's float registers; node tests 8 lanes at once with AVX2 batches
+    // (this file's copies of xsimd's AVX2 helpers are its own: kernels/isa_rename.cmake).
     static const AccelKernelTable table = isa_avx512::make_accel_table<xsimd::avx512bw, xsimd::fma3<xsimd::avx2>>();
     return table;
 }

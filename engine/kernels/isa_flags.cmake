@@ -7,8 +7,11 @@
 # GCC 12 gives false -Wuninitialized/-Wmaybe-uninitialized warnings with AVX-512 (bug 105593).
 set(STREAMRT_SSE42_FLAGS "-msse4.2;-ffp-contract=off")
 set(STREAMRT_AVX2_FLAGS "-mavx2;-mfma;-ffp-contract=off")
+# Unoptimised builds (Debug) compile the AVX-512 files at -Og: at -O0 GCC 12 defines some
+# AVX-512 intrinsics as macros with casts, and xsimd 8.1's integer select (reached through
+# xsimd::pow) then fails to compile.
 set(STREAMRT_AVX512_FLAGS
-  "-mavx512f;-mavx512cd;-mavx512dq;-mavx512bw;-mavx512vl;-mfma;-ffp-contract=off;-Wno-uninitialized;-Wno-maybe-uninitialized")
+  "-mavx512f;-mavx512cd;-mavx512dq;-mavx512bw;-mavx512vl;-mfma;-ffp-contract=off;-Wno-uninitialized;-Wno-maybe-uninitialized;$<$<CONFIG:Debug>:-Og>")
 foreach(suffix "" "_accel")
   set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/isa_sse42${suffix}.cpp PROPERTIES COMPILE_OPTIONS "${STREAMRT_SSE42_FLAGS}")
   set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/kernels/isa_avx2${suffix}.cpp PROPERTIES COMPILE_OPTIONS "${STREAMRT_AVX2_FLAGS}")

@@ -11,7 +11,7 @@
 #include "kernels/shade_job.h"
 #include "mesh/mesh_view.h"
 #include "scene/scene.h"
-#include "stream/ray_stream.h"
+#include "kernels/ray_stream.h"
 
 namespace streamrt {
 

@@ -7,6 +7,7 @@
 
 #include "kernels/kernel_object.h"
 #include "mesh/mesh_view.h"
+#include "render/camera_rays.h"
 #include "render/shading.h"
 #include "scene/scene.h"
 
@@ -41,10 +42,7 @@ struct ShadeJob {
     const MaterialT<float>* material;
     const LightT<float>* lights;
     std::size_t n_lights;
-    int degree;
-    float ambient;
-    bool spawn;    ///< depth allows reflected / refracted children
-    float spread;  ///< ray-cone spread angle (texture filtering)
+    ShadeRules<float> rules;  ///< degree, ambient, whether children spawn, cut-off, cone spread
     // Outputs: the weighted local colour of each ray (same indexing as the inputs) ...
     float *lr, *lg, *lb;
     // ... and the rays it spawns.
@@ -70,8 +68,8 @@ struct GenerateJob {
     int pattern;  ///< SamplePattern
     bool jitter;  ///< false: pixel centres (spp = 1)
     float cols, rows;
-    float origin[3], du[3], dv[3], dback[3];
-    float inv_width, inv_height, weight;
+    const CameraRays<float>* camera;
+    float weight;
     RayAppend out;
 };
 using GenerateFn = void (*)(const GenerateJob& job);

@@ -1,7 +1,8 @@
 #pragma once
-// The SIMD shade kernel: local terms by degree, shadow rays, reflected and refracted rays
-// for a run of rays that all hit one object. Specialised at compile time on the features
-// the scene uses. Included only by kernels/isa_*.cpp, inside their own namespace.
+// The SIMD shade kernel: a run of rays that all hit one object (or, gathered, one material
+// and shape kind) goes through the shading rules of render/shading.h (shade_hit) a packet at
+// a time. Specialised at compile time on the features the scene uses. Included only by
+// kernels/isa_*.cpp, inside their own namespace.
 #include <xsimd/xsimd.hpp>
 
 #include <algorithm>
@@ -31,39 +32,11 @@ struct LaneRows {
     const B& operator[](int k) const { return v[k]; }
 };
 
-template <class B, class M>
-inline Vec3T<B> apply_point(const M& m, const Vec3T<B>& p) {
-    return {xsimd::fma(m[0], p.x, xsimd::fma(m[1], p.y, xsimd::fma(m[2], p.z, m[3]))),
-            xsimd::fma(m[4], p.x, xsimd::fma(m[5], p.y, xsimd::fma(m[6], p.z, m[7]))),
-            xsimd::fma(m[8], p.x, xsimd::fma(m[9], p.y, xsimd::fma(m[10], p.z, m[11])))};
-}
-template <class B, class M>
-inline Vec3T<B> apply_vector(const M& m, const Vec3T<B>& v) {
-    return {xsimd::fma(m[0], v.x, xsimd::fma(m[1], v.y, m[2] * v.z)),
-            xsimd::fma(m[4], v.x, xsimd::fma(m[5], v.y, m[6] * v.z)),
-            xsimd::fma(m[8], v.x, xsimd::fma(m[9], v.y, m[10] * v.z))};
-}
-/// Mn n with Mn = (Mi's linear part) transposed, read from Mi's row-major 3x4 rows.
-template <class B, class M>
-inline Vec3T<B> apply_normal(const M& mi, const Vec3T<B>& n) {
-    return normalize(Vec3T<B>{xsimd::fma(mi[0], n.x, xsimd::fma(mi[4], n.y, mi[8] * n.z)),
-                              xsimd::fma(mi[1], n.x, xsimd::fma(mi[5], n.y, mi[9] * n.z)),
-                              xsimd::fma(mi[2], n.x, xsimd::fma(mi[6], n.y, mi[10] * n.z))});
-}
-
 template <class B>
 inline Vec3T<B> canonical_normal(ShapeKind kind, const Vec3T<B>& p, const B& param) {
-    // One branch per packet (every lane hit the same object), never per ray.
-    switch (kind) {
-        case ShapeKind::Sphere: return SphereMath::normal<B>(p, param);
-        case ShapeKind::Cube: return CubeMath::normal<B>(p, param);
-        case ShapeKind::Cylinder: return CylinderMath::normal<B>(p, param);
-        case ShapeKind::Cone: return ConeMath::normal<B>(p, param);
-        case ShapeKind::Torus: return TorusMath::normal<B>(p, param);
-        case ShapeKind::Plane: break;
-        case ShapeKind::Mesh: break;  // mesh_normals() below
-    }
-    return PlaneMath::normal<B>(p, param);
+    // One branch per packet (every lane hit the same object), never per ray. Meshes take
+    // mesh_normals() below.
+    return visit_shape(kind, [&](auto shape) { return shape.template normal<B>(p, param); });
 }
 
 /// Canonical normals of a mesh's hits, gathered lane by lane from the hit triangles: the face
@@ -126,6 +99,44 @@ inline void append(const ShadeJob& job, std::size_t i, const M& active, const Ve
     *r.count = j + n;
 }
 
+/// Where shade_hit's results go in the SIMD kernel: the packet's local colours into the
+/// run's output arrays, shadow and child rays compacted into their streams.
+template <class B>
+struct SimdSink {
+    static constexpr bool kTestsShadowsNow = false;
+    using Mask = xsimd::batch_bool<float, typename B::arch_type>;
+    const ShadeJob& job;
+    std::size_t i;  ///< the packet's first ray in the run
+
+    void local(const ColorT<B>& c) const {
+        c.x.store_unaligned(job.lr + i);
+        c.y.store_unaligned(job.lg + i);
+        c.z.store_unaligned(job.lb + i);
+    }
+    void shadow(const Mask& send, const Vec3T<B>& from, const Vec3T<B>& to, const B& t_max, const ColorT<B>& c) const {
+        const unsigned bits = lane_bits(send);
+        if (bits == 0) return;
+        const ShadowAppend& sa = job.shadows;
+        const std::size_t j = *sa.count;
+        compress_store(from.x, bits, sa.ox + j);
+        compress_store(from.y, bits, sa.oy + j);
+        compress_store(from.z, bits, sa.oz + j);
+        compress_store(to.x, bits, sa.dx + j);
+        compress_store(to.y, bits, sa.dy + j);
+        compress_store(to.z, bits, sa.dz + j);
+        compress_store(t_max, bits, sa.t_max + j);
+        compress_store(c.x, bits, sa.cr + j);
+        compress_store(c.y, bits, sa.cg + j);
+        compress_store(c.z, bits, sa.cb + j);
+        *sa.count = j + compress_store(xsimd::batch<std::int32_t, typename B::arch_type>::load_unaligned(job.pixel + i),
+                                       bits, sa.pixel + j);
+    }
+    void child(const Mask& send, const Vec3T<B>& from, const Vec3T<B>& dir, const ColorT<B>& weight, const ColorT<B>&,
+               const B& cone, RayKind kind) const {
+        append(job, i, send, from, dir, weight, cone, kind);
+    }
+};
+
 /// kGathered: the run shares a material and a shape kind, not an object; each lane's Mi, shape
 /// parameter and colour are gathered from its object's records (the same values a run of that
 /// object would broadcast, so the same arithmetic per lane).
@@ -142,8 +153,6 @@ void shade_run(const ShadeJob& job) {
     const float* object_floats = reinterpret_cast<const float*>(kGathered ? job.objects : job.object);
     const float* surface_floats = reinterpret_cast<const float*>(job.surfaces);
     const MaterialT<float>& m = *job.material;
-    const bool reflect_here = kReflect && job.spawn && m.refl > 0.f;
-    const bool refract_here = kRefract && job.spawn && m.trans > 0.f;
     alignas(64) float lane_index[W];
     for (std::size_t l = 0; l < W; ++l) lane_index[l] = float(l);
     const B lanes = B::load_aligned(lane_index);
@@ -177,65 +186,14 @@ void shade_run(const ShadeJob& job) {
         // is the ray's own.
         const Vec3T<B> pc = apply_point(rows, o) + apply_vector(rows, d) * t;
         const Vec3T<B> p = o + d * t;
-        const B cone_in = B::load_unaligned(job.cone + i);
-        const B cone = cone_in + B(job.spread) * t;
-        ColorT<B> base;
-        Vec3T<B> n_out;
+        Vec3T<B> n_out{};
         if (kLit || m.checker)
             n_out = apply_normal(rows, kind == ShapeKind::Mesh && !kGathered ? mesh_normals<B>(job, i)
                                                                               : canonical_normal(kind, pc, param));
-        if (m.checker)
-            base = surface_color(m, color, p, n_out, footprint_width(cone_in, B(job.spread), t, dot(d, n_out)));
-        else base = color;
-        ColorT<B> local;
-        if constexpr (!kLit) {
-            local = mul(w, base);
-        } else {
-            const auto facing = dot(n_out, d) < B(0.f);
-            const Vec3T<B> n = select3(facing, n_out, -n_out);
-            local = mul(w, ambient_light(job.degree, job.ambient, m, base));
-            Vec3T<B> shadow_origin{};
-            if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, o);
-            for (std::size_t li = 0; li < job.n_lights; ++li) {
-                const LightT<float>& l = job.lights[li];
-                const LightSample<B> ls = sample_light(l, p);
-                const DirectLight<B> dl = direct_light(job.degree, m, base, n, d, l, ls);
-                const auto send = dl.lit && active;
-                if (xsimd::none(send)) continue;
-                if constexpr (kShadows) {
-                    const Vec3T<B> to =
-                        l.kind == LightKind::Directional ? ls.to_light : splat<B>(l.pos) - shadow_origin;
-                    const ColorT<B> c = mul(w, dl.color);
-                    const unsigned bits = lane_bits(send);
-                    const ShadowAppend& sa = job.shadows;
-                    const std::size_t j = *sa.count;
-                    compress_store(shadow_origin.x, bits, sa.ox + j);
-                    compress_store(shadow_origin.y, bits, sa.oy + j);
-                    compress_store(shadow_origin.z, bits, sa.oz + j);
-                    compress_store(to.x, bits, sa.dx + j);
-                    compress_store(to.y, bits, sa.dy + j);
-                    compress_store(to.z, bits, sa.dz + j);
-                    compress_store(ls.t_max, bits, sa.t_max + j);
-                    compress_store(c.x, bits, sa.cr + j);
-                    compress_store(c.y, bits, sa.cg + j);
-                    compress_store(c.z, bits, sa.cb + j);
-                    *sa.count = j + compress_store(xsimd::batch<std::int32_t, Arch>::load_unaligned(job.pixel + i), bits,
-                                                   sa.pixel + j);
-                } else {
-                    local = local + mul(w, dl.color);
-                }
-            }
-            if (reflect_here) append(job, i, active, offset_ray_origin(p, n, o), reflect(d, n), w * B(m.refl), cone, RayKind::Reflected);
-            if (refract_here) {
-                const Vec3T<B> tr = refract(d, n_out, m.ior);
-                const auto out_side = dot(tr, n_out) > B(0.f);
-                append(job, i, active, offset_ray_origin(p, select3(out_side, n_out, -n_out), o), tr, w * B(m.trans),
-                       cone, RayKind::Refracted);
-            }
-        }
-        local.x.store_unaligned(job.lr + i);
-        local.y.store_unaligned(job.lg + i);
-        local.z.store_unaligned(job.lb + i);
+        const ArrivingRay<B> arriving{o, d, t, B::load_unaligned(job.cone + i), w, w};
+        SimdSink<B> sink{job, i};
+        shade_hit<kLit, kShadows, kReflect, kRefract>(job.rules, m, job.lights, job.n_lights, arriving, p, n_out, color,
+                                                      active, sink);
     }
 }
 

@@ -22,7 +22,11 @@
 #endif
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
+#include <mutex>
+#include <set>
+#include <thread>
 #include <utility>
 
 namespace streamrt {
@@ -43,6 +47,15 @@ struct Tile {
     int height() const { return y1 - y0; }
 };
 
+/// Tile number `index` of a width x height image cut into kTileSize squares, numbered row by
+/// row from the top-left (the numbering of for_each_tile).
+inline Tile tile_rect(int width, int height, int index) {
+    const int nx = (width + kTileSize - 1) / kTileSize;
+    const int tx = index % nx, ty = index / nx;
+    return Tile{tx * kTileSize, ty * kTileSize, std::min(width, (tx + 1) * kTileSize),
+                std::min(height, (ty + 1) * kTileSize)};
+}
+
 /// The number of threads "all cores" means.
 inline int default_jobs() {
 #if STREAMRT_STD_THREADS
@@ -52,13 +65,52 @@ inline int default_jobs() {
 #endif
 }
 
+/// Notes every thread that runs a piece of a parallel loop of this file while it is alive
+/// (one at a time): tests check with it that -j bounds the threads of a phase.
+class ThreadProbe {
+  public:
+    ThreadProbe() { installed().store(this); }
+    ~ThreadProbe() { installed().store(nullptr); }
+    ThreadProbe(const ThreadProbe&) = delete;
+    ThreadProbe& operator=(const ThreadProbe&) = delete;
+    /// Distinct threads seen.
+    std::size_t threads() const {
+        std::lock_guard<std::mutex> lock(mutex_);
+        return ids_.size();
+    }
+    /// Called by the loops: notes the calling thread if a probe is installed.
+    static void note() {
+        if (ThreadProbe* p = installed().load(std::memory_order_relaxed)) {
+            std::lock_guard<std::mutex> lock(p->mutex_);
+            p->ids_.insert(std::this_thread::get_id());
+        }
+    }
+
+  private:
+    static std::atomic<ThreadProbe*>& installed() {
+        static std::atomic<ThreadProbe*> probe{nullptr};
+        return probe;
+    }
+    mutable std::mutex mutex_;
+    std::set<std::thread::id> ids_;
+};
+
 #if STREAMRT_STD_THREADS
 namespace parallel_detail {
 /// Runs work() on `threads` threads (the caller is one of them).
+/// The threads of the Parallelism::run() the calling thread is in (0: none, all cores).
+inline thread_local int current_jobs = 0;
 template <class Work>
 void run_on_threads(int threads, Work&& work) {
     std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back([&] { work(); });
+    const int jobs = current_jobs;
+    for (int t = 1; t < threads; ++t)
+        pool.emplace_back([&] {
+            current_jobs = jobs;
+            ThreadProbe::note();
+            work();
+        });
+    ThreadProbe::note();
     work();
     for (std::thread& t : pool) t.join();
 }
@@ -69,6 +121,18 @@ class Parallelism {
   public:
     explicit Parallelism(int jobs) : jobs_(jobs > 0 ? jobs : default_jobs()) {}
     int jobs() const { return jobs_; }
+
+    /// Runs f() so that the loops it calls (parallel_for_index, parallel_invoke) use at most
+    /// jobs() threads; returns what f returns.
+    template <class F>
+    decltype(auto) run(F&& f) {
+        struct Restore {
+            int saved = parallel_detail::current_jobs;
+            ~Restore() { parallel_detail::current_jobs = saved; }
+        } restore;
+        parallel_detail::current_jobs = jobs_;
+        return f();
+    }
 
     template <class Body>
     void for_each_tile(int width, int height, int tile, Body&& body) {
@@ -99,13 +163,14 @@ class Parallelism {
 template <class A, class B>
 inline void parallel_invoke(A&& a, B&& b) {
     // Two threads per level for the first levels of a recursive build, then sequential.
-    if (parallel_detail::invoke_depth >= 3) {
+    if (parallel_detail::invoke_depth >= 3 || parallel_detail::current_jobs == 1) {
         a();
         b();
         return;
     }
     std::thread other([&] {
         parallel_detail::invoke_depth = 4;  // the new thread recurses sequentially
+        ThreadProbe::note();
         a();
     });
     ++parallel_detail::invoke_depth;
@@ -116,7 +181,8 @@ inline void parallel_invoke(A&& a, B&& b) {
 
 template <class Body>
 inline void parallel_for_index(std::size_t n, std::size_t grain, Body&& body) {
-    Parallelism(default_jobs()).for_each_index(n, grain, std::forward<Body>(body));
+    const int jobs = parallel_detail::current_jobs;
+    Parallelism(jobs > 0 ? jobs : default_jobs()).for_each_index(n, grain, std::forward<Body>(body));
 }
 
 #else
@@ -131,6 +197,13 @@ class Parallelism {
 
     int jobs() const { return jobs_; }
 
+    /// Runs f() inside this arena, so the loops it calls (parallel_for_index,
+    /// parallel_invoke) use at most jobs() threads; returns what f returns.
+    template <class F>
+    decltype(auto) run(F&& f) {
+        return arena_.execute(std::forward<F>(f));
+    }
+
     /// body(tile_index, Tile) for every tile of a width x height image cut into tile x tile
     /// squares. Tiles depend only on the image size, never on -j, and are handed out
     /// dynamically (grain 1), so the picture is the same for every thread count.
@@ -141,6 +214,7 @@ class Parallelism {
             oneapi::tbb::parallel_for(
                 oneapi::tbb::blocked_range<int>(0, nx * ny, 1),
                 [&](const oneapi::tbb::blocked_range<int>& r) {
+                    ThreadProbe::note();
                     for (int i = r.begin(); i != r.end(); ++i) {
                         const int tx = i % nx, ty = i / nx;
                         body(i, Tile{tx * tile, ty * tile, std::min(width, (tx + 1) * tile),
@@ -157,6 +231,7 @@ class Parallelism {
         arena_.execute([&] {
             oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, grain),
                                       [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                                          ThreadProbe::note();
                                           for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
                                       });
         });
@@ -172,7 +247,15 @@ class Parallelism {
 /// work, or after one was made, -j is honoured). For recursive builds (engine/accel).
 template <class A, class B>
 inline void parallel_invoke(A&& a, B&& b) {
-    oneapi::tbb::parallel_invoke(std::forward<A>(a), std::forward<B>(b));
+    oneapi::tbb::parallel_invoke(
+        [&] {
+            ThreadProbe::note();
+            a();
+        },
+        [&] {
+            ThreadProbe::note();
+            b();
+        });
 }
 
 /// body(i) for i in [0, n), chunks of `grain`, in the caller's arena (see parallel_invoke).
@@ -180,6 +263,7 @@ template <class Body>
 inline void parallel_for_index(std::size_t n, std::size_t grain, Body&& body) {
     oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, grain),
                               [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                                  ThreadProbe::note();
                                   for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
                               });
 }

@@ -8,6 +8,7 @@
 
 #include "core/vec3.h"
 #include "scene/scene.h"
+#include "simd/lanes.h"
 
 namespace streamrt {
 
@@ -33,10 +34,19 @@ struct CameraRays {
     }
 
     /// Unit direction through image position (px, py), in pixels from the top-left corner.
-    Vec3T<T> direction(T px, T py) const {
-        const T u = T(2) * px * inv_width - T(1);
-        const T w = T(1) - T(2) * py * inv_height;
-        return normalize(du * u + dv * w + dback);
+    Vec3T<T> direction(T px, T py) const { return direction_of<T>(px, py); }
+    /// The same for a batch of positions (the stream engine's generate kernel).
+    template <class B>
+        requires simd::is_batch<B>
+    Vec3T<B> direction(const B& px, const B& py) const { return direction_of<B>(px, py); }
+
+  private:
+    template <class V>
+    Vec3T<V> direction_of(const V& px, const V& py) const {
+        const auto lanes = [](const Vec3T<T>& a) { return Vec3T<V>{V(a.x), V(a.y), V(a.z)}; };
+        const V u = V(T(2)) * px * V(inv_width) - V(T(1));
+        const V w = V(T(1)) - V(T(2)) * py * V(inv_height);
+        return normalize(lanes(du) * u + lanes(dv) * w + lanes(dback));
     }
 };
 

@@ -5,6 +5,8 @@
 
 namespace streamrt {
 
+enum class RayKind : std::uint8_t { Primary, Reflected, Refracted };
+
 struct RayCounts {
     std::uint64_t primary = 0, shadow = 0, reflected = 0, refracted = 0;
     std::uint64_t total() const { return primary + shadow + reflected + refracted; }

@@ -7,8 +7,11 @@
 #include <cstdint>
 
 #include "scene/scene.h"
+#include "simd/lanes.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 /// A 32-bit integer hash with good avalanche (xor-shift-multiply, "lowbias32" constants).
 /// U is std::uint32_t or an xsimd batch of it.
@@ -28,12 +31,19 @@ inline void sample_hashes(const U& pixel, const U& k, U& h1, U& h2) {
     h2 = hash32(h1 ^ U(0x5bd1e995u));
 }
 
-/// Top 24 bits of a hash as a float in [0, 1), exactly representable.
-inline float unit_from_hash(std::uint32_t h) { return float(h >> 8) * 0x1p-24f; }
+/// Top 24 bits of a hash as a float in [0, 1), exactly representable. U is std::uint32_t
+/// (giving float) or a batch of it (giving a float batch).
+template <class U>
+inline auto unit_from_hash(const U& h) {
+    const auto f = simd::to_float(h >> 8);
+    return f * decltype(f)(0x1p-24f);
+}
 
-struct PixelSample {
-    float x, y;  ///< offset inside the pixel, in [0, 1)
+template <class V>
+struct PixelSampleT {
+    V x, y;  ///< offset inside the pixel, in [0, 1)
 };
+using PixelSample = PixelSampleT<float>;
 
 /// Lattice used by the grid and stratified patterns: cols x rows = spp exactly, as square
 /// as possible (cols is the smallest divisor of spp not below its square root).
@@ -43,14 +53,16 @@ inline int grid_columns(int spp) {
     return cols;
 }
 
-/// Offset of sample k in its lattice cell (cx, cy) of a cols x rows lattice, from the two
+/// Offset of a sample in its lattice cell (cx, cy) of a cols x rows lattice, from the two
 /// hash values u, v in [0, 1): grid takes cell centres, stratified one uniform point per
-/// cell, random ignores the lattice. The same float operations run in the SIMD kernel.
-inline PixelSample lattice_sample(SamplePattern pattern, int cx, int cy, int cols, int rows, float u, float v) {
+/// cell, random ignores the lattice. V is float, or a float batch in the generate kernel.
+template <class V>
+inline PixelSampleT<V> lattice_sample(SamplePattern pattern, const V& cx, const V& cy, const V& cols, const V& rows,
+                                      const V& u, const V& v) {
     if (pattern == SamplePattern::Random) return {u, v};
-    const float ju = pattern == SamplePattern::Grid ? 0.5f : u;
-    const float jv = pattern == SamplePattern::Grid ? 0.5f : v;
-    return {(float(cx) + ju) / float(cols), (float(cy) + jv) / float(rows)};
+    const V ju = pattern == SamplePattern::Grid ? V(0.5f) : u;
+    const V jv = pattern == SamplePattern::Grid ? V(0.5f) : v;
+    return {(cx + ju) / cols, (cy + jv) / rows};
 }
 
 /// Sample `sample` of `spp` in pixel `pixel` (row-major index). spp = 1 always takes the
@@ -60,8 +72,9 @@ inline PixelSample pixel_sample(SamplePattern pattern, int spp, std::uint64_t pi
     std::uint32_t h1, h2;
     sample_hashes(std::uint32_t(pixel), std::uint32_t(sample), h1, h2);
     const int cols = grid_columns(spp);
-    return lattice_sample(pattern, sample % cols, sample / cols, cols, spp / cols, unit_from_hash(h1),
-                          unit_from_hash(h2));
+    return lattice_sample(pattern, float(sample % cols), float(sample / cols), float(cols), float(spp / cols),
+                          unit_from_hash(h1), unit_from_hash(h2));
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

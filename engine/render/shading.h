@@ -9,7 +9,9 @@
 #include <limits>
 
 #include "core/vec3.h"
+#include "render/render_stats.h"
 #include "scene/scene.h"
+#include "simd/isa_namespace.h"
 #include "simd/lanes.h"
 
 namespace streamrt {
@@ -19,6 +21,8 @@ using ColorT = Vec3T<T>;
 
 template <class V>
 using MaskOf = decltype(V() < V());
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 template <class V, class M>
 inline Vec3T<V> select3(const M& m, const Vec3T<V>& a, const Vec3T<V>& b) {
@@ -30,6 +34,8 @@ template <class V, class T>
 inline Vec3T<V> splat(const Vec3T<T>& a) {
     return {V(a.x), V(a.y), V(a.z)};
 }
+
+STREAMRT_ISA_END
 
 /// A material in the engine's precision. The object's own colour (Object::color) is passed
 /// beside it wherever a surface colour is needed.
@@ -68,6 +74,8 @@ struct LightT {
                 T(std::cos(l.angle * 3.14159265358979323846 / 180.0))};
     }
 };
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 namespace detail {
 /// G(x) = integral from 0 to x of [floor(u) is odd] du; G(x + 2) = G(x) + 1.
@@ -174,12 +182,11 @@ inline DirectLight<V> direct_light(int degree, const MaterialT<T>& m, const Colo
     if (degree == 1) return {base * k, lit};
     ColorT<V> c = base * (V(m.diff) * k);
     if (m.spec > T(0)) {
-        using std::pow;
         const Vec3T<V> r = n * (V(2) * ndotw) - s.w;  // w mirrored about n
         const V rv = -dot(r, view);
         const auto shiny = lit && (rv > zero) && (rv > V(m.spec_cutoff));
         if (any(shiny)) {
-            const V h = select(shiny, V(m.spec) * pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
+            const V h = select(shiny, V(m.spec) * simd::pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
             c = c + ColorT<V>{h, h, h};
         }
     }
@@ -248,4 +255,120 @@ inline Vec3T<V> offset_ray_origin(const Vec3T<V>& p, const Vec3T<V>& n, const Ve
     return p + n * step;
 }
 
+STREAMRT_ISA_END
+
+/// What the shading rules take from the render settings, in the engine's precision (a data
+/// type the kernels' jobs carry: outside the per-level namespaces).
+template <class T>
+struct ShadeRules {
+    int degree;
+    T ambient;  ///< alpha
+    bool spawn;  ///< the depth still allows reflected and refracted children
+    /// Weight cut-off: a child whose throughput is below this in every channel is not traced
+    /// (image cutoff=, --cutoff); 0 traces every child, as the handout does.
+    T cutoff;
+    T spread;  ///< ray-cone spread per unit of distance (checker filtering)
+};
+
+/// The ray that found a hit, at the hit.
+template <class V>
+struct ArrivingRay {
+    Vec3T<V> origin, dir;  ///< dir unit
+    V t;                   ///< where it hit
+    V cone;                ///< its footprint width at its origin
+    /// What its colour is worth in the pixel: multiplies every term it gathers. The stream
+    /// engine carries the product of the weights along the path (and 1/spp); the recursive
+    /// engine multiplies on the way back instead, so it passes 1 here.
+    ColorT<V> weight;
+    /// The product of the refl / trans weights from the camera to this ray (no 1/spp): what
+    /// the cut-off compares.
+    ColorT<V> throughput;
+};
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
+
+/// The handout's shading of one hit (or one packet of hits), written once for the recursive
+/// baseline (V = double, one ray), the stream engine's scalar path (float) and its SIMD
+/// kernels (float batches): the surface colour (checker), the local terms by degree, shadow
+/// rays, and the reflected and refracted children with their weights. What differs between
+/// engines is only where the results go, the Sink:
+///   sink.local(c)                                  the ray's weighted local colour, first
+///   sink.shadow(send, origin, to, t_max, c)        degree 5: c reaches the pixel if the
+///                                                  segment origin + s to, s in (0, t_max),
+///                                                  is unblocked (lanes `send`)
+///   sink.child(send, origin, dir, weight, throughput, cone, kind)   a reflected or refracted
+///                                                  ray to trace (lanes `send`)
+/// A sink with kTestsShadowsNow (the recursive engine) answers sink.occluded(origin, to,
+/// t_max) at once instead, and the unblocked light joins the local colour.
+/// The features are compile-time flags so a scene's pipeline carries no code for what it
+/// lacks: kLit (degree >= 1), kShadows (degree 5), kReflect (degree >= 3 and some refl),
+/// kRefract (degree >= 4 and some trans). p is the world hit point, n_out the unit outward
+/// normal (needed when kLit or the material is a checker), color the object's colour.
+template <bool kLit, bool kShadows, bool kReflect, bool kRefract, class V, class T, class M, class Sink>
+inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const LightT<T>* lights,
+                      std::size_t n_lights, const ArrivingRay<V>& ray, const Vec3T<V>& p, const Vec3T<V>& n_out,
+                      const ColorT<V>& color, const M& active, Sink& sink) {
+    using namespace simd;
+    const Vec3T<V>& d = ray.dir;
+    const ColorT<V> base =
+        m.checker ? surface_color(m, color, p, n_out, footprint_width(ray.cone, V(rules.spread), ray.t, dot(d, n_out)))
+                  : color;
+    if constexpr (!kLit) {
+        sink.local(mul(ray.weight, base));
+        return;
+    } else {
+        // Light on the side the ray arrives from (a camera inside a room or a sphere sees the
+        // inner faces lit).
+        const Vec3T<V> n = select3(dot(n_out, d) < V(0), n_out, -n_out);
+        ColorT<V> local = mul(ray.weight, ambient_light(rules.degree, rules.ambient, m, base));
+        Vec3T<V> shadow_origin{};
+        if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, ray.origin);
+        for (std::size_t li = 0; li < n_lights; ++li) {
+            const LightT<T>& l = lights[li];
+            const LightSample<V> ls = sample_light(l, p);
+            const DirectLight<V> dl = direct_light(rules.degree, m, base, n, d, l, ls);
+            const auto send = dl.lit && active;
+            if (!any(send)) continue;
+            const ColorT<V> c = mul(ray.weight, dl.color);
+            if constexpr (kShadows) {
+                // Towards the light from the moved origin, so t_max = 1 still ends at it.
+                const Vec3T<V> to = l.kind == LightKind::Directional ? ls.to_light : splat<V>(l.pos) - shadow_origin;
+                if constexpr (Sink::kTestsShadowsNow) {
+                    if (!sink.occluded(shadow_origin, to, ls.t_max)) local = local + c;
+                } else {
+                    sink.shadow(send, shadow_origin, to, ls.t_max, c);
+                }
+            } else {
+                local = local + c;
+            }
+        }
+        sink.local(local);
+        if (!rules.spawn) return;
+        const V cone = ray.cone + V(rules.spread) * ray.t;
+        // A child is traced unless the cut-off is on and its throughput is below it in
+        // every channel.
+        const auto kept = [&](const ColorT<V>& throughput) {
+            if (!(rules.cutoff > T(0))) return active;
+            return active && (max(throughput.x, max(throughput.y, throughput.z)) >= V(rules.cutoff));
+        };
+        if constexpr (kReflect) {
+            if (rules.degree >= 3 && m.refl > T(0)) {
+                const ColorT<V> throughput = ray.throughput * V(m.refl);
+                sink.child(kept(throughput), offset_ray_origin(p, n, ray.origin), reflect(d, n),
+                           ray.weight * V(m.refl), throughput, cone, RayKind::Reflected);
+            }
+        }
+        if constexpr (kRefract) {
+            if (rules.degree >= 4 && m.trans > T(0)) {
+                const Vec3T<V> t = refract(d, n_out, m.ior);
+                const Vec3T<V> side = select3(dot(t, n_out) > V(0), n_out, -n_out);
+                const ColorT<V> throughput = ray.throughput * V(m.trans);
+                sink.child(kept(throughput), offset_ray_origin(p, side, ray.origin), t, ray.weight * V(m.trans),
+                           throughput, cone, RayKind::Refracted);
+            }
+        }
+    }
+}
+
+STREAMRT_ISA_END
 }  // namespace streamrt

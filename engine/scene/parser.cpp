@@ -17,6 +17,7 @@
 
 #include "mesh/mesh.h"
 #include "parallel/parallelism.h"
+#include "shapes/shapes.h"
 
 #include <algorithm>
 #include <array>
@@ -204,7 +205,7 @@ class Statement {
             if (std::none_of(allowed.begin(), allowed.end(), [&](std::string_view k) { return same(k, a.key); })) {
                 std::string msg = "unknown key " + quote(a.key) + " for '" + std::string(word()) +
                                   "' (expected one of:";
-                for (auto k : allowed) msg += " " + std::string(k);
+                for (auto k : allowed) (msg += ' ') += k;  // not " " + string: GCC 12's -Wrestrict false alarm
                 msg += ")";
                 fail(a.key_col, msg);
             }
@@ -315,7 +316,7 @@ const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rota
                                                       "translate"};
 const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
                                                   "depth",  "degree",  "output",
-                                                  "sampler", "calibration"};
+                                                  "sampler", "calibration", "cutoff"};
 const std::vector<std::string_view> kLookAtKeys = {"eye", "look", "up", "fov"};
 const std::vector<std::string_view> kExplicitCameraKeys = {"rx",       "ry",       "df",
                                                            "scale",    "rotate_x", "rotate_y",
@@ -331,17 +332,23 @@ std::vector<std::string_view> join(std::initializer_list<std::vector<std::string
 const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys});
 const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
 const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys});
-const std::vector<std::string_view> kTorusKeys = join({kShapeKeys, {"minor"}});
 const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth"}});
 const std::vector<std::string_view> kPointLightKeys = {"pos", "color"};
 const std::vector<std::string_view> kSpotLightKeys = {"pos", "dir", "angle", "color"};
 const std::vector<std::string_view> kDirectionalLightKeys = {"dir", "color"};
 
-const std::vector<std::string_view>& shape_keys(ShapeKind kind) {
-    if (kind == ShapeKind::Torus) return kTorusKeys;
-    if (kind == ShapeKind::Mesh) return kMeshKeys;
-    return kShapeKeys;
-}
+/// Each kind's keys: the common ones, plus its parameter key (shapes/shapes.h) or the mesh's.
+const std::array<std::vector<std::string_view>, kShapeKindCount> kKeysOfKind = [] {
+    std::array<std::vector<std::string_view>, kShapeKindCount> keys;
+    for (int k = 0; k < kShapeKindCount; ++k) {
+        const ShapeParam p = shape_param(ShapeKind(k));
+        keys[std::size_t(k)] = p.present() ? join({kShapeKeys, {p.key}}) : kShapeKeys;
+    }
+    keys[std::size_t(ShapeKind::Mesh)] = kMeshKeys;
+    return keys;
+}();
+
+const std::vector<std::string_view>& shape_keys(ShapeKind kind) { return kKeysOfKind[std::size_t(kind)]; }
 
 bool contains(const std::vector<std::string_view>& v, std::string_view k) {
     return std::find(v.begin(), v.end(), k) != v.end();
@@ -398,15 +405,14 @@ bool apply_transform_key(const Statement& st, const Arg& a, glm::dmat4& md) {
     return true;
 }
 
-std::optional<ShapeKind> shape_from_word(std::string_view w) {
-    if (same(w, "sphere")) return ShapeKind::Sphere;
-    if (same(w, "cube")) return ShapeKind::Cube;
-    if (same(w, "cylinder")) return ShapeKind::Cylinder;
-    if (same(w, "cone")) return ShapeKind::Cone;
-    if (same(w, "torus")) return ShapeKind::Torus;
-    if (same(w, "plane")) return ShapeKind::Plane;
-    return std::nullopt;
-}
+std::optional<ShapeKind> shape_from_word(std::string_view w) { return canonical_shape_named(w); }
+
+/// The statement words, in the order the unknown-statement message lists them.
+const std::string kStatementList = [] {
+    std::string list = "image, ambient, background, camera, light, material, ";
+    CanonicalShapes::for_each([&](auto s) { list += std::string(s.name) + ", "; });
+    return list + "mesh or include";
+}();
 
 /// The statement words the chunked reader parses in parallel (mesh and include fall back to
 /// one sequential pass: they read other files).
@@ -725,9 +731,7 @@ class Parser {
         else if (w == "mesh") one_pass_shape(st, toks, ShapeKind::Mesh);
         else if (auto kind = shape_from_word(w)) one_pass_shape(st, toks, *kind);
         else
-            st.fail_here("unknown statement " + quote(w) +
-                         " (expected image, ambient, background, camera, light, material, "
-                         "sphere, cube, cylinder, cone, torus, plane, mesh or include)");
+            st.fail_here("unknown statement " + quote(w) + " (expected " + kStatementList + ")");
     }
 
     /// The single positional value of `ambient`, `background` and `include`.
@@ -751,6 +755,7 @@ class Parser {
             else if (k == "spp") s.spp = st.integer(a, 1, 65536);
             else if (k == "depth") s.depth = st.integer(a, 0, 256);
             else if (k == "degree") s.degree = st.integer(a, 0, 5);
+            else if (k == "cutoff") s.cutoff = st.in_closed(a, 0.0, 1.0);
             else if (k == "output") s.output = std::string(a.value);
             else if (k == "sampler") {
                 if (a.value == "stratified") s.pattern = SamplePattern::Stratified;
@@ -896,7 +901,7 @@ class Parser {
         ShapeKind kind = ShapeKind::Sphere;
         Appearance look;
         glm::dmat4 md{1.0};
-        double minor = 0.25;  // the torus's default
+        double param = 0.0;  // the shape's parameter (ShapeParam: the torus's minor)
         bool smooth = false;
         std::optional<std::uint32_t> mesh;  // index in scene.meshes
     };
@@ -907,7 +912,7 @@ class Parser {
                             Object& obj, ObjectLoc& loc) {
         obj.kind = f.kind;
         obj.md = glm::dmat4x3(f.md);
-        obj.param = f.kind == ShapeKind::Torus ? f.minor : f.kind == ShapeKind::Mesh ? (f.smooth ? 1.0 : 0.0) : 0.0;
+        obj.param = f.kind == ShapeKind::Mesh ? (f.smooth ? 1.0 : 0.0) : f.param;
         obj.color = glm::vec3(f.look.color);
         obj.material = materials.intern(f.look.m);
         obj.mesh = f.mesh.value_or(0);
@@ -941,12 +946,14 @@ class Parser {
         st.read_args(toks, 1, shape_keys(kind));
         ShapeFields f;
         f.kind = kind;
+        const ShapeParam param = shape_param(kind);
+        f.param = param.default_value;
         if (const Arg* base = st.find("material")) f.look = lookup_material(st, *base);
         for (const Arg& a : st.args) {
             if (same(a.key, "material")) continue;
             if (apply_material_key(st, a, f.look)) continue;
             if (apply_transform_key(st, a, f.md)) continue;
-            if (same(a.key, "minor")) f.minor = st.positive(a);
+            if (param.present() && same(a.key, param.key)) f.param = st.positive(a);
             else if (same(a.key, "smooth")) {
                 if (same(a.value, "true")) f.smooth = true;
                 else if (same(a.value, "false")) f.smooth = false;
@@ -970,6 +977,7 @@ class Parser {
         std::error_code ec;
         if (!fs::is_regular_file(target, ec))
             st.fail(a.value_col, "cannot open mesh file " + quote(target.string()));
+        if (options_.copies) copy_file(target);
         try {
             auto mesh = load_obj_mesh(target.string());
             const auto index = std::uint32_t(scene.meshes.size());
@@ -979,6 +987,11 @@ class Parser {
         } catch (const std::exception& e) {
             st.fail(a.value_col, quote(target.string()) + ": " + e.what());
         }
+    }
+
+    void copy_file(const fs::path& p) {
+        FileText text;
+        options_.copies->push_back(FileCopy{p.string(), text.open(p) ? std::string(text.text()) : std::string()});
     }
 
     void include(Statement& st, const std::vector<Token>& toks, int depth) {
@@ -1002,6 +1015,7 @@ class Parser {
             st.fail(t.column, "include cycle: " + quote(shown) + " is already being read");
         FileText text;
         if (!text.open(target)) st.fail(t.column, "cannot open included file " + quote(shown));
+        if (options_.copies) options_.copies->push_back(FileCopy{shown, std::string(text.text())});
         read_text(text.text(), shown, id, depth + 1);
     }
 };
@@ -1011,10 +1025,14 @@ class Parser {
 Scene load_scene(const std::string& path, const ReadOptions& options) {
     FileText text;
     if (!text.open(fs::path(path))) throw SceneError(SourceLoc{path, 0, 0}, "cannot open scene file");
-    Parser p(options);
-    p.scene.path = path;
-    p.read_top(text.text(), path, identity_of(path), text.mapped());
-    return std::move(p.scene);
+    if (options.copies) options.copies->push_back(FileCopy{path, std::string(text.text())});
+    // Everything reading starts (meshes, their hierarchies) runs in options.jobs threads.
+    return Parallelism(options.jobs).run([&] {
+        Parser p(options);
+        p.scene.path = path;
+        p.read_top(text.text(), path, identity_of(path), text.mapped());
+        return std::move(p.scene);
+    });
 }
 
 Scene load_scene(const std::string& path, int jobs) {
@@ -1024,10 +1042,12 @@ Scene load_scene(const std::string& path, int jobs) {
 }
 
 Scene parse_scene(std::string_view text, const std::string& name, const ReadOptions& options) {
-    Parser p(options);
-    p.scene.path = name;
-    p.read_top(text, name, identity_of(name.empty() ? fs::path("<memory>") : fs::path(name)), false);
-    return std::move(p.scene);
+    return Parallelism(options.jobs).run([&] {
+        Parser p(options);
+        p.scene.path = name;
+        p.read_top(text, name, identity_of(name.empty() ? fs::path("<memory>") : fs::path(name)), false);
+        return std::move(p.scene);
+    });
 }
 
 Scene parse_scene(std::string_view text, const std::string& name) { return parse_scene(text, name, ReadOptions{}); }

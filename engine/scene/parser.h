@@ -4,10 +4,17 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "scene/scene.h"
 
 namespace streamrt {
+
+/// A file the reader read, and its bytes (ReadOptions::copies).
+struct FileCopy {
+    std::string path;  ///< as the reader named it (relative to the working folder or absolute)
+    std::string bytes;
+};
 
 /// How a large text is read: cut into chunks at line ends, shapes of the chunks parsed in
 /// parallel (docs/architecture.md, "Scene reading"). The Scene and the error are the same
@@ -16,6 +23,9 @@ struct ReadOptions {
     int jobs = 0;                          ///< threads; <= 0: all cores
     std::size_t chunk_bytes = 1u << 20;    ///< a chunk's size, extended to the next line end
     std::size_t chunked_from = 1u << 20;   ///< smaller texts are read in one sequential pass
+    /// When set, receives a copy of every file read (the scene, its includes, its meshes), in
+    /// reading order: what another machine needs to read the same scene (engine/distributed).
+    std::vector<FileCopy>* copies = nullptr;
 };
 
 /// Loads and validates a scene file, following `include` statements. `jobs` threads read a

@@ -1,22 +1,5 @@
 #include "scene/scene.h"
 
-namespace streamrt {
-
-const char* shape_kind_name(ShapeKind k) {
-    switch (k) {
-        case ShapeKind::Sphere: return "sphere";
-        case ShapeKind::Cube: return "cube";
-        case ShapeKind::Cylinder: return "cylinder";
-        case ShapeKind::Cone: return "cone";
-        case ShapeKind::Torus: return "torus";
-        case ShapeKind::Plane: return "plane";
-        case ShapeKind::Mesh: return "mesh";
-    }
-    return "?";
-}
-
-}  // namespace streamrt
-
 #include <cmath>
 #include <cstring>
 #include <functional>

@@ -14,23 +14,12 @@
 
 #include "core/error.h"
 #include "core/transform.h"
+#include "shapes/shape_kind.h"
 
 namespace streamrt {
 
 struct Mesh;
 
-/// Canonical shapes (docs/scene-format.md gives each exact definition).
-enum class ShapeKind : std::uint8_t {
-    Sphere,    ///< unit sphere centred at the origin
-    Cube,      ///< [-1,1]^3
-    Cylinder,  ///< radius 1 around the y axis, y in [-1,1], both ends capped
-    Cone,      ///< base radius 1 at y=-1, apex at y=+1, base capped
-    Torus,     ///< major radius 1 around the y axis in the xz-plane, minor radius per object
-    Plane,     ///< y = 0, normal +y, infinite
-    Mesh,      ///< a triangle mesh in its own coordinates (engine/mesh/mesh.h); not closed-form
-};
-inline constexpr int kShapeKindCount = 7;
-const char* shape_kind_name(ShapeKind k);
 
 /// A material's optical parameters (the handout's ambi, diff, refl, trans and their
 /// companions). The colour is not here: it is the object's own (Object::color), so that
@@ -115,6 +104,9 @@ struct RenderSettings {
     int depth = 5;   ///< maximum number of reflection/refraction bounces after the primary hit
     int degree = 5;  ///< 0 flat .. 5 shadows, cumulative (handout)
     double ambient = 0.1;  ///< alpha, the ambient fraction
+    /// Weight cut-off: reflected / refracted rays whose throughput (product of the refl and
+    /// trans weights from the camera) is below this in every channel are not traced; 0 = all.
+    double cutoff = 0.0;
     glm::dvec3 background{0.0, 0.0, 0.0};
     Calibration calibration = Calibration::Clamp;
     SamplePattern pattern = SamplePattern::Stratified;

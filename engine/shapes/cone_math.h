@@ -2,10 +2,20 @@
 // Canonical cone: base radius 1 at y = -1, apex at y = +1, base capped.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct ConeMath {
+    static constexpr ShapeKind kind = ShapeKind::Cone;
+    static constexpr std::string_view name = "cone";
+    static constexpr ShapeParam param = kNoShapeParam;
+    using Compute = float;
+    static constexpr CanonicalBounds bounds(double /*param*/) {
+        return {CanonicalBounds::Form::Box, {-1, -1, -1}, {1, 1, 1}};
+    }
     /// Side: x^2 + z^2 = (k (1 - y))^2 with k = 1/2, for y in [-1, 1]. A ray parallel to a
     /// generator has a = 0: solve_quadratic's c/q is then the single linear root.
     template <class V>
@@ -48,4 +58,5 @@ struct ConeMath {
     }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -2,10 +2,20 @@
 // Canonical cube: [-1,1]^3.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct CubeMath {
+    static constexpr ShapeKind kind = ShapeKind::Cube;
+    static constexpr std::string_view name = "cube";
+    static constexpr ShapeParam param = kNoShapeParam;
+    using Compute = float;
+    static constexpr CanonicalBounds bounds(double /*param*/) {
+        return {CanonicalBounds::Form::Box, {-1, -1, -1}, {1, 1, 1}};
+    }
     /// Slab test (Kay & Kajiya). A zero direction component gives +-inf slab distances; an
     /// origin exactly on that slab's face gives 0*inf = NaN, which the select-based max/min
     /// below ignore (the slab is then treated as not limiting, a grazing hit).
@@ -42,4 +52,5 @@ struct CubeMath {
     }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

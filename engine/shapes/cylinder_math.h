@@ -2,10 +2,20 @@
 // Canonical cylinder: radius 1 around the y axis, y in [-1,1], both ends capped.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct CylinderMath {
+    static constexpr ShapeKind kind = ShapeKind::Cylinder;
+    static constexpr std::string_view name = "cylinder";
+    static constexpr ShapeParam param = kNoShapeParam;
+    using Compute = float;
+    static constexpr CanonicalBounds bounds(double /*param*/) {
+        return {CanonicalBounds::Form::Box, {-1, -1, -1}, {1, 1, 1}};
+    }
     template <class V>
     static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
         using namespace simd;
@@ -36,4 +46,5 @@ struct CylinderMath {
     }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

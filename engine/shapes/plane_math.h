@@ -2,10 +2,22 @@
 // Canonical plane: y = 0, normal +y, infinite.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct PlaneMath {
+    static constexpr ShapeKind kind = ShapeKind::Plane;
+    static constexpr std::string_view name = "plane";
+    static constexpr ShapeParam param = kNoShapeParam;
+    using Compute = float;
+    /// Unbounded (outside the hierarchy); the y extent 0 says where it lies.
+    static constexpr CanonicalBounds bounds(double /*param*/) {
+        return {CanonicalBounds::Form::Unbounded, {-kUnboundedExtent, 0, -kUnboundedExtent},
+                {kUnboundedExtent, 0, kUnboundedExtent}};
+    }
     /// A ray parallel to the plane gives t = +-inf (or NaN when it lies in it): both miss.
     template <class V>
     static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
@@ -19,4 +31,5 @@ struct PlaneMath {
     static Vec3T<V> normal(const Vec3T<V>& /*p*/, V /*param*/) { return {V(0), V(1), V(0)}; }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

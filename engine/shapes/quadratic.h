@@ -4,8 +4,10 @@
 
 #include "core/vec3.h"
 #include "simd/lanes.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 template <class V>
 inline V infinity_v() {
@@ -55,4 +57,5 @@ inline V miss_if_unchanged(V best, V t_max) {
     return select(best < t_max, best, infinity_v<V>());
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -2,10 +2,20 @@
 // Canonical sphere: unit radius, centred at the origin.
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
+#include "shapes/shape_traits.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 struct SphereMath {
+    static constexpr ShapeKind kind = ShapeKind::Sphere;
+    static constexpr std::string_view name = "sphere";
+    static constexpr ShapeParam param = kNoShapeParam;
+    using Compute = float;
+    static constexpr CanonicalBounds bounds(double /*param*/) {
+        return {CanonicalBounds::Form::UnitBall, {-1, -1, -1}, {1, 1, 1}};
+    }
     /// Nearest t in (t_min, t_max) with |o + t d| = 1, or +inf. d need not be unit length.
     template <class V>
     static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
@@ -28,4 +38,5 @@ struct SphereMath {
     static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) { return p; }
 };
 
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -25,9 +25,12 @@
 #include <limits>
 
 #include "core/vec3.h"
+#include "shapes/shape_traits.h"
 #include "simd/lanes.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 namespace torus_detail {
 
@@ -328,4 +331,24 @@ Vec3T<V> torus_normal(const Vec3T<V>& p, V minor) {
     return {p.x - sgn * ux, p.y, p.z - sgn * uz};
 }
 
+/// The torus as the engines see it (shapes/shape_traits.h). Its quartic is solved in double
+/// lanes in both engines.
+struct TorusMath {
+    static constexpr ShapeKind kind = ShapeKind::Torus;
+    static constexpr std::string_view name = "torus";
+    static constexpr ShapeParam param{"minor", 0.25};  ///< the tube radius
+    using Compute = double;
+    /// The ring's box: |x|, |z| <= 1 + minor, |y| <= minor.
+    static constexpr CanonicalBounds bounds(double minor) {
+        return {CanonicalBounds::Form::Box, {-1 - minor, -minor, -1 - minor}, {1 + minor, minor, 1 + minor}};
+    }
+    template <class V>
+    static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
+        return torus_hit_t(o, d, minor, t_min, t_max);
+    }
+    template <class V>
+    static Vec3T<V> normal(const Vec3T<V>& p, V minor) { return torus_normal(p, minor); }
+};
+
+STREAMRT_ISA_END
 }  // namespace streamrt

@@ -18,8 +18,10 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "simd/lanes.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 /// The per-ray part of the test, computed once per ray (or per packet of rays).
 template <class V>
@@ -138,4 +140,5 @@ inline Vec3T<V> triangle_normal(const Vec3T<V>& p0, const Vec3T<V>& p1, const Ve
     return cross(p1 - p0, p2 - p0);
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

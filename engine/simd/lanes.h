@@ -9,7 +9,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "simd/isa_namespace.h"
+
 namespace streamrt::simd {
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 inline float select(bool m, float a, float b) { return m ? a : b; }
 inline double select(bool m, double a, double b) { return m ? a : b; }
@@ -59,6 +62,13 @@ template <class B>
     requires is_batch<B>
 inline B max(const B& a, const B& b) { return xsimd::max(a, b); }
 
+/// An unsigned integer below 2^31 as a float (exact below 2^24).
+inline float to_float(std::uint32_t h) { return float(h); }
+template <class A>
+inline xsimd::batch<float, A> to_float(const xsimd::batch<std::uint32_t, A>& h) {
+    return xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int32_t, A>>(h));
+}
+
 template <class T, class A>
 inline xsimd::batch<T, A> sign_of(const xsimd::batch<T, A>& a) {
     return xsimd::copysign(xsimd::batch<T, A>(T(1)), a);
@@ -66,6 +76,43 @@ inline xsimd::batch<T, A> sign_of(const xsimd::batch<T, A>& a) {
 
 using std::sqrt;
 using xsimd::sqrt;
+
+/// a * b + c rounded twice, at every level. xsimd::fma fuses at AVX2 and AVX-512 only (one
+/// rounding), so the kernels write this instead: the pictures are then the same bits at every
+/// level (docs/architecture.md, "Kernels and instruction sets"). The kernel files are built
+/// with -ffp-contract=off, so the compiler does not fuse it either.
+template <class B>
+inline B mul_add(const B& a, const B& b, const B& c) {
+    return a * b + c;
+}
+
+/// x^y. Scalars: std::pow. Batches: xsimd::pow, whose polynomials are evaluated with
+/// xsimd::fma; the AVX2 and AVX-512 levels run it on plain-AVX2 batches (no fma3), so it
+/// rounds like the SSE levels and gives the same bits (an unqualified call on batches would
+/// pick xsimd::pow through argument-dependent lookup: call simd::pow).
+inline float pow(float x, float y) { return std::pow(x, y); }
+inline double pow(double x, double y) { return std::pow(x, y); }
+template <class B>
+    requires is_batch<B>
+inline B pow(const B& x, const B& y) { return xsimd::pow(x, y); }
+#if defined(__AVX2__)
+inline xsimd::batch<float, xsimd::fma3<xsimd::avx2>> pow(const xsimd::batch<float, xsimd::fma3<xsimd::avx2>>& x,
+                                                          const xsimd::batch<float, xsimd::fma3<xsimd::avx2>>& y) {
+    using P = xsimd::batch<float, xsimd::avx2>;
+    return __m256(xsimd::pow(P(__m256(x)), P(__m256(y))));
+}
+#endif
+#if defined(__AVX512F__)
+inline xsimd::batch<float, xsimd::avx512bw> pow(const xsimd::batch<float, xsimd::avx512bw>& x,
+                                                const xsimd::batch<float, xsimd::avx512bw>& y) {
+    using P = xsimd::batch<float, xsimd::avx2>;
+    const __m512d xd = _mm512_castps_pd(x), yd = _mm512_castps_pd(y);
+    const P lo = xsimd::pow(P(_mm512_castps512_ps256(x)), P(_mm512_castps512_ps256(y)));
+    const P hi = xsimd::pow(P(_mm256_castpd_ps(_mm512_extractf64x4_pd(xd, 1))),
+                            P(_mm256_castpd_ps(_mm512_extractf64x4_pd(yd, 1))));
+    return _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castps_pd(_mm512_castps256_ps512(lo)), _mm256_castps_pd(hi), 1));
+}
+#endif
 
 /// The element type behind V (float for batch<float>, double for double, ...).
 template <class V>
@@ -91,12 +138,16 @@ class FlushDenormals {
     unsigned saved_;
 };
 
+STREAMRT_ISA_END
+
 /// Widest batch we build (AVX-512: 16 floats). Streams are padded to it in every build so the
 /// layout is the same at 4, 8 and 16 lanes and aligned loads are always legal.
 inline constexpr std::size_t kMaxLanes = 16;
 inline constexpr std::size_t kAlign = 64;
 template <class T>
 using AlignedVec = std::vector<T, xsimd::aligned_allocator<T, kAlign>>;
+STREAMRT_ISA_BEGIN
 constexpr std::size_t round_up_lanes(std::size_t n) { return (n + kMaxLanes - 1) / kMaxLanes * kMaxLanes; }
+STREAMRT_ISA_END
 
 }  // namespace streamrt::simd

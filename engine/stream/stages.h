@@ -1,6 +1,7 @@
 #pragma once
 // The stages of the stream pipeline, specialised at compile time on the features a scene
-// uses. Read run_chunk() top to bottom: it is the whole algorithm for one chunk of a tile.
+// uses. Read run_chunk(), trace_generation() and trace_slice() top to bottom: they are the
+// whole algorithm for one chunk of a tile.
 #include <algorithm>
 #include <cstdint>
 #include <limits>
@@ -13,7 +14,7 @@
 #include "render/sampling.h"
 #include "shapes/shapes.h"
 #include "stream/profile.h"
-#include "stream/ray_stream.h"
+#include "kernels/ray_stream.h"
 #include "stream/shade_mode.h"
 #include "stream/stream_scene.h"
 
@@ -67,9 +68,23 @@ struct GenerateScratch {
 /// Per-thread buffers, reused from chunk to chunk.
 struct Workspace {
     GenerateScratch generate;
-    RayStream current, next;
-    AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of `current`
-    MeshHits mesh_hits;               ///< triangle and barycentrics per ray of `current` (mesh hits)
+    RayStream current;  ///< camera rays
+    RayStream next;     ///< the rays a slice spawns (swapped in and out around the shade stage)
+    /// Buffers of generations no longer in use (PipelineStages::trace_generation takes and
+    /// gives back), so a thread holds as many as were ever in use at once.
+    std::vector<RayStream> spare;
+    RayStream regroup;  ///< a generation regrouped into slices (cut_into_slices)
+    RayStream take() {
+        if (spare.empty()) return RayStream{};
+        RayStream r = std::move(spare.back());
+        spare.pop_back();
+        r.count = 0;
+        return r;
+    }
+    void give(RayStream&& r) { spare.push_back(std::move(r)); }
+    std::vector<std::uint32_t> pixel_rays, pixel_slice;  ///< per tile pixel (cut_into_slices)
+    AlignedVec<std::int32_t> object;  ///< closest-hit object per ray of the slice traced
+    MeshHits mesh_hits;               ///< triangle and barycentrics per ray of the slice (mesh hits)
     ShadowStream shadows, shadows_in_pixel_order;
     SortedHits sorted;
     std::vector<std::uint32_t> slot;
@@ -100,19 +115,6 @@ inline ShadeMode resolve_shade_mode(const StreamScene& sc, ShadeMode asked) {
 
 namespace stage_detail {
 
-inline Vec3f apply_point(const float* m, const Vec3f& p) {
-    return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
-            m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
-}
-inline Vec3f apply_vector(const float* m, const Vec3f& v) {
-    return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
-            m[8] * v.x + m[9] * v.y + m[10] * v.z};
-}
-/// Mn n with Mn = (Mi's linear part) transposed, read from Mi's row-major 3x4 rows.
-inline Vec3f apply_normal(const float* mi, const Vec3f& n) {
-    return normalize(Vec3f{mi[0] * n.x + mi[4] * n.y + mi[8] * n.z, mi[1] * n.x + mi[5] * n.y + mi[9] * n.z,
-                           mi[2] * n.x + mi[6] * n.y + mi[10] * n.z});
-}
 inline void add(float* accum, std::int32_t pixel, const ColorT<float>& c) {
     accum[pixel * 3 + 0] += c.x;
     accum[pixel * 3 + 1] += c.y;
@@ -120,6 +122,68 @@ inline void add(float* accum, std::int32_t pixel, const ColorT<float>& c) {
 }
 inline std::uint64_t lanes_for(std::size_t n, int width) {
     return (std::uint64_t(n) + std::uint64_t(width) - 1) / std::uint64_t(width) * std::uint64_t(width);
+}
+
+/// Copies rays [from, from + n) of `src` into `dst` (which then holds exactly them).
+inline void copy_rays(const RayStream& src, std::size_t from, std::size_t n, RayStream& dst) {
+    dst.reserve(n);
+    for (auto a : {&RayStream::ox, &RayStream::oy, &RayStream::oz, &RayStream::dx, &RayStream::dy, &RayStream::dz,
+                   &RayStream::t_max, &RayStream::wr, &RayStream::wg, &RayStream::wb, &RayStream::cone})
+        std::copy_n((src.*a).begin() + std::ptrdiff_t(from), n, (dst.*a).begin());
+    std::copy_n(src.pixel.begin() + std::ptrdiff_t(from), n, dst.pixel.begin());
+    std::copy_n(src.kind.begin() + std::ptrdiff_t(from), n, dst.kind.begin());
+    dst.count = n;
+}
+
+/// Cuts a generation of more than `cap` rays into slices of at most `cap` rays that each
+/// hold all the rays of their pixels (pixels in order, as many whole pixels as fit), and
+/// regroups `gen` so each slice is contiguous, keeping the rays' order within a slice. A
+/// pixel with more than `cap` rays alone is cut, in stream order, into slices of its own.
+/// Returns the slices' bounds in `gen` (first 0, last gen.count). `scratch` ends holding the
+/// generation's former buffer.
+inline std::vector<std::size_t> cut_into_slices(RayStream& gen, RayStream& scratch, std::size_t cap,
+                                                std::size_t tile_pixels, std::vector<std::uint32_t>& pixel_rays,
+                                                std::vector<std::uint32_t>& pixel_slice) {
+    pixel_rays.assign(tile_pixels, 0);
+    for (std::size_t i = 0; i < gen.count; ++i) ++pixel_rays[std::size_t(gen.pixel[i])];
+    // Each pixel's first slice: pixels are packed greedily, in pixel order.
+    pixel_slice.assign(tile_pixels, 0);
+    std::vector<std::size_t> size;  // rays per slice
+    std::size_t fill = cap;         // rays in the last slice (cap: full, open a new one)
+    for (std::size_t p = 0; p < tile_pixels; ++p) {
+        const std::size_t n = pixel_rays[p];
+        if (n == 0) continue;
+        if (n > cap) {
+            pixel_slice[p] = std::uint32_t(size.size());
+            for (std::size_t left = n; left > 0; left -= std::min(left, cap)) size.push_back(std::min(left, cap));
+            fill = cap;
+            continue;
+        }
+        if (fill + n > cap) size.push_back(0), fill = 0;
+        pixel_slice[p] = std::uint32_t(size.size() - 1);
+        size.back() += n;
+        fill += n;
+    }
+    std::vector<std::size_t> bounds(size.size() + 1, 0);
+    for (std::size_t k = 0; k < size.size(); ++k) bounds[k + 1] = bounds[k] + size[k];
+    // A stable counting sort by slice; a cut pixel's k-th ray goes to its slice k / cap.
+    std::vector<std::size_t> at(bounds.begin(), bounds.end() - 1);
+    pixel_rays.assign(tile_pixels, 0);  // now: the pixel's rays placed so far
+    scratch.reserve(gen.count);
+    for (std::size_t i = 0; i < gen.count; ++i) {
+        const std::size_t p = std::size_t(gen.pixel[i]);
+        const std::size_t j = at[pixel_slice[p] + pixel_rays[p]++ / cap]++;
+        scratch.ox[j] = gen.ox[i], scratch.oy[j] = gen.oy[i], scratch.oz[j] = gen.oz[i];
+        scratch.dx[j] = gen.dx[i], scratch.dy[j] = gen.dy[i], scratch.dz[j] = gen.dz[i];
+        scratch.t_max[j] = gen.t_max[i];
+        scratch.wr[j] = gen.wr[i], scratch.wg[j] = gen.wg[i], scratch.wb[j] = gen.wb[i];
+        scratch.cone[j] = gen.cone[i];
+        scratch.pixel[j] = gen.pixel[i];
+        scratch.kind[j] = gen.kind[i];
+    }
+    scratch.count = gen.count;
+    std::swap(gen, scratch);
+    return bounds;
 }
 
 }  // namespace stage_detail
@@ -161,7 +225,6 @@ struct PipelineStages {
             }
         }
         rays.count = i;
-        const CameraRays<float>& cam = sc.camera;
         GenerateJob job{n,
                         g.px.data(),
                         g.py.data(),
@@ -173,12 +236,7 @@ struct PipelineStages {
                         kJitter,
                         float(cols),
                         float(spp / cols),
-                        {cam.origin.x, cam.origin.y, cam.origin.z},
-                        {cam.du.x, cam.du.y, cam.du.z},
-                        {cam.dv.x, cam.dv.y, cam.dv.z},
-                        {cam.dback.x, cam.dback.y, cam.dback.z},
-                        cam.inv_width,
-                        cam.inv_height,
+                        &sc.camera,
                         1.f / float(spp),
                         {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(),
                          rays.dz.data(), rays.t_max.data(), rays.wr.data(), rays.wg.data(), rays.wb.data(),
@@ -213,20 +271,62 @@ struct PipelineStages {
                 kt.closest[k](view, object.data(), group.data(), group.size());
             if (fig) {
                 fig->lanes_used += rays.count;
-                fig->lanes_total += stage_detail::lanes_for(rays.count, k == int(ShapeKind::Torus) ? kt.float_lanes / 2 : kt.float_lanes);
+                fig->lanes_total += stage_detail::lanes_for(rays.count, shape_computes_in_double(ShapeKind(k)) ? kt.float_lanes / 2 : kt.float_lanes);
             }
         }
     }
 
-    /// shade + spawn: local terms by degree into the tile (or into shadow rays when degree 5
-    /// asks for visibility), reflected and refracted rays appended to `next` (the compaction:
-    /// only surviving rays move on). Misses bring the background.
+    /// The shading rules for rays of generation `depth`. The stream's weights carry the
+    /// sample's 1/spp, so the cut-off (defined on the refl / trans product alone, as in the
+    /// recursive engine) is scaled by it.
+    static ShadeRules<float> shade_rules(const StreamScene& sc, int depth) {
+        const RenderSettings& s = sc.settings;
+        return {s.degree, float(s.ambient), kSecondary && depth < s.depth, float(s.cutoff / s.spp), sc.camera.spread};
+    }
+
+    /// Where shade_hit's results go on the scalar path: the local colour into the tile,
+    /// shadow and child rays appended to their streams.
+    struct ScalarSink {
+        static constexpr bool kTestsShadowsNow = false;
+        float* accum;
+        std::int32_t px;
+        RayStream& next;
+        ShadowStream& shadows;
+        RayCounts& counts;
+
+        void local(const ColorT<float>& c) { stage_detail::add(accum, px, c); }
+        void shadow(bool send, const Vec3f& from, const Vec3f& to, float t_max, const ColorT<float>& c) {
+            if (!send) return;
+            const std::size_t j = shadows.count++;
+            shadows.ox[j] = from.x;
+            shadows.oy[j] = from.y;
+            shadows.oz[j] = from.z;
+            shadows.dx[j] = to.x;
+            shadows.dy[j] = to.y;
+            shadows.dz[j] = to.z;
+            shadows.t_max[j] = t_max;
+            shadows.cr[j] = c.x;
+            shadows.cg[j] = c.y;
+            shadows.cb[j] = c.z;
+            shadows.pixel[j] = px;
+        }
+        void child(bool send, const Vec3f& from, const Vec3f& dir, const ColorT<float>& weight, const ColorT<float>&,
+                   float cone, RayKind kind) {
+            if (!send) return;
+            push(next, next.count++, from, dir, weight, cone, px, kind);
+            ++(kind == RayKind::Reflected ? counts.reflected : counts.refracted);
+        }
+    };
+
+    /// shade + spawn, one ray at a time (shade_hit in render/shading.h with V = float):
+    /// local terms into the tile, shadow rays when degree 5 asks for visibility, reflected
+    /// and refracted rays appended to `next` (only surviving rays move on). Misses bring the
+    /// background.
     static void shade(const StreamScene& sc, const RayStream& rays, const AlignedVec<std::int32_t>& object,
                       const MeshHits& mesh_hits, int depth, RayStream& next, ShadowStream& shadows, float* accum,
                       RayCounts& counts) {
         using namespace stage_detail;
-        const RenderSettings& s = sc.settings;
-        const bool may_spawn = kSecondary && depth < s.depth;
+        const ShadeRules<float> rules = shade_rules(sc, depth);
         // This path serves scenes with many objects, where each hit's records are likely
         // cache misses: fetch them a few rays ahead (in leaf order, neighbouring rays mostly
         // hit objects close in memory).
@@ -260,62 +360,12 @@ struct PipelineStages {
                     ? mesh_normal<float>(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i], mesh_hits.v[i],
                                          ob.xf.param != 0.f)
                     : visit_shape(kind, [&](auto shape) { return shape.template normal<float>(pc, ob.xf.param); });
-            const Vec3f n_out = apply_normal(ob.xf.m, nc);
-            const float cone = rays.cone[i] + sc.camera.spread * t;
-            const ColorT<float> base = surface_color(m, ColorT<float>{sf.color[0], sf.color[1], sf.color[2]}, p, n_out,
-                                                     footprint_width(rays.cone[i], sc.camera.spread, t, dot(d, n_out)));
-            if constexpr (!kLighting) {
-                add(accum, px, mul(w, base));
-                continue;
-            } else {
-                const Vec3f n = dot(n_out, d) < 0.f ? n_out : -n_out;
-                add(accum, px, mul(w, ambient_light(s.degree, float(s.ambient), m, base)));
-                Vec3f shadow_origin{};
-                if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, o);
-                for (const LightT<float>& l : sc.lights) {
-                    const LightSample<float> ls = sample_light(l, p);
-                    const DirectLight<float> dl = direct_light(s.degree, m, base, n, d, l, ls);
-                    if (!dl.lit) continue;
-                    const ColorT<float>& c = dl.color;
-                    if constexpr (kShadows) {
-                        const std::size_t j = shadows.count++;
-                        const Vec3f to = l.kind == LightKind::Directional ? ls.to_light : l.pos - shadow_origin;
-                        shadows.ox[j] = shadow_origin.x;
-                        shadows.oy[j] = shadow_origin.y;
-                        shadows.oz[j] = shadow_origin.z;
-                        shadows.dx[j] = to.x;
-                        shadows.dy[j] = to.y;
-                        shadows.dz[j] = to.z;
-                        shadows.t_max[j] = ls.t_max;
-                        const ColorT<float> wc = mul(w, c);
-                        shadows.cr[j] = wc.x;
-                        shadows.cg[j] = wc.y;
-                        shadows.cb[j] = wc.z;
-                        shadows.pixel[j] = px;
-                    } else {
-                        add(accum, px, mul(w, c));
-                    }
-                }
-                if (!may_spawn) continue;
-                if constexpr (kReflect) {
-                    if (m.refl > 0.f) {
-                        const std::size_t j = next.count++;
-                        const Vec3f r = reflect(d, n);
-                        const Vec3f from = offset_ray_origin(p, n, o);
-                        push(next, j, from, r, w * m.refl, cone, px, RayKind::Reflected);
-                        ++counts.reflected;
-                    }
-                }
-                if constexpr (kRefract) {
-                    if (m.trans > 0.f) {
-                        const std::size_t j = next.count++;
-                        const Vec3f tr = refract(d, n_out, m.ior);
-                        const Vec3f from = offset_ray_origin(p, dot(tr, n_out) > 0.f ? n_out : -n_out, o);
-                        push(next, j, from, tr, w * m.trans, cone, px, RayKind::Refracted);
-                        ++counts.refracted;
-                    }
-                }
-            }
+            const ArrivingRay<float> arriving{o, d, t, rays.cone[i], w, w};
+            ScalarSink sink{accum, px, next, shadows, counts};
+            shade_hit<kLighting, kShadows, kReflect, kRefract>(rules, m, sc.lights.data(), sc.lights.size(), arriving,
+                                                               p, apply_normal(ob.xf.m, nc),
+                                                               ColorT<float>{sf.color[0], sf.color[1], sf.color[2]},
+                                                               true, sink);
         }
     }
 
@@ -380,8 +430,7 @@ struct PipelineStages {
         ShadowStream& sh = ws.shadows;
         ShadeJob job{h.ox.data(), h.oy.data(), h.oz.data(), h.dx.data(), h.dy.data(), h.dz.data(), h.t.data(),
                      h.wr.data(), h.wg.data(), h.wb.data(), h.cone.data(), h.pixel.data(), 0, 0, nullptr, {}, nullptr,
-                     sc.lights.data(), sc.lights.size(), sc.settings.degree, float(sc.settings.ambient),
-                     kSecondary && depth < sc.settings.depth, sc.camera.spread, h.lr.data(), h.lg.data(), h.lb.data(),
+                     sc.lights.data(), sc.lights.size(), shade_rules(sc, depth), h.lr.data(), h.lg.data(), h.lb.data(),
                      {nx.ox.data(), nx.oy.data(), nx.oz.data(), nx.dx.data(), nx.dy.data(), nx.dz.data(),
                       nx.t_max.data(), nx.wr.data(), nx.wg.data(), nx.wb.data(), nx.cone.data(), nx.pixel.data(),
                       nx.kind.data(), &nx.count},
@@ -482,61 +531,123 @@ struct PipelineStages {
                 kt.any[k](view_of(shadows), group.data(), group.size());
             if (fig) {
                 fig->lanes_used += shadows.count;
-                fig->lanes_total += stage_detail::lanes_for(shadows.count, k == int(ShapeKind::Torus) ? kt.float_lanes / 2 : kt.float_lanes);
+                fig->lanes_total += stage_detail::lanes_for(shadows.count, shape_computes_in_double(ShapeKind(k)) ? kt.float_lanes / 2 : kt.float_lanes);
             }
         }
         for (std::size_t i = 0; i < shadows.count; ++i)
             if (shadows.t_max[i] > 0.f) stage_detail::add(accum, shadows.pixel[i], {shadows.cr[i], shadows.cg[i], shadows.cb[i]});
     }
 
+    /// What the stages of one chunk share.
+    struct Chunk {
+        const StreamScene& sc;
+        const KernelTable& kt;
+        const Tile& tile;
+        Workspace& ws;
+        float* accum;
+        RayCounts& counts;
+        StreamProfile* profile;
+        ShadeMode shade_mode;
+        std::size_t slice_rays;  ///< the most rays traced at once
+        StageFigures* fig(Stage s) const { return profile ? &profile->stages[int(s)] : nullptr; }
+    };
+
+    /// One slice of generation `depth`: intersect, shade, occlusion; the rays it spawns (at
+    /// most two per ray) go to `spawned`.
+    static void trace_slice(const Chunk& c, int depth, RayStream& rays, RayStream& spawned) {
+        const StreamScene& sc = c.sc;
+        Workspace& ws = c.ws;
+        std::swap(ws.next, spawned);  // the shade stage appends to ws.next
+        {
+            StageTimer timer(c.fig(Stage::Intersect));
+            intersect(sc, c.kt, rays, ws.object, ws.mesh_hits, c.fig(Stage::Intersect));
+            if (c.profile) c.fig(Stage::Intersect)->rays_in += rays.count, c.fig(Stage::Intersect)->rays_out += rays.count;
+        }
+        {
+            StageTimer timer(c.fig(Stage::Shade));
+            // Room for every ray spawning both children and a shadow ray per light.
+            ws.next.reserve(kSecondary ? rays.count * 2 : 0);
+            if constexpr (kShadows) ws.shadows.reserve(rays.count * sc.lights.size());
+            if (c.shade_mode == ShadeMode::Scalar)
+                shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, c.accum, c.counts);
+            else
+                shade_sorted(sc, c.kt, rays, ws.object, depth, ws, c.accum, c.counts, c.shade_mode == ShadeMode::Gathered);
+            if (kShadows && c.shade_mode == ShadeMode::Gathered)
+                order_shadows_by_pixel(ws, std::size_t(c.tile.width() * c.tile.height()));
+            if (c.profile) {
+                c.fig(Stage::Shade)->rays_in += rays.count;
+                c.fig(Stage::Shade)->rays_out += ws.next.count + (kShadows ? ws.shadows.count : 0);
+            }
+        }
+        if constexpr (kShadows) {
+            StageTimer timer(c.fig(Stage::Occlusion));
+            c.counts.shadow += ws.shadows.count;
+            occlusion(sc, c.kt, ws.shadows, c.accum, c.fig(Stage::Occlusion));
+            if (c.profile) {
+                c.fig(Stage::Occlusion)->rays_in += ws.shadows.count;
+                for (std::size_t i = 0; i < ws.shadows.count; ++i) c.fig(Stage::Occlusion)->rays_out += ws.shadows.t_max[i] > 0.f;
+            }
+        }
+        std::swap(ws.next, spawned);
+        rays.count = 0;  // traced
+    }
+
+    /// Traces generation `depth` and everything it spawns, deepest first: a generation of
+    /// more than slice_rays rays is cut into slices, and each slice's descendants are traced
+    /// before the next slice. A slice spawns at most twice its rays, so the rays held are at
+    /// most 2 x slice_rays for each generation on the way down, whatever the depth, instead
+    /// of 2^depth; a generation traced whole gives its buffer back before its children are
+    /// traced, so chains of such generations reuse the same few buffers.
+    /// The slices hold whole pixels (cut_into_slices) and pixels do not interact, so each
+    /// pixel gets the same terms as when every generation is traced whole; one ray at a time
+    /// (scalar shading) in the same order, bit for bit. Only a pixel with more than
+    /// slice_rays rays in one generation is cut itself. Either way, the order is fixed by the
+    /// tile's content: the same picture for every -j.
+    static void trace_generation(const Chunk& c, int depth, RayStream&& rays) {
+        Workspace& ws = c.ws;
+        RayStream gen = std::move(rays);
+        if (gen.count <= c.slice_rays) {  // whole: no copy
+            RayStream spawned = ws.take();
+            trace_slice(c, depth, gen, spawned);
+            ws.give(std::move(gen));
+            descend(c, depth, std::move(spawned));
+            return;
+        }
+        const std::vector<std::size_t> bounds =
+            stage_detail::cut_into_slices(gen, ws.regroup, c.slice_rays, std::size_t(c.tile.width() * c.tile.height()),
+                                          ws.pixel_rays, ws.pixel_slice);
+        for (std::size_t k = 0; k + 1 < bounds.size(); ++k) {
+            RayStream slice = ws.take(), spawned = ws.take();
+            stage_detail::copy_rays(gen, bounds[k], bounds[k + 1] - bounds[k], slice);
+            trace_slice(c, depth, slice, spawned);
+            ws.give(std::move(slice));
+            descend(c, depth, std::move(spawned));
+        }
+        gen.count = 0;
+        ws.give(std::move(gen));
+    }
+
+    /// The rays generation `depth` spawned: traced, or (none) their buffer given back.
+    static void descend(const Chunk& c, int depth, RayStream&& spawned) {
+        if (kSecondary && spawned.count > 0) trace_generation(c, depth + 1, std::move(spawned));
+        else c.ws.give(std::move(spawned));
+    }
+
+    /// The whole algorithm for one chunk of a tile: camera rays, then every generation they
+    /// spawn (trace_generation). slice_rays: the most rays traced at once.
     static void run_chunk(const StreamScene& sc, const KernelTable& kt, const Tile& tile, int first, int n_pixels,
                           Workspace& ws, float* accum, RayCounts& counts, StreamProfile* profile,
-                          ShadeMode shade_mode) {
-        const auto fig = [&](Stage s) { return profile ? &profile->stages[int(s)] : nullptr; };
-        const std::size_t lights = sc.lights.size();
+                          ShadeMode shade_mode, std::size_t slice_rays) {
+        const Chunk c{sc, kt, tile, ws, accum, counts, profile, shade_mode, std::max<std::size_t>(1, slice_rays)};
         {
-            StageTimer timer(fig(Stage::Generate));
+            StageTimer timer(c.fig(Stage::Generate));
             generate(sc, kt, tile, first, n_pixels, ws);
             counts.primary += ws.current.count;
-            if (profile) fig(Stage::Generate)->rays_out += ws.current.count, fig(Stage::Generate)->rays_in += std::uint64_t(n_pixels);
+            if (profile) c.fig(Stage::Generate)->rays_out += ws.current.count, c.fig(Stage::Generate)->rays_in += std::uint64_t(n_pixels);
         }
-        for (int depth = 0; ws.current.count > 0; ++depth) {
-            RayStream& rays = ws.current;
-            {
-                StageTimer timer(fig(Stage::Intersect));
-                intersect(sc, kt, rays, ws.object, ws.mesh_hits, fig(Stage::Intersect));
-                if (profile) fig(Stage::Intersect)->rays_in += rays.count, fig(Stage::Intersect)->rays_out += rays.count;
-            }
-            {
-                StageTimer timer(fig(Stage::Shade));
-                // Room for every ray spawning both children and a shadow ray per light.
-                ws.next.reserve(kSecondary ? rays.count * 2 : 0);
-                if constexpr (kShadows) ws.shadows.reserve(rays.count * lights);
-                if (shade_mode == ShadeMode::Scalar)
-                    shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, accum, counts);
-                else
-                    shade_sorted(sc, kt, rays, ws.object, depth, ws, accum, counts, shade_mode == ShadeMode::Gathered);
-                if (kShadows && shade_mode == ShadeMode::Gathered) order_shadows_by_pixel(ws, std::size_t(tile.width() * tile.height()));
-                if (profile) {
-                    fig(Stage::Shade)->rays_in += rays.count;
-                    fig(Stage::Shade)->rays_out += ws.next.count + (kShadows ? ws.shadows.count : 0);
-                }
-            }
-            if constexpr (kShadows) {
-                StageTimer timer(fig(Stage::Occlusion));
-                counts.shadow += ws.shadows.count;
-                occlusion(sc, kt, ws.shadows, accum, fig(Stage::Occlusion));
-                if (profile) {
-                    fig(Stage::Occlusion)->rays_in += ws.shadows.count;
-                    for (std::size_t i = 0; i < ws.shadows.count; ++i) fig(Stage::Occlusion)->rays_out += ws.shadows.t_max[i] > 0.f;
-                }
-            }
-            if constexpr (kSecondary) {
-                std::swap(ws.current, ws.next);
-            } else {
-                ws.current.count = 0;
-            }
-        }
+        RayStream primary = ws.take();
+        std::swap(primary, ws.current);
+        trace_generation(c, 0, std::move(primary));
     }
 };
 

@@ -9,11 +9,11 @@
 #include <memory>
 #include <vector>
 
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 #include "core/default_init.h"
 #include "kernels/accel_kernel_table.h"
 #include "kernels/kernel_table.h"
-#include "stream/ray_stream.h"
+#include "kernels/ray_stream.h"
 
 namespace streamrt {
 

@@ -10,8 +10,12 @@
 
 namespace streamrt {
 
-StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade)
-    : scene_(scene), kernels_(kernel_table(isa)), tile_fn_(nullptr), shade_mode_(resolve_shade_mode(scene_, shade)) {
+StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade, std::size_t slice_rays)
+    : scene_(scene),
+      kernels_(kernel_table(isa)),
+      tile_fn_(nullptr),
+      shade_mode_(resolve_shade_mode(scene_, shade)),
+      slice_rays_(slice_rays > 0 ? slice_rays : default_slice_rays(scene_.settings.spp)) {
     tile_fn_ = select_tile_fn();
 }
 
@@ -22,7 +26,7 @@ std::vector<std::string> StreamRenderer::built_stages() const {
     bool first = true;
     for (int k = 0; k < kShapeKindCount; ++k)
         if (!scene_.groups[k].empty()) {
-            kernels += (first ? "" : ",") + std::string(shape_kind_name(ShapeKind(k)));
+            (kernels += first ? "" : ",") += shape_kind_name(ShapeKind(k));
             first = false;
         }
     b.push_back(kernels + "]");
@@ -51,7 +55,8 @@ void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, f
     for (int first = 0; first < tile_pixels; first += pixels_per_chunk) {
         if (cancel && cancel->cancelled()) return;
         const int n_pixels = std::min(pixels_per_chunk, tile_pixels - first);
-        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile, self.shade_mode_);
+        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile, self.shade_mode_,
+                          self.slice_rays_);
     }
 }
 
@@ -76,6 +81,25 @@ StreamRenderer::TileFn StreamRenderer::select_tile_fn() const {
     return table[key];
 }
 
+void StreamRenderer::render_one_tile(const Tile& tile, float* rgb, RayCounts& counts, StreamProfile* profile,
+                                     const RenderProgress* cancel) const {
+    // Tile-local accumulation in a fixed order: the result cannot depend on scheduling.
+    float accum[kTileSize * kTileSize * 3] = {};
+    tile_fn_(*this, tile, accum, counts, profile, cancel);
+    const int pixels = tile.width() * tile.height();
+    StageTimer timer(profile ? &profile->stages[int(Stage::Accumulate)] : nullptr);
+    std::copy_n(accum, pixels * 3, rgb);
+    if (profile) profile->stages[int(Stage::Accumulate)].rays_in += std::uint64_t(pixels);
+}
+
+void StreamRenderer::describe(StreamProfile& profile, double wall_seconds, int threads) const {
+    profile.wall_seconds = wall_seconds;
+    profile.threads = threads;
+    profile.isa = kernels_.name;
+    profile.lanes = kernels_.float_lanes;
+    profile.built = built_stages();
+}
+
 Framebuffer StreamRenderer::render(Parallelism& par, RenderProgress* progress, StreamProfile* profile) const {
     const RenderSettings& s = scene_.settings;
     Framebuffer fb = Framebuffer::uninitialized(s.width, s.height);  // every tile writes its pixels
@@ -85,29 +109,22 @@ Framebuffer StreamRenderer::render(Parallelism& par, RenderProgress* progress, S
         if (progress && progress->cancelled()) return;
         RayCounts counts;
         StreamProfile local;
-        // Tile-local accumulation in a fixed order: the result cannot depend on scheduling.
-        float accum[kTileSize * kTileSize * 3] = {};
-        tile_fn_(*this, tile, accum, counts, profile ? &local : nullptr, progress);
+        float rgb[kTileSize * kTileSize * 3];
+        render_one_tile(tile, rgb, counts, profile ? &local : nullptr, progress);
         {
             StageTimer timer(profile ? &local.stages[int(Stage::Accumulate)] : nullptr);
             for (int y = tile.y0; y < tile.y1; ++y)
-                std::copy_n(&accum[((y - tile.y0) * tile.width()) * 3], tile.width() * 3, fb.pixel(tile.x0, y));
+                std::copy_n(&rgb[((y - tile.y0) * tile.width()) * 3], tile.width() * 3, fb.pixel(tile.x0, y));
         }
         if (profile) {
-            local.stages[int(Stage::Accumulate)].rays_in += std::uint64_t(tile.width() * tile.height());
             std::lock_guard<std::mutex> lock(profile_mutex);
             *profile += local;
             profile->counts += counts;
         }
         if (progress) progress->add(counts);
     });
-    if (profile) {
-        profile->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        profile->threads = par.jobs();
-        profile->isa = kernels_.name;
-        profile->lanes = kernels_.float_lanes;
-        profile->built = built_stages();
-    }
+    if (profile)
+        describe(*profile, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), par.jobs());
     return fb;
 }
 

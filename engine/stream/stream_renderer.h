@@ -2,6 +2,9 @@
 // The ray-stream engine: rays in structure-of-arrays streams, processed breadth-first in
 // stages per tile (generate, intersect, shade + spawn, occlusion, accumulate), with one SIMD
 // kernel per canonical shape. Same pictures as the recursive baseline, in single precision.
+#include <algorithm>
+#include <cstddef>
+
 #include "image/framebuffer.h"
 #include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
@@ -16,10 +19,21 @@ class StreamRenderer {
   public:
     /// shade: how the shade stage groups hits for its SIMD kernel (stream/shade_mode.h; Auto
     /// picks by object count, the others are kept for measurement and tests).
-    StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade = ShadeMode::Auto);
+    /// slice_rays: the most rays of one generation traced at once per thread (0: the default,
+    /// max(kSliceRays, spp)); smaller values are for tests.
+    StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade = ShadeMode::Auto, std::size_t slice_rays = 0);
 
     /// Renders the image. With a profile, every stage is timed and counted into it.
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr, StreamProfile* profile = nullptr) const;
+
+    /// Renders one tile into `rgb` (tile.width() x tile.height() pixels, 3 floats each, row by
+    /// row): the values render() gives those pixels, whichever thread or process runs it.
+    /// With a profile, the stages are timed and counted into it.
+    void render_one_tile(const Tile& tile, float* rgb, RayCounts& counts, StreamProfile* profile = nullptr,
+                         const RenderProgress* cancel = nullptr) const;
+
+    /// Fills the profile's description of the run: wall time, threads, kernels and stages.
+    void describe(StreamProfile& profile, double wall_seconds, int threads) const;
 
     /// Names of the stages and kernels this scene's pipeline is built from.
     std::vector<std::string> built_stages() const;
@@ -27,6 +41,12 @@ class StreamRenderer {
     /// Pixels per tile side, and the most primary rays in flight per tile chunk.
     static constexpr int kTileSize = streamrt::kTileSize;
     static constexpr std::size_t kMaxChunkRays = 4096;
+    /// Generations are traced deepest first in slices of at most max(kSliceRays, spp) rays
+    /// (stages.h, trace_generation): per thread, at most 2 x that many rays are held per
+    /// generation reached, whatever the depth.
+    static constexpr std::size_t kSliceRays = 16384;
+    /// The slice size used for a scene with `spp` samples per pixel (slice_rays 0).
+    static std::size_t default_slice_rays(int spp) { return std::max(kSliceRays, std::size_t(spp)); }
 
   private:
     // `cancel` (may be null) is polled between chunks, so an interrupt is seen within one chunk.
@@ -42,6 +62,7 @@ class StreamRenderer {
     const KernelTable& kernels_;
     TileFn tile_fn_;
     ShadeMode shade_mode_;  ///< resolved for this scene
+    std::size_t slice_rays_;
 };
 
 }  // namespace streamrt

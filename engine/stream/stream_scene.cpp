@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 #include "core/memory_advice.h"
 #include "parallel/parallelism.h"
 

@@ -11,8 +11,9 @@
 #include <cmath>
 #include <string>
 
-#include "render/limits.h"
+#include "driver/limits.h"
 #include "scene/parser.h"
+#include "shapes/shapes.h"
 
 namespace streamrt_fuzz {
 
@@ -54,8 +55,9 @@ inline std::string check_scene(const Scene& sc) {
         const Object& o = sc.objects[i];
         if (!finite(o.direct()) || !finite(glm::dmat4(affine_inverse(o.md))))
             return "object transform not finite: " + sc.where(i).str();
-        if (o.kind == ShapeKind::Torus && (!(o.param > 0) || !std::isfinite(o.param)))
-            return "torus minor invalid: " + sc.where(i).str();
+        if (shape_param(o.kind).present() && (!(o.param > 0) || !std::isfinite(o.param)))
+            return std::string(shape_kind_name(o.kind)) + " " + std::string(shape_param(o.kind).key) +
+                   " invalid: " + sc.where(i).str();
         if (o.material >= sc.materials.size()) return "material index out of range: " + sc.where(i).str();
         const Material& m = sc.material_of(o);
         if (!finite(glm::dvec3(o.color)) || !(m.ior > 0) || !(m.cell > 0) || !std::isfinite(m.cell))

@@ -49,9 +49,7 @@ TEST_CASE("generate kernel: same sample positions and directions as the scalar f
                 rays.reserve(n);
                 GenerateJob job{n, a_px.data(), a_py.data(), a_cx.data(), a_cy.data(), a_kp.data(), a_ks.data(),
                                 int(scene.settings.pattern), spp > 1, float(cols), float(spp / cols),
-                                {cam.origin.x, cam.origin.y, cam.origin.z}, {cam.du.x, cam.du.y, cam.du.z},
-                                {cam.dv.x, cam.dv.y, cam.dv.z}, {cam.dback.x, cam.dback.y, cam.dback.z},
-                                cam.inv_width, cam.inv_height, 1.f / float(spp),
+                                &cam, 1.f / float(spp),
                                 {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(),
                                  rays.dz.data(), rays.t_max.data(), rays.wr.data(), rays.wg.data(), rays.wb.data(),
                                  rays.cone.data(), rays.pixel.data(), rays.kind.data(), &rays.count}};

@@ -1,25 +1,14 @@
-// The SIMD intersection kernels (kernels/isa_*.cpp) against the scalar shape math they are
-// built from, at every ISA level this CPU runs.
+// The SIMD intersection kernels (kernels/isa_*.cpp) against an independent reference, at
+// every ISA level this CPU runs.
 //
-// Reference: Shape::hit_t<double> on the same canonical ray. The kernels read float rays and
-// float Mi rows; the reference takes exactly those floats, widened to double, and applies Mi
-// in double, so the only differences left are the kernel's own float rounding (transform
-// and solve; double for the torus).
-//
-// Agreement rule, per ray:
-//  * same hit/miss, same object id, and |t_kernel - t_ref| <= tol with
-//      tol = 1e-4 * (t_ref + (|o_c| + 1) / |d_c|)       (o_c, d_c: the canonical ray)
-//    Why 1e-4: float has eps = 6e-8; rounding the ray into canonical space moves it by a few
-//    eps * (|o_c| + 1) in space, i.e. by that over |d_c| in t, and the quadratic solve adds a
-//    few eps times its condition number. 1e-4 is ~1700 ulps: it holds for every ray whose
-//    condition number is below ~1000; worse-conditioned rays are in the band below.
-//  * except inside the near-tangent band: rays whose double-precision answer is itself
-//    unstable, i.e. changes hit/miss or object, or moves t by more than tol, when the origin
-//    is nudged by kNudge * (|o_c| + 1) along each axis or the direction by kNudge * |d_c|
-//    (kNudge = 1e-5, ~170 float ulps, well above the kernel's rounding), or whose two nearest
-//    hits (or nearest hit and t_max) are within tol of each other. Tangent and near-tangent
-//    rays, rays grazing edges, rims and the apex fall here. Disagreements in the band are
-//    counted and their share is bounded.
+// Reference: a double-precision intersection per canonical shape written in this file from
+// docs/scene-format.md (no engine/shapes/ header), on the kernel's float ray and float Mi
+// rows widened to double. Agreement rule, per ray: same hit/miss, same object id, and
+// |t_kernel - t_ref| <= tol, with tol derived from float error analysis (see "Tolerance from
+// float error analysis" below), except in the ill-conditioned band, which the reference
+// computes on its own in double (grazing rays, hits near edges, rims and the apex, answers
+// that change under a displacement as large as float rounding, close hits). Every
+// disagreement must lie in the band; nothing is excused by running the code under test.
 #include <doctest/doctest.h>
 
 #include <glm/glm.hpp>
@@ -36,8 +25,9 @@
 #include <vector>
 
 #include "kernels/kernel_table.h"
+#include "kernels/ray_stream.h"
+#include "scene/scene.h"
 #include "shapes/shapes.h"
-#include "stream/ray_stream.h"
 
 using namespace streamrt;
 
@@ -45,9 +35,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr float kInfF = std::numeric_limits<float>::infinity();
-constexpr double kRelTol = 1e-4;
-constexpr double kNudge = 1e-5;
-constexpr double kMaxShare = 5e-2;
 constexpr std::int32_t kSentinelId = 0x5EED;
 constexpr float kSentinelT = 1.0e30f;
 
@@ -101,86 +88,286 @@ struct RayArrays {
 };
 
 // ---------------------------------------------------------------------------------------
-// Reference
+// Reference: an independent double-precision intersection per canonical shape, written here
+// from docs/scene-format.md ("Canonical shapes") and sharing no code with engine/shapes/:
+//   sphere   x^2 + y^2 + z^2 = 1
+//   cube     [-1, 1]^3 (slabs)
+//   cylinder x^2 + z^2 = 1 for |y| <= 1, caps y = +-1 with x^2 + z^2 <= 1
+//   cone     x^2 + z^2 = ((1 - y) / 2)^2 for -1 <= y <= 1, base cap y = -1 with x^2 + z^2 <= 1
+//   torus    (rho - 1)^2 + y^2 = minor^2 (rho = sqrt(x^2 + z^2), ring torus, minor < 1): found
+//            by sphere tracing its exact signed distance sqrt((rho-1)^2 + y^2) - minor, then
+//            bisection on the bracket where its sign changes (ref_torus) — no quartic
+//   plane    y = 0
+// Each returns the nearest t > 0, the unit outward normal there and the distance from the
+// hit point to the nearest edge, rim or apex (where the surface has no tangent plane).
+
+struct RefSurf {
+    double t = kInf;
+    Vec3d n{0, 0, 0};
+    double feature = kInf;  ///< distance from the hit point to the nearest edge/rim/apex
+    bool unsure = false;    ///< the torus march did not settle (grazing for thousands of steps)
+};
+
+void consider(RefSurf& best, double t, const Vec3d& n, double feature) {
+    if (t > 0 && t < best.t) best = {t, n, feature, false};
+}
+
+/// Both roots of a t^2 + 2 b t + c = 0 in the stable form; false when there is none.
+bool roots(double a, double b, double c, double& t0, double& t1) {
+    if (a == 0) {
+        if (b == 0) return false;
+        t0 = t1 = -c / (2 * b);
+        return true;
+    }
+    const double disc = b * b - a * c;
+    if (disc < 0) return false;
+    const double q = -(b + std::copysign(std::sqrt(disc), b));
+    t0 = q / a;
+    t1 = q != 0 ? c / q : t0;
+    if (t0 > t1) std::swap(t0, t1);
+    return true;
+}
+
+RefSurf ref_sphere(const Vec3d& o, const Vec3d& d) {
+    RefSurf r;
+    double t0, t1;
+    if (roots(dot(d, d), dot(o, d), dot(o, o) - 1, t0, t1))
+        for (double t : {t0, t1}) consider(r, t, normalize(o + d * t), kInf);
+    return r;
+}
+
+RefSurf ref_cube(const Vec3d& o, const Vec3d& d) {
+    RefSurf r;
+    const double oc[3] = {o.x, o.y, o.z}, dc[3] = {d.x, d.y, d.z};
+    for (int axis = 0; axis < 3; ++axis)
+        for (double side : {-1.0, 1.0}) {
+            if (dc[axis] == 0) continue;
+            const double t = (side - oc[axis]) / dc[axis];
+            const Vec3d p = o + d * t;
+            const double pc[3] = {p.x, p.y, p.z};
+            const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+            if (std::abs(pc[a1]) > 1 || std::abs(pc[a2]) > 1) continue;
+            double n[3] = {0, 0, 0};
+            n[axis] = side;
+            consider(r, t, {n[0], n[1], n[2]}, std::min(1 - std::abs(pc[a1]), 1 - std::abs(pc[a2])));
+        }
+    return r;
+}
+
+RefSurf ref_cylinder(const Vec3d& o, const Vec3d& d) {
+    RefSurf r;
+    double t0, t1;
+    if (roots(d.x * d.x + d.z * d.z, o.x * d.x + o.z * d.z, o.x * o.x + o.z * o.z - 1, t0, t1))
+        for (double t : {t0, t1}) {
+            const Vec3d p = o + d * t;
+            if (std::abs(p.y) <= 1) consider(r, t, normalize(Vec3d{p.x, 0, p.z}), 1 - std::abs(p.y));
+        }
+    for (double side : {-1.0, 1.0}) {
+        if (d.y == 0) continue;
+        const double t = (side - o.y) / d.y;
+        const Vec3d p = o + d * t;
+        const double rho = std::sqrt(p.x * p.x + p.z * p.z);
+        if (rho <= 1) consider(r, t, {0, side, 0}, 1 - rho);
+    }
+    return r;
+}
+
+RefSurf ref_cone(const Vec3d& o, const Vec3d& d) {
+    // x^2 + z^2 - (1 - y)^2 / 4 = 0 along o + t d, with w = 1 - y:
+    // (dx^2 + dz^2 - dy^2/4) t^2 + 2 (ox dx + oz dz + w dy / 4) t + (ox^2 + oz^2 - w^2/4) = 0.
+    RefSurf r;
+    const double w = 1 - o.y;
+    double t0, t1;
+    if (roots(d.x * d.x + d.z * d.z - d.y * d.y / 4, o.x * d.x + o.z * d.z + w * d.y / 4,
+              o.x * o.x + o.z * o.z - w * w / 4, t0, t1))
+        for (double t : {t0, t1}) {
+            const Vec3d p = o + d * t;
+            if (p.y < -1 || p.y > 1) continue;
+            const double rho = std::sqrt(p.x * p.x + p.z * p.z);
+            // gradient of x^2 + z^2 - (1-y)^2/4: (2x, (1-y)/2, 2z); at the apex: +y (the docs)
+            const Vec3d g = rho > 0 ? normalize(Vec3d{p.x / rho, 0.5, p.z / rho}) : Vec3d{0, 1, 0};
+            const double to_apex = length(p - Vec3d{0, 1, 0}), to_rim = (p.y + 1) * std::sqrt(1.25);
+            consider(r, t, g, std::min(to_apex, to_rim));
+        }
+    if (d.y != 0) {
+        const double t = (-1 - o.y) / d.y;
+        const Vec3d p = o + d * t;
+        const double rho = std::sqrt(p.x * p.x + p.z * p.z);
+        if (rho <= 1) consider(r, t, {0, -1, 0}, 1 - rho);
+    }
+    return r;
+}
+
+double torus_sdf(const Vec3d& p, double minor) {
+    const double rho = std::sqrt(p.x * p.x + p.z * p.z);
+    return std::sqrt((rho - 1) * (rho - 1) + p.y * p.y) - minor;
+}
+
+RefSurf ref_torus(const Vec3d& o, const Vec3d& d, double minor) {
+    RefSurf r;
+    const double len = length(d);
+    if (!(len > 0)) return r;
+    const Vec3d u = d * (1 / len);  // unit steps: s along u is distance
+    // Only the part of the ray inside the bounding sphere |p| <= 1 + minor can meet it.
+    const double R = 1 + minor + 1e-9;
+    const double b = dot(o, u), c = dot(o, o) - R * R, disc = b * b - c;
+    if (disc < 0) return r;
+    const double s_far = -b + std::sqrt(disc);
+    if (s_far <= 0) return r;
+    const double s0 = std::max(0.0, -b - std::sqrt(disc));
+    // Starting inside the tube: march to the exit (the distance to the surface is -sdf).
+    const double sign = s0 == 0 && torus_sdf(o, minor) < 0 ? -1.0 : 1.0;
+    // Sphere tracing: a step of the distance to the surface cannot cross it. Near the surface
+    // the steps are at least kMinStep (1e-3), so a crossing shows as a change of sign,
+    // bracketed by the last two points and bisected. A ray that enters and leaves the tube
+    // within one such step goes less than (1e-3)^2 / (8 minor) <= 5e-7 deep: a graze that a
+    // displacement of the ray by delta (>= 32 eps ~ 2e-6) turns into a clear hit or miss, so
+    // it is in the band through the displaced rays (expected(), below) either way.
+    constexpr double kMinStep = 1e-3;
+    double prev = s0, s = s0;
+    for (int step = 0; step < 100000; ++step) {
+        const double g = sign * torus_sdf(o + u * s, minor);
+        if (g <= 0) {
+            double lo = prev, hi = s;
+            for (int k = 0; k < 80 && lo < hi; ++k) {
+                const double mid = 0.5 * (lo + hi);
+                (sign * torus_sdf(o + u * mid, minor) > 0 ? lo : hi) = mid;
+            }
+            const double sh = hi;
+            if (!(sh > 0)) {  // on the surface at the origin: no answer the reference trusts
+                r.unsure = true;
+                return r;
+            }
+            const Vec3d p = o + u * sh;
+            const double rho = std::sqrt(p.x * p.x + p.z * p.z);
+            const Vec3d ring{p.x / rho, 0, p.z / rho};
+            r.t = sh / len;
+            r.n = normalize(p - ring);
+            return r;
+        }
+        if (s > s_far) return r;
+        prev = s;
+        s += std::max(g, kMinStep);
+    }
+    r.unsure = true;
+    return r;
+}
+
+RefSurf ref_plane(const Vec3d& o, const Vec3d& d) {
+    RefSurf r;
+    if (d.y != 0) consider(r, -o.y / d.y, {0, 1, 0}, kInf);
+    return r;
+}
+
+RefSurf ref_shape(ShapeKind kind, const Vec3d& o, const Vec3d& d, double param) {
+    switch (kind) {
+        case ShapeKind::Sphere: return ref_sphere(o, d);
+        case ShapeKind::Cube: return ref_cube(o, d);
+        case ShapeKind::Cylinder: return ref_cylinder(o, d);
+        case ShapeKind::Cone: return ref_cone(o, d);
+        case ShapeKind::Torus: return ref_torus(o, d, param);
+        case ShapeKind::Plane: return ref_plane(o, d);
+        default: break;
+    }
+    FAIL("no reference for this shape kind");
+    return {};
+}
 
 struct Canon {
     Vec3d o, d;
+    double so = 0, sd = 0;  ///< sums of |terms| of the float transform (for its rounding error)
 };
 
 Canon to_canonical_d(const ObjectXf& ob, const Vec3f& of, const Vec3f& df) {
     const auto m = [&](int i) { return double(ob.m[i]); };
     const Vec3d o = vec_cast<double>(of), d = vec_cast<double>(df);
-    return {{m(0) * o.x + m(1) * o.y + m(2) * o.z + m(3), m(4) * o.x + m(5) * o.y + m(6) * o.z + m(7),
+    Canon c{{m(0) * o.x + m(1) * o.y + m(2) * o.z + m(3), m(4) * o.x + m(5) * o.y + m(6) * o.z + m(7),
              m(8) * o.x + m(9) * o.y + m(10) * o.z + m(11)},
             {m(0) * d.x + m(1) * d.y + m(2) * d.z, m(4) * d.x + m(5) * d.y + m(6) * d.z,
              m(8) * d.x + m(9) * d.y + m(10) * d.z}};
+    for (int r = 0; r < 3; ++r) {
+        c.so = std::max(c.so, std::abs(m(4 * r)) * std::abs(o.x) + std::abs(m(4 * r + 1)) * std::abs(o.y) +
+                                  std::abs(m(4 * r + 2)) * std::abs(o.z) + std::abs(m(4 * r + 3)));
+        c.sd = std::max(c.sd, std::abs(m(4 * r)) * std::abs(d.x) + std::abs(m(4 * r + 1)) * std::abs(d.y) +
+                                  std::abs(m(4 * r + 2)) * std::abs(d.z));
+    }
+    return c;
 }
 
-double scalar_hit(ShapeKind kind, const Canon& c, double param) {
-    return visit_shape(kind, [&](auto shape) { return shape.template hit_t<double>(c.o, c.d, param, 0.0, kInf); });
-}
+// Tolerance from float error analysis. The kernel rounds the ray into canonical space in
+// float (3 products and 3 sums per component: each component off by at most ~4 eps S, S the
+// sum of the terms' magnitudes, eps = 2^-24), then solves in float (torus: double) from that
+// ray, which moves the computed hit point by a few eps of its magnitude |o_c| + t |d_c| + 1
+// (the shape's unit size). So the kernel answers exactly for a ray whose origin and hit point
+// are displaced by at most
+//     delta = kUlps * eps * (S_o + |o_c| + 1 + t (S_d + |d_c|))        (kUlps = 32:
+// 4 roundings in the transform, ~8 in the solve, a factor of ~3 for safety and FMA/no-FMA).
+// A displacement delta of the hit point moves t by delta / (|d_c| cos theta), theta the angle
+// between the ray and the surface normal (the condition number of t is 1 / cos theta), so
+//     tol = delta / (|d_c| max(cos theta, kMinCos)).
+// Rays with cos theta < kMinCos (= 1e-2: grazing within 0.6 degree) are ill-conditioned: in
+// the band. So are rays whose reference answer changes (hit/miss, object, or t beyond tol)
+// when the canonical ray is displaced by delta (silhouettes, edges, rims, the apex: the
+// reference's own double-precision margin, computed without the kernel), rays whose hit lies
+// within delta / kMinCos of an edge, rim or apex, and rays with two hits (or a hit and t_max)
+// within tol of each other. Nothing in the band is computed by the code under test.
+constexpr double kEpsF = 0x1p-24;
+constexpr double kUlps = 32;
+constexpr double kMinCos = 1e-2;
 
 struct RefHit {
-    double t = kInf;      ///< nearest hit over all objects (before t_max)
-    int id = -1;          ///< its object id, -1 for none
-    double second = kInf; ///< the next nearest hit of another object
-    double tol = 0;       ///< agreement tolerance on t
+    double t = kInf;       ///< nearest hit over all objects (before t_max)
+    int id = -1;           ///< its object id, -1 for none
+    double second = kInf;  ///< the next nearest hit of another object
+    double tol = 0;        ///< agreement tolerance on t (above)
+    double delta = 0;      ///< the float displacement bound at the hit (canonical units)
+    double dlen = 1;       ///< |d_c| of the hit object
+    bool grazing = false;  ///< cos theta < kMinCos, near a feature, or the reference unsure
 };
 
-/// Closest hit in double; `kinds` parallel to `objs` (mixed kinds allowed).
+/// Closest hit in double; `kinds` parallel to `objs` (mixed kinds allowed). nudge: a
+/// displacement of the canonical origin (o_nudge) or direction (d_nudge) by a fraction of
+/// delta along an axis, for the band.
 RefHit ref_closest(const std::vector<ShapeKind>& kinds, const std::vector<ObjectXf>& objs, const Vec3f& o,
-                   const Vec3f& d, double o_nudge[3] = nullptr, double d_nudge[3] = nullptr) {
+                   const Vec3f& d, const double o_nudge[3] = nullptr, const double d_nudge[3] = nullptr) {
     RefHit r;
-    double best_scale = 1;
     for (std::size_t k = 0; k < objs.size(); ++k) {
         Canon c = to_canonical_d(objs[k], o, d);
-        if (o_nudge) {
-            const double s = kNudge * (length(c.o) + 1.0);
-            c.o = c.o + Vec3d{o_nudge[0] * s, o_nudge[1] * s, o_nudge[2] * s};
+        const double dlen = length(c.d);
+        const double delta_o = kUlps * kEpsF * (c.so + length(c.o) + 1);
+        if (o_nudge) c.o = c.o + Vec3d{o_nudge[0], o_nudge[1], o_nudge[2]} * delta_o;
+        if (d_nudge) c.d = c.d + Vec3d{d_nudge[0], d_nudge[1], d_nudge[2]} * (kUlps * kEpsF * (c.sd + dlen));
+        const RefSurf s = ref_shape(kinds[k], c.o, c.d, double(objs[k].param));
+        if (s.unsure) r.grazing = true;
+        if (kinds[k] == ShapeKind::Cone) {
+            // Lines through the apex meet the side in a double root there (every line through
+            // it is tangent to the double cone): ill-conditioned whether the reference hits or
+            // misses, when the ray passes within delta / kMinCos of the apex ahead of its origin.
+            const Vec3d to_apex = Vec3d{0, 1, 0} - c.o;
+            const double ta = std::max(0.0, dot(to_apex, c.d) / (dlen * dlen));
+            const double near_apex = length(c.o + c.d * ta - Vec3d{0, 1, 0});
+            if (near_apex < (delta_o + kUlps * kEpsF * ta * (c.sd + dlen)) / kMinCos) r.grazing = true;
         }
-        if (d_nudge) {
-            const double s = kNudge * length(c.d);
-            c.d = c.d + Vec3d{d_nudge[0] * s, d_nudge[1] * s, d_nudge[2] * s};
-        }
-        const double t = scalar_hit(kinds[k], c, double(objs[k].param));
-        const double scale = (length(c.o) + 1.0) / length(c.d);
-        if (t < r.t) {
+        if (s.t < r.t) {
             r.second = r.t;
-            r.t = t;
+            r.t = s.t;
             r.id = objs[k].id;
-            best_scale = scale;
-        } else if (t < r.second) {
-            r.second = t;
+            r.delta = delta_o + kUlps * kEpsF * s.t * (c.sd + dlen);
+            r.dlen = dlen;
+            const double cos_theta = std::abs(dot(s.n, c.d)) / dlen;
+            r.tol = r.delta / (dlen * std::max(cos_theta, kMinCos));
+            r.grazing = r.grazing || cos_theta < kMinCos || s.feature < r.delta / kMinCos;
+        } else if (s.t < r.second) {
+            r.second = s.t;
         }
     }
-    r.tol = kRelTol * ((std::isfinite(r.t) ? r.t : 0.0) + best_scale);
+    if (!std::isfinite(r.t)) {  // a miss: t's tolerance does not matter, the nudges decide
+        r.tol = 0;
+    }
     return r;
 }
 
-/// The same shape math at the kernel's own precision (float; double for the torus, see
-/// ComputeType in intersect_kernel.h) on the canonical ray rounded to float: what a correct
-/// kernel would compute, without its SIMD code. Returns the closest hit (t, id).
-std::pair<double, int> kernel_precision_closest(const std::vector<ShapeKind>& kinds, const std::vector<ObjectXf>& objs,
-                                                const Vec3f& o, const Vec3f& d) {
-    double best = kInf;
-    int id = -1;
-    for (std::size_t k = 0; k < objs.size(); ++k) {
-        const Canon c = to_canonical_d(objs[k], o, d);
-        const Vec3f of = vec_cast<float>(c.o), df = vec_cast<float>(c.d);
-        double t;
-        if (kinds[k] == ShapeKind::Torus) {
-            t = scalar_hit(kinds[k], {vec_cast<double>(of), vec_cast<double>(df)}, double(objs[k].param));
-        } else {
-            t = visit_shape(kinds[k], [&](auto shape) {
-                return double(shape.template hit_t<float>(of, df, objs[k].param, 0.f, std::numeric_limits<float>::infinity()));
-            });
-        }
-        if (t < best) best = t, id = objs[k].id;
-    }
-    return {best, id};
-}
-
-enum BandReason : int { NotInBand, NudgeUnstable, CloseHits, FloatLimited };
+enum BandReason : int { NotInBand, NudgeUnstable, CloseHits, IllConditioned };
 
 struct Expected {
     bool hit;
@@ -191,14 +378,19 @@ struct Expected {
     int reason = NotInBand;
 };
 
-/// The reference answer for one ray with its t_max, and whether it is in the near-tangent band.
+/// The reference answer for one ray with its t_max, and whether it is in the ill-conditioned
+/// band (every criterion computed by the reference in double; see the tolerance above).
 Expected expected(const std::vector<ShapeKind>& kinds, const std::vector<ObjectXf>& objs, const TestRay& ray) {
     const RefHit r = ref_closest(kinds, objs, ray.o, ray.d);
     const double t_max = double(ray.t_max);
     Expected e{r.t < t_max, r.t, r.id, r.tol, false};
     if (!e.hit) e.id = -1;
+    if (r.grazing) e.band = true, e.reason = IllConditioned;
     // Two hits (or a hit and t_max) too close to tell apart in float.
-    if (std::isfinite(r.t) && (r.second - r.t <= r.tol || std::abs(r.t - t_max) <= r.tol)) e.band = true, e.reason = CloseHits;
+    if (!e.band && std::isfinite(r.t) && (r.second - r.t <= r.tol || std::abs(r.t - t_max) <= r.tol))
+        e.band = true, e.reason = CloseHits;
+    // The reference's answer under a displacement of the canonical ray as large as the float
+    // rounding bound (delta), along each axis, both ways, origin and direction.
     for (int axis = 0; axis < 3 && !e.band; ++axis)
         for (double sgn : {-1.0, 1.0}) {
             double n[3] = {0, 0, 0};
@@ -207,33 +399,10 @@ Expected expected(const std::vector<ShapeKind>& kinds, const std::vector<ObjectX
                 const RefHit p = on_origin ? ref_closest(kinds, objs, ray.o, ray.d, n, nullptr)
                                            : ref_closest(kinds, objs, ray.o, ray.d, nullptr, n);
                 const bool p_hit = p.t < t_max;
-                if (p_hit != e.hit || (e.hit && (p.id != e.id || std::abs(p.t - r.t) > r.tol))) e.band = true, e.reason = NudgeUnstable;
-            }
-        }
-    // Float-limited: the scalar math at the kernel's precision already gets it wrong. This
-    // catches rays that are geometrically stable but numerically ill-posed for the formula,
-    // e.g. rays along a cone generator that pass within ~1e-4 of the apex: there the cone's
-    // b and c are each a cancellation of terms ~|o||d| down to ~1e-4, float's relative error
-    // in the linear root c/(2b) is ~1e-3 and the apex test y <= 1 flips.
-    // The kernel's float rounding (and the FMAs of the AVX2/AVX-512 builds, which SSE emulates
-    // with a multiply and an add) moves the canonical ray by an ulp or so, so the float math
-    // must also hold when any component of the ray moves by 1 or 16 ulps. Near a double root
-    // (tangency; every line through the cone's apex) the float discriminant's sign is
-    // rounding noise: the root moves by ~sqrt(eps) ~ 2.4e-4, beyond the double nudges above.
-    const auto float_disagrees = [&](const Vec3f& o, const Vec3f& d) {
-        const auto [tf, idf] = kernel_precision_closest(kinds, objs, o, d);
-        const bool f_hit = tf < t_max;
-        return f_hit != e.hit || (e.hit && (idf != e.id || std::abs(tf - r.t) > r.tol));
-    };
-    if (!e.band && float_disagrees(ray.o, ray.d)) e.band = true, e.reason = FloatLimited;
-    for (int comp = 0; comp < 6 && !e.band; ++comp)
-        for (int ulps : {1, -1, 16, -16}) {
-            Vec3f o = ray.o, d = ray.d;
-            float* v = comp < 3 ? (&o.x + comp) : (&d.x + (comp - 3));
-            for (int k = 0; k < std::abs(ulps); ++k) *v = std::nextafter(*v, ulps > 0 ? kInfF : -kInfF);
-            if (float_disagrees(o, d)) {
-                e.band = true, e.reason = FloatLimited;
-                break;
+                // A smooth answer moves by at most tol under this displacement (that is how tol
+                // is derived); more than twice that is a jump (another face, a silhouette).
+                if (p.grazing || p_hit != e.hit || (e.hit && (p.id != e.id || std::abs(p.t - r.t) > 2 * r.tol)))
+                    e.band = true, e.reason = NudgeUnstable;
             }
         }
     return e;
@@ -567,8 +736,8 @@ void judge_closest(const std::vector<TestRay>& rays, const std::vector<Expected>
 void report(const char* what, const Tally& t) {
     std::ostringstream s;
     s << what << ": " << t.rays << " rays, " << t.hits << " kernel hits, band " << t.band << " (nudge-unstable "
-      << t.band_reason[NudgeUnstable] << ", close hits " << t.band_reason[CloseHits] << ", float-limited "
-      << t.band_reason[FloatLimited] << "), disagreements " << t.disagree
+      << t.band_reason[NudgeUnstable] << ", close hits " << t.band_reason[CloseHits] << ", ill-conditioned "
+      << t.band_reason[IllConditioned] << "), disagreements " << t.disagree
       << " (outside band " << t.disagree_outside_band << ") by category:";
     for (int c = 0; c < kCategories; ++c)
         if (t.per_cat[std::size_t(c)]) s << " " << category_name(c) << " " << t.disagree_cat[std::size_t(c)] << "/" << t.per_cat[std::size_t(c)];
@@ -576,19 +745,31 @@ void report(const char* what, const Tally& t) {
     for (const std::string& f : t.first_failures) MESSAGE("outside the band: " << f);
 }
 
-/// The bound on disagreements. Random rays: <= 2e-4 of them (measured worst: 4 of 40000,
-/// 1e-4, rays nearly parallel to an infinite plane, all in the band). The constructed tangent,
-/// parallel and axis families (half of the canonical rays) aim at the ill-conditioned cases
-/// on purpose (exactly tangent, lying in a face, grazing a rim or the apex); for them only
-/// the band rule holds, and the share of all rays is bounded by kMaxShare = 5e-2. Measured:
-/// sphere ~0.7%, cylinder ~1.1%, cone ~2.9% (its float discriminant b^2 - a c cancels,
-/// unlike the sphere's and cylinder's closest-approach form), cube and plane 0.
-void check_tally(const Tally& t) {
+/// The bound on disagreements: none outside the band, so the share of rays allowed to
+/// disagree is the band's share, which the reference alone decides (kMaxShare = 5 % is gone).
+/// The band itself is bounded, so that it cannot grow to excuse everything: measured
+/// (`build/tests/streamrt_tests -tc='kernels:*' -s`) x 1.3. Canonical sets, half of them
+/// aimed at tangents, faces, rims and the apex on purpose: sphere 8.1 %, cube 12.2 %,
+/// cylinder 12.5 %, cone 11.3 %, torus 9.4 %, plane 41.3 % (origins on the plane, rays
+/// parallel to it); transformed objects hit by random rays: at most 0.81 % (cube x7).
+double max_band_share(ShapeKind kind) {
+    switch (kind) {
+        case ShapeKind::Sphere: return 0.105;
+        case ShapeKind::Cube: return 0.16;
+        case ShapeKind::Cylinder: return 0.163;
+        case ShapeKind::Cone: return 0.147;
+        case ShapeKind::Torus: return 0.124;
+        default: return 0.54;
+    }
+}
+constexpr double kMaxBandShareWorld = 0.011;
+
+void check_tally(const Tally& t, double max_band = kMaxBandShareWorld) {
     CHECK(t.disagree_outside_band == 0);
     CHECK(t.untouched_violations == 0);
     const std::size_t general = t.per_cat[General];
     if (general > 0) CHECK(double(t.disagree_cat[General]) <= 2e-4 * double(general));
-    CHECK(double(t.disagree) < kMaxShare * double(t.rays));
+    CHECK(double(t.band) <= max_band * double(t.rays));
 }
 
 std::vector<Expected> expectations(const std::vector<ShapeKind>& kinds, const std::vector<ObjectXf>& objs,
@@ -640,7 +821,7 @@ TEST_CASE("kernels: closest hit on canonical shapes matches the scalar math, eve
             Tally tally;
             judge_closest(rays, exp, run_closest(kernel_table(isa), kinds, objs, rays), tally);
             report((std::string(shape_kind_name(kind)) + " canonical " + isa_name(isa)).c_str(), tally);
-            check_tally(tally);
+            check_tally(tally, max_band_share(kind));
         }
     }
 }
@@ -666,7 +847,7 @@ TEST_CASE("kernels: closest hit among several transformed objects returns the ri
             CAPTURE(isa_str);
                 Tally tally;
                 judge_closest(rays, exp, run_closest(kernel_table(isa), kinds, objs, rays), tally);
-                if (n_objs == 7) report((std::string(shape_kind_name(kind)) + " x7 world " + isa_name(isa)).c_str(), tally);
+                report((std::string(shape_kind_name(kind)) + " x7 world " + isa_name(isa)).c_str(), tally);
                 check_tally(tally);
             }
         }
@@ -750,8 +931,7 @@ TEST_CASE("kernels: any hit blocks exactly the rays whose closest hit is before 
                                               << " blocked before, disagreements " << disagree << " (outside band " << outside << ")");
                 CHECK(stayed == prior);
                 CHECK(changed_open == 0);
-                CHECK(outside == 0);
-                CHECK(double(disagree) < kMaxShare * double(set.size()));
+                CHECK(outside == 0);  // every disagreement in the band (the reference's)
             }
         }
     }
@@ -808,7 +988,6 @@ TEST_CASE("kernels: every ISA level agrees with every other") {
                                           << any_differ);
             CHECK(outside == 0);
             CHECK(any_outside == 0);
-            CHECK(double(differ) < kMaxShare * double(rays.size()));  // as check_tally
         }
     }
 }
@@ -918,7 +1097,7 @@ TEST_CASE("kernels: hand-picked rays (inside, tangent, parallel, along axes) at 
             CAPTURE(c.o.x); CAPTURE(c.o.y); CAPTURE(c.o.z); CAPTURE(c.d.x); CAPTURE(c.d.y); CAPTURE(c.d.z);
             const std::vector<TestRay> rays{{c.o, c.d, kInfF, Axis}};
             const KernelOut out = run_closest(kernel_table(isa), {c.kind}, {identity_object(0.25, 42)}, rays);
-            const double scalar = scalar_hit(c.kind, {vec_cast<double>(c.o), vec_cast<double>(c.d)}, 0.25);
+            const double scalar = ref_shape(c.kind, vec_cast<double>(c.o), vec_cast<double>(c.d), 0.25).t;
             if (std::isfinite(c.t)) {
                 CHECK(scalar == doctest::Approx(c.t).epsilon(1e-12));
                 CHECK(out.id[0] == 42);
@@ -929,12 +1108,12 @@ TEST_CASE("kernels: hand-picked rays (inside, tangent, parallel, along axes) at 
                 CHECK(out.t[0] == kInfF);
             }
         }
-        // The torus: kernel and TorusMath agree on rays along the axes, whatever solver is in.
+        // The torus: kernel and the reference agree on rays along the axes.
         for (const auto& [o, d] : std::initializer_list<std::pair<Vec3f, Vec3f>>{
                  {{0, 3, 0}, {0, -1, 0}}, {{-3, 0, 0}, {1, 0, 0}}, {{0, 0, -3}, {0, 0, 1}}, {{1, 3, 0}, {0, -1, 0}}}) {
             CAPTURE(o.x); CAPTURE(o.y); CAPTURE(o.z);
             const KernelOut out = run_closest(kernel_table(isa), {ShapeKind::Torus}, {identity_object(0.25, 5)}, {{o, d, kInfF, Axis}});
-            const double scalar = scalar_hit(ShapeKind::Torus, {vec_cast<double>(o), vec_cast<double>(d)}, 0.25);
+            const double scalar = ref_shape(ShapeKind::Torus, vec_cast<double>(o), vec_cast<double>(d), 0.25).t;
             if (std::isfinite(scalar)) {
                 CHECK(out.id[0] == 5);
                 CHECK(double(out.t[0]) == doctest::Approx(scalar).epsilon(1e-5));

@@ -12,14 +12,14 @@
 #include <string>
 #include <vector>
 
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 #include "image/image_compare.h"
 #include "kernels/kernel_table.h"
 #include "mesh/mesh.h"
 #include "mesh/mesh_trace.h"
 #include "parallel/parallelism.h"
 #include "render/camera_rays.h"
-#include "render/render.h"
+#include "driver/render.h"
 #include "scene/parser.h"
 #include "stream/stream_accel.h"
 

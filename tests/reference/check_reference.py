@@ -39,7 +39,7 @@ import reference_render as rr  # noqa: E402
 
 TOL_ABS = 2e-3
 MAX_SHARE = 0.005
-SHAPES = ("sphere", "cube", "cylinder", "cone", "torus", "plane")
+SHAPES = ("sphere", "cube", "cylinder", "cone", "torus", "plane", "disk")
 
 
 def _scene(name):
@@ -75,7 +75,7 @@ GROUPS = {
 
 # Golden images: small, checker-free scenes rendered by the reference.
 GOLDEN = [("sphere", 5), ("cube", 4), ("cylinder", 3), ("cone", 2), ("torus", 5),
-          ("plane", 4), ("lights", 5), ("mirror_scale", 1)]
+          ("plane", 4), ("lights", 5), ("mirror_scale", 1), ("disk", 5)]
 GOLDEN_SIZE = (64, 48)
 
 

@@ -60,7 +60,7 @@ def _transform_step(key, val):
 TRANSFORM_KEYS = ("scale", "rotate_x", "rotate_y", "rotate_z", "translate")
 MATERIAL_DEFAULT = dict(color=np.ones(3), ambi=1.0, diff=1.0, spec=0.0, shininess=32.0,
                         refl=0.0, trans=0.0, ior=1.0, checker=None, cell=1.0)
-SHAPES = ("sphere", "cube", "cylinder", "cone", "torus", "plane")
+SHAPES = ("sphere", "cube", "cylinder", "cone", "torus", "plane", "disk")
 
 
 def _kv(args):
@@ -419,9 +419,25 @@ def normal_plane(p, obj):
     return np.tile([0.0, 1.0, 0.0], (len(p), 1))
 
 
+def hit_disk(o, d, tmin, obj):
+    """The unit disk x^2 + z^2 <= 1 of the plane y = 0 (edge included)."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        t = -o[:, 1] / d[:, 1]
+        x = o[:, 0] + t * d[:, 0]
+        z = o[:, 2] + t * d[:, 2]
+        inside = x * x + z * z <= 1
+    t = np.where(np.isfinite(t) & (t > tmin) & inside, t, np.inf)
+    return t, o + np.where(np.isfinite(t), t, 0)[:, None] * d
+
+
+def normal_disk(p, obj):
+    return np.tile([0.0, 1.0, 0.0], (len(p), 1))
+
+
 HIT = dict(sphere=(hit_sphere, normal_sphere), cube=(hit_cube, normal_cube),
            cylinder=(hit_cylinder, normal_cylinder), cone=(hit_cone, normal_cone),
-           torus=(hit_torus, normal_torus), plane=(hit_plane, normal_plane))
+           torus=(hit_torus, normal_torus), plane=(hit_plane, normal_plane),
+           disk=(hit_disk, normal_disk))
 
 
 def closest_hit(scene, o, d, tmin=0.0):

@@ -6,7 +6,8 @@
 #include <cmath>
 #include <string>
 
-#include "render/render.h"
+#include "driver/render.h"
+#include "render/one_pixel.h"
 #include "render/shading.h"
 #include "scene/parser.h"
 
@@ -21,16 +22,8 @@ const std::string kHead =
     "background 0.2,0.3,0.4\n";
 
 void check_pixel(const std::string& body, int degree, double r, double g, double b) {
-    const Scene scene = parse_scene(kHead + "image degree=" + std::to_string(degree) + "\n" + body, "pixel.cfg");
-    for (EngineKind e : {EngineKind::Recursive, EngineKind::Stream}) {
-        CAPTURE(engine_name(e));
-        Parallelism par(1);
-        const RenderResult res = render_scene(scene, e, par);
-        const float* p = res.image.pixel(0, 0);
-        CHECK(p[0] == doctest::Approx(r).epsilon(1e-5));
-        CHECK(p[1] == doctest::Approx(g).epsilon(1e-5));
-        CHECK(p[2] == doctest::Approx(b).epsilon(1e-5));
-    }
+    test::check_one_pixel(parse_scene(kHead + "image degree=" + std::to_string(degree) + "\n" + body, "pixel.cfg"), r,
+                          g, b);
 }
 
 }  // namespace

@@ -1,11 +1,11 @@
-// The memory estimate and the refusal of renders that cannot fit (render/limits.h).
+// The memory estimate and the refusal of renders that cannot fit (driver/limits.h).
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <string>
 
 #include "core/error.h"
-#include "render/limits.h"
+#include "driver/limits.h"
 #include "scene/parser.h"
 
 using namespace streamrt;
@@ -17,30 +17,32 @@ TEST_CASE("limits: the estimate counts the framebuffer, the output and the per-t
     // One PNG band (the whole image): two 8-bit rows 600, filtered rows 50 * 301, their
     // deflate bound 15050 + 16 + 64, one deflate state 270336. PNG needs the most.
     CHECK(e.output_bytes == 600 + 15050 + 15130 + 270336);
-    CHECK(e.branching == 1);
-    CHECK(e.peak_stream_rays == 4096);  // no mirror: the stream never grows
+    CHECK(e.generations == 1);  // no mirror: one generation, never more
+    CHECK(e.slice_rays == 16384);
     CHECK(e.threads == 4);
     CHECK(e.total_bytes == doctest::Approx(e.framebuffer_bytes + e.output_bytes + 4 * e.per_thread_bytes));
 
-    // spp above the chunk size: one pixel's samples are one chunk.
+    // spp above the slice size: one pixel's samples are one chunk and one slice.
     sc.settings.spp = 65536;
-    CHECK(estimate_render_memory(sc, true, 1).peak_stream_rays == 65536);
+    CHECK(estimate_render_memory(sc, true, 1).slice_rays == 65536);
 }
 
-TEST_CASE("limits: 2^depth secondaries only when one material both reflects and transmits") {
-    Scene mirror = parse_scene("image depth=10\nsphere refl=0.5\ncube trans=0.5\n", "t.cfg");
-    CHECK(estimate_render_memory(mirror, true, 1).branching == 1);
-    Scene glass = parse_scene("image depth=10\nsphere refl=0.5 trans=0.5\n", "t.cfg");
-    const MemoryEstimate e = estimate_render_memory(glass, true, 1);
-    CHECK(e.branching == 2);
-    CHECK(e.peak_stream_rays == 4096.0 * 1024);
-    glass.settings.degree = 3;  // no refraction below degree 4
-    CHECK(estimate_render_memory(glass, true, 1).branching == 1);
-    // The recursive engine's memory does not grow with 2^depth.
-    glass.settings.degree = 5;
+TEST_CASE("limits: the stream engine's memory grows linearly with depth, never as 2^depth") {
+    Scene glass = parse_scene("image depth=10\nsphere refl=0.5 trans=0.5\nlight point pos=0,5,5\n", "t.cfg");
+    const MemoryEstimate e10 = estimate_render_memory(glass, true, 1);
+    CHECK(e10.generations == 12);  // depth + 1 generations and the empty spawns of the last
+    Scene mirror = parse_scene("image depth=10\nsphere refl=0.5\n", "t.cfg");
+    CHECK(estimate_render_memory(mirror, true, 1).generations == 12);
+    mirror.settings.degree = 2;  // no reflection below degree 3
+    CHECK(estimate_render_memory(mirror, true, 1).generations == 1);
+    // Each further level costs at most two slices of rays (49 bytes each), whatever the
+    // materials: 2 x 16384 x 49 bytes per level and thread.
     glass.settings.depth = 256;
+    const MemoryEstimate e256 = estimate_render_memory(glass, true, 1);
+    CHECK(e256.per_thread_bytes - e10.per_thread_bytes == doctest::Approx(246.0 * 2 * 16384 * 49));
+    CHECK(e256.per_thread_bytes < 512.0 * 1024 * 1024);  // depth 256: about 420 MB a thread
+    // The recursive engine's memory is its stack.
     CHECK(estimate_render_memory(glass, false, 1).total_bytes < 1e8);
-    CHECK(std::isfinite(estimate_render_memory(glass, true, 1).total_bytes));  // 2^256 fits a double
 }
 
 TEST_CASE("limits: a render above the limit is refused with what it would need") {
@@ -61,9 +63,30 @@ TEST_CASE("limits: a render above the limit is refused with what it would need")
         CHECK(m.find("but this machine has 8.0 GiB") != std::string::npos);
         CHECK(m.find('\n') == std::string::npos);
     }
+    // Refused before bounded-depth tracing (2^depth estimate: "about 28.4 GiB" for depth 14 at
+    // 640x360 4 spp, 2^256 rays at depth 256), accepted now on the real machine.
+    Scene whitted = parse_scene("image width=640 height=360 spp=4 depth=14\nsphere refl=0.08 trans=0.9\n"
+                                "light point pos=0,5,5\nlight point pos=3,5,5\n",
+                                "t.cfg");
+    CHECK_NOTHROW(check_render_memory(whitted, true, 2));
+    CHECK(estimate_render_memory(whitted, true, 2).total_bytes < 80.0 * 1024 * 1024);
     Scene deep = parse_scene("image depth=256\nsphere refl=0.5 trans=0.5\n", "t.cfg");
-    CHECK_THROWS_AS(check_render_memory(deep, true, 1), UsageError);  // the real machine
+    CHECK_NOTHROW(check_render_memory(deep, true, 2));
     CHECK_NOTHROW(check_render_memory(deep, false, 1));
+    // What truly cannot fit still is: at spp 65536 a slice is 65536 rays, about 1.6 GiB of
+    // streams a thread at depth 256; 64 threads need about 100 GiB.
+    deep.settings.spp = 65536;
+    const MemoryEstimate huge = estimate_render_memory(deep, true, 64);
+    CHECK(huge.total_bytes > 64.0 * 1024 * 1024 * 1024);
+    try {
+        check_render_memory(deep, true, 64, 24.0 * 1024 * 1024 * 1024);
+        FAIL("expected a UsageError");
+    } catch (const UsageError& e) {
+        const std::string m = e.what();
+        CHECK(m.find("spp 65536, depth 256 would need about") != std::string::npos);
+        CHECK(m.find("64 threads x") != std::string::npos);
+        CHECK(m.find("of ray streams") != std::string::npos);
+    }
     CHECK(physical_memory_bytes() > 0);
 }
 

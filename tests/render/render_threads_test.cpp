@@ -5,7 +5,7 @@
 #include <atomic>
 
 #include "parallel/parallelism.h"
-#include "render/render.h"
+#include "driver/render.h"
 #include "scene/parser.h"
 
 using namespace streamrt;

@@ -632,3 +632,29 @@ TEST_CASE("parser: the example in docs/scene-format.md parses") {
     CHECK(s.camera.look_at);
     CHECK(s.settings.output == "example.png");
 }
+
+TEST_CASE("parser: disk statements (shapes/shapes.h registry), keys and errors at file:line:col") {
+    const Scene s = parse(
+        "material shiny refl=0.5\n"
+        "disk color=0.2,0.4,0.6 diff=0.7 scale=2 rotate_x=90 translate=0,1,0\n"
+        "  disk material=shiny\n");
+    REQUIRE(s.objects.size() == 2);
+    CHECK(s.objects[0].kind == ShapeKind::Disk);
+    CHECK(s.objects[0].param == 0.0);
+    CHECK(s.objects[1].kind == ShapeKind::Disk);
+    CHECK(s.where(1).line == 3);
+    CHECK(s.where(1).column == 3);
+    CHECK(s.material_of(s.objects[1]).refl == doctest::Approx(0.5));
+    // The canonical point (1, 0, 0) -> scale 2 -> rotate_x 90 (unchanged) -> (2, 1, 0).
+    const glm::dvec3 p = glm::dvec3(s.objects[0].direct() * glm::dvec4(1, 0, 0, 1));
+    CHECK(p.x == doctest::Approx(2.0));
+    CHECK(p.y == doctest::Approx(1.0));
+
+    expect_error("disk\ndisk minor=0.3", 2, 6, "unknown key 'minor' for 'disk'");
+    expect_error("disk radius=2", 1, 6, "unknown key 'radius'");
+    expect_error("disks", 1, 1, "torus, plane, disk, mesh or include");
+    // The torus keeps its parameter key, default and check, now declared by TorusMath.
+    CHECK(parse("torus").objects[0].param == doctest::Approx(0.25));
+    CHECK(parse("torus minor=0.4").objects[0].param == doctest::Approx(0.4));
+    expect_error("torus minor=0", 1, 13, "'minor' must be > 0");
+}

@@ -105,15 +105,12 @@ TEST_CASE("cone: side, base cap, apex, along the axis, parallel to a generator")
 
 TEST_CASE("every shape: NaN and zero directions miss, never NaN") {
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    for (ShapeKind k : {ShapeKind::Sphere, ShapeKind::Cube, ShapeKind::Cylinder, ShapeKind::Cone, ShapeKind::Plane}) {
-        const std::string name = shape_kind_name(k);
+    CanonicalShapes::for_each([&](auto s) {  // every registered shape (shapes/shapes.h)
+        using S = decltype(s);
+        const std::string name(S::name);
         CAPTURE(name);
-        visit_shape(k, [&](auto s) {
-            using S = decltype(s);
-            CHECK(hit<S>({0, 0, 5}, {nan, 0, -1}) == kInf);
-            CHECK(hit<S>({nan, 0, 5}, {0, 0, -1}) == kInf);
-            CHECK(hit<S>({0, 0, 5}, {0, 0, 0}) == kInf);
-            return 0;
-        });
-    }
+        CHECK(hit<S>({0, 0, 5}, {nan, 0, -1}) == kInf);
+        CHECK(hit<S>({nan, 0, 5}, {0, 0, -1}) == kInf);
+        CHECK(hit<S>({0, 0, 5}, {0, 0, 0}) == kInf);
+    });
 }

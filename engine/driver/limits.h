@@ -15,13 +15,14 @@ struct MemoryEstimate {
     double per_thread_bytes = 0;   ///< ray streams of one worker (stream engine) or its stack
     int threads = 1;
     double total_bytes = 0;        ///< framebuffer + output + threads * per_thread
-    int branching = 1;             ///< secondary rays one hit can spawn (1 or 2)
-    double peak_stream_rays = 0;   ///< largest ray generation of one chunk (stream engine)
+    double slice_rays = 0;         ///< stream engine: most rays of a generation traced at once
+    int generations = 0;           ///< stream engine: generations whose rays may be held at once
 };
 
-/// The stream engine keeps at most max(4096, spp) primary rays per chunk and thread; each
-/// bounce can multiply a generation by the number of secondary rays a hit spawns (2 when a
-/// material both reflects and transmits at the scene's degree), up to `depth` times.
+/// The stream engine traces at most slice = max(16384, spp) rays of a generation at once and
+/// the generations deepest first (stream/stages.h, trace_generation): per thread it holds at
+/// most 2 x slice rays per generation a ray can reach (depth + 2 with mirrors or glass, else 1),
+/// plus a few slice-sized buffers; linear in depth, never 2^depth.
 MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, int threads);
 
 /// Physical memory of the machine: sysconf(_SC_PHYS_PAGES) * page size (0 if unknown).

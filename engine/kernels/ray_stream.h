@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "render/render_stats.h"
 #include "simd/lanes.h"
 
 namespace streamrt {
@@ -24,8 +25,6 @@ inline void make_tail_inert(Stream& s) {
         s.t_max[i] = -1.f;
     }
 }
-
-enum class RayKind : std::uint8_t { Primary, Reflected, Refracted };
 
 /// Rays of one generation of one tile chunk.
 struct RayStream {

@@ -1,8 +1,9 @@
-#include "accel/scene_bvh.h"
+#include "scene/scene_bvh.h"
 
 #include <cmath>
 
 #include "mesh/mesh.h"
+#include "shapes/shapes.h"
 
 #include "parallel/parallelism.h"
 
@@ -15,25 +16,28 @@ AccelConfig& accel_config() {
 
 bool object_world_bounds(const Object& o, const Mesh* mesh, double lo[3], double hi[3]) {
     const glm::dmat4x3& m = o.md;
-    switch (o.kind) {
-        case ShapeKind::Plane: return false;
-        case ShapeKind::Sphere:
-            // Exact box of an affine image of the unit sphere: centre +- the row norms of M.
-            for (int a = 0; a < 3; ++a) {
-                const double r = std::sqrt(m[0][a] * m[0][a] + m[1][a] * m[1][a] + m[2][a] * m[2][a]);
-                lo[a] = m[3][a] - r;
-                hi[a] = m[3][a] + r;
-            }
-            return true;
-        default: break;
-    }
-    // The canonical box through Md: centre +- |M| half-extent (the box of the 8 corners).
-    double c[3] = {0, 0, 0}, e[3] = {1, 1, 1};
-    if (o.kind == ShapeKind::Torus) e[0] = e[2] = 1 + o.param, e[1] = o.param;
+    // The canonical box: the shape's own bounds (shapes/shapes.h), or the mesh's.
+    double c[3], e[3];
     if (o.kind == ShapeKind::Mesh) {
         if (!mesh || mesh->triangle_count() == 0) return false;
         for (int a = 0; a < 3; ++a) c[a] = 0.5 * (mesh->lo[a] + mesh->hi[a]), e[a] = 0.5 * (mesh->hi[a] - mesh->lo[a]);
+    } else {
+        const CanonicalBounds b = canonical_bounds(o.kind, o.param);
+        switch (b.form) {
+            case CanonicalBounds::Form::Unbounded: return false;
+            case CanonicalBounds::Form::UnitBall:
+                // Exact box of an affine image of the unit ball: centre +- the row norms of M.
+                for (int a = 0; a < 3; ++a) {
+                    const double r = std::sqrt(m[0][a] * m[0][a] + m[1][a] * m[1][a] + m[2][a] * m[2][a]);
+                    lo[a] = m[3][a] - r;
+                    hi[a] = m[3][a] + r;
+                }
+                return true;
+            case CanonicalBounds::Form::Box: break;
+        }
+        for (int a = 0; a < 3; ++a) c[a] = 0.5 * (b.lo[a] + b.hi[a]), e[a] = 0.5 * (b.hi[a] - b.lo[a]);
     }
+    // The canonical box through Md: centre +- |M| half-extent (the box of the 8 corners).
     for (int a = 0; a < 3; ++a) {
         double mid = m[3][a], ext = 0;
         for (int k = 0; k < 3; ++k) {
@@ -69,7 +73,8 @@ std::unique_ptr<SceneBvh> SceneBvh::build_for(const Scene& scene, const AccelCon
     if (config.mode == AccelMode::Flat) return nullptr;
     if (config.mode == AccelMode::Auto) {
         std::size_t bounded = 0;
-        for (const Object& o : scene.objects) bounded += o.kind != ShapeKind::Plane;
+        for (const Object& o : scene.objects)
+            bounded += o.kind == ShapeKind::Mesh || canonical_bounds(o.kind, o.param).bounded();
         if (bounded < config.min_objects) return nullptr;
     }
     return build(scene, config.build, shift);

@@ -1,6 +1,9 @@
 #pragma once
 // One entry point for both engines, used by the command line, the tests and perf/.
+#include <cstddef>
+#include <functional>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "image/framebuffer.h"
@@ -27,6 +30,7 @@ struct EngineOptions {
     Isa isa = best_isa();               ///< stream engine: kernel level
     StreamProfile* profile = nullptr;   ///< stream engine: per-stage figures, when wanted
     ShadeMode shade = ShadeMode::Auto;  ///< stream engine: how the shade stage groups hits
+    std::size_t slice_rays = 0;         ///< stream engine: most rays traced at once (0: default; tests)
 };
 
 /// An engine with its set-up done (tables, hierarchy), ready to render.
@@ -37,14 +41,42 @@ class PreparedRender {
     /// False when the engine rendering no longer reads the scene's objects (the stream engine
     /// renders from its own tables): the caller may then release them before rendering.
     virtual bool reads_scene_objects() const = 0;
+    /// Renders one tile into `rgb` (tile.width() x tile.height() x 3 floats, row by row): the
+    /// values render() gives those pixels, on any thread, in any process. Thread-safe.
+    virtual void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) = 0;
+    /// After render_tile calls: completes the profile's description (stream engine).
+    virtual void finish_tiles(double /*wall_seconds*/, int /*threads*/) {}
     double setup_seconds = 0;
+    int width = 0, height = 0;  ///< the image's size (the scene's settings)
 };
+
+/// One finished tile: its number (tile_rect), rectangle, pixels, rays and render time.
+struct TileOutput {
+    int index = 0;
+    Tile tile{};
+    const float* rgb = nullptr;  ///< tile.width() x tile.height() x 3 floats, row by row
+    RayCounts counts;
+    double seconds = 0;
+};
+/// Receives finished tiles, from the worker threads (possibly several at once).
+using TileSink = std::function<void(const TileOutput&)>;
+/// Hands out tile numbers to render (thread-safe); a negative number: no more.
+using TileSource = std::function<int()>;
 
 /// The set-up of an engine for `scene`, which must outlive it.
 std::unique_ptr<PreparedRender> prepare_render(const Scene& scene, EngineKind engine, const EngineOptions& options = {});
 
 /// Set-up then rendering, the two timed apart.
 RenderResult render_prepared(PreparedRender& prepared, Parallelism& par, RenderProgress* progress = nullptr);
+
+/// Renders the tiles `source` hands out, on par's threads, each given to `sink` once done;
+/// progress (optional) counts them and its cancel flag stops early. Whatever splits the
+/// tiles (threads, processes, shards), a tile's pixels are the same.
+void render_tiles(PreparedRender& prepared, Parallelism& par, const TileSource& source, const TileSink& sink,
+                  RenderProgress* progress = nullptr);
+/// The same for a list of tile numbers, taken in order.
+void render_tiles(PreparedRender& prepared, Parallelism& par, std::span<const int> tiles, const TileSink& sink,
+                  RenderProgress* progress = nullptr);
 
 RenderResult render_scene(const Scene& scene, EngineKind engine, Parallelism& par,
                           RenderProgress* progress = nullptr, const EngineOptions& options = {});

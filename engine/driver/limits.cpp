@@ -1,4 +1,4 @@
-#include "render/limits.h"
+#include "driver/limits.h"
 
 #include <unistd.h>
 
@@ -8,16 +8,18 @@
 
 #include "core/error.h"
 #include "image/image_io.h"
+#include "stream/stream_renderer.h"
 
 namespace streamrt {
 
 namespace {
-constexpr double kChunkRays = 4096;  // StreamRenderer::kMaxChunkRays
-// Bytes per ray slot: RayStream 10 floats + pixel int32 + kind byte; closest-hit object
-// int32; ShadowStream 10 floats + pixel int32.
-constexpr double kRayBytes = 10 * 4 + 4 + 1;
-constexpr double kObjectBytes = 4;
+// Bytes per ray slot: RayStream 11 floats + pixel int32 + kind byte; ShadowStream 10 floats +
+// pixel int32; per traced ray: closest-hit object int32 and mesh hit (int32 + 2 floats), sized
+// as the slice's buffer (2 x slice); per hit: the sorted copy (16 floats + 3 int32).
+constexpr double kRayBytes = 11 * 4 + 4 + 1;
 constexpr double kShadowBytes = 10 * 4 + 4;
+constexpr double kHitBytes = 4 + 12;
+constexpr double kSortedBytes = 16 * 4 + 3 * 4;
 constexpr double kRecursiveFrameBytes = 2048;  // one recursion level of the baseline, generous
 }  // namespace
 
@@ -29,23 +31,18 @@ MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, in
     e.framebuffer_bytes = pixels * 3 * sizeof(float);
     // Writing streams bands into the file: a few bands' buffers, never a copy of the image.
     e.output_bytes = image_write_buffer_bytes(s.width, s.height);
-    bool reflect = false, both = false;
-    for (const Material& m : scene.materials) {
-        const bool r = s.degree >= 3 && m.refl > 0;
-        const bool t = s.degree >= 4 && m.trans > 0;
-        reflect = reflect || r || t;
-        both = both || (r && t);
-    }
-    e.branching = both ? 2 : 1;
+    bool spawns = false;
+    for (const Material& m : scene.materials) spawns = spawns || (s.degree >= 3 && m.refl > 0) || (s.degree >= 4 && m.trans > 0);
     if (stream_engine) {
-        const double primary = std::max(kChunkRays, double(s.spp));
-        const double depth = reflect ? double(s.depth) : 0.0;
-        const double peak = primary * std::pow(double(e.branching), depth);
-        e.peak_stream_rays = peak;
+        const double slice = double(StreamRenderer::default_slice_rays(s.spp));
+        e.slice_rays = slice;
+        // Levels ws.pending (depth + 2 with spawns), plus the slice traced, its spawns and the
+        // regrouping buffer: each at most 2 x slice rays.
+        e.generations = spawns ? s.depth + 2 : 1;
+        const double streams = (double(e.generations) + 3) * 2 * slice * kRayBytes;
         const double lights = s.degree >= 5 ? double(scene.lights.size()) : 0.0;
-        // current generation, the next one (reserved at twice the current), hit objects,
-        // shadow rays (one per light and ray).
-        e.per_thread_bytes = peak * kRayBytes + 2 * peak * kRayBytes + peak * kObjectBytes + peak * lights * kShadowBytes;
+        // The shadow rays of a slice, twice (regrouped by pixel after gathered shading).
+        e.per_thread_bytes = streams + 2 * slice * kHitBytes + slice * kSortedBytes + 2 * slice * lights * kShadowBytes;
     } else {
         e.per_thread_bytes = (double(s.depth) + 2) * kRecursiveFrameBytes;
     }
@@ -86,8 +83,6 @@ void check_render_memory(const Scene& scene, bool stream_engine, int threads, do
                       ", output " + format_bytes(e.output_bytes) + ", " + std::to_string(e.threads) + " thread" +
                       (e.threads > 1 ? "s" : "") + " x " + format_bytes(e.per_thread_bytes) +
                       (stream_engine ? " of ray streams" : " of stack");
-    if (stream_engine && e.branching > 1)
-        msg += ", up to 2^" + std::to_string(s.depth) + " secondary rays per primary ray";
     msg += ") but this machine has " + format_bytes(limit_bytes) +
            "; lower --width/--height, --spp, --depth or -j";
     throw UsageError(msg);

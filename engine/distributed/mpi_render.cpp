@@ -1,0 +1,313 @@
+#include "distributed/mpi_render.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <thread>
+
+#include "core/error.h"
+#include "distributed/tile_file.h"
+
+#if STREAMRT_HAVE_MPI
+#include <mpi.h>
+#endif
+
+namespace streamrt {
+
+const char* mpi_launcher_variable() {
+    // Open MPI (OMPI_COMM_WORLD_SIZE), MPICH/Hydra and Slurm's PMI-2 (PMI_SIZE): a size
+    // above 1 means several copies of this program run now. PMIx (srun --mpi=pmix) names
+    // the rank only.
+    for (const char* size : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+        if (const char* v = std::getenv(size); v && std::atoi(v) > 1) return size;
+    if (std::getenv("PMIX_RANK") && !std::getenv("OMPI_COMM_WORLD_SIZE") && !std::getenv("PMI_SIZE"))
+        return "PMIX_RANK";
+    return nullptr;
+}
+
+std::string rank_stats_text(const std::vector<RankStats>& stats) {
+    std::string out = "rank  tiles   busy s   idle s   bytes sent\n";
+    char line[160];
+    for (const RankStats& s : stats) {
+        std::snprintf(line, sizeof line, "%4d %6llu %8.3f %8.3f %12llu\n", s.rank,
+                      static_cast<unsigned long long>(s.tiles), s.busy_seconds, s.idle_seconds,
+                      static_cast<unsigned long long>(s.bytes_sent));
+        out += line;
+    }
+    return out;
+}
+
+#if !STREAMRT_HAVE_MPI
+
+bool mpi_available() { return false; }
+MpiSession::MpiSession(int&, char**&) { throw UsageError("--mpi: this streamrt was built without MPI (cmake -DSTREAMRT_MPI=ON)"); }
+MpiSession::~MpiSession() = default;
+int MpiSession::broadcast_status(int status) const { return status; }
+void MpiSession::broadcast_bundle(SceneBundle&) const {}
+int MpiSession::min_over_ranks(int value) const { return value; }
+void MpiSession::abort(int code) const { std::exit(code); }
+std::vector<RankStats> mpi_render_tiles(const MpiSession&, PreparedRender&, Parallelism&, std::span<const int>,
+                                        MpiSchedule, const TileSink&, RenderProgress&, StreamProfile*) {
+    throw UsageError("--mpi: this streamrt was built without MPI");
+}
+
+#else
+
+bool mpi_available() { return true; }
+
+namespace {
+
+constexpr int kTagResult = 1;  // worker -> rank 0: int32 jobs, then finished tile records
+constexpr int kTagAssign = 2;  // rank 0 -> worker: int32 tile numbers; none: no more work
+constexpr int kTagFinal = 3;   // worker -> rank 0: its figures (FinalMessage)
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+struct FinalMessage {
+    RankStats stats;
+    std::array<StageFigures, kStageCount> stages;
+    RayCounts counts;
+};
+
+/// Waits for a request without spinning a core away from the render threads.
+void wait_quietly(MPI_Request& request, MPI_Status* status = MPI_STATUS_IGNORE) {
+    for (int done = 0;;) {
+        MPI_Test(&request, &done, status);
+        if (done) return;
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+}
+
+/// Receives a message of unknown length from `source` with `tag`.
+template <class T>
+std::vector<T> receive(int source, int tag, MPI_Status* status_out = nullptr) {
+    MPI_Status status;
+    for (int flag = 0; !flag;) {
+        MPI_Iprobe(source, tag, MPI_COMM_WORLD, &flag, &status);
+        if (!flag) std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+    int bytes = 0;
+    MPI_Get_count(&status, MPI_BYTE, &bytes);
+    std::vector<T> data(std::size_t(bytes) / sizeof(T));
+    MPI_Recv(data.data(), bytes, MPI_BYTE, status.MPI_SOURCE, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    if (status_out) *status_out = status;
+    return data;
+}
+
+void send_bytes(const void* data, std::size_t bytes, int dest, int tag, std::uint64_t& sent) {
+    MPI_Request request;
+    MPI_Isend(data, int(bytes), MPI_BYTE, dest, tag, MPI_COMM_WORLD, &request);
+    wait_quietly(request);
+    sent += bytes;
+}
+
+/// Rank 0's hand-out of tiles from one list in a fixed order: dynamic (the next tiles of
+/// the list, to whoever asks) or static (rank r gets list positions r, r + N, ...).
+class TileQueue {
+  public:
+    TileQueue(std::span<const int> tiles, int ranks, MpiSchedule schedule)
+        : tiles_(tiles), ranks_(ranks), schedule_(schedule), next_(std::size_t(ranks)) {
+        for (int r = 0; r < ranks; ++r) next_[std::size_t(r)] = std::size_t(r);
+    }
+    /// Up to n tiles for `rank` (none: no more).
+    std::vector<std::int32_t> take(int rank, std::size_t n) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        std::vector<std::int32_t> out;
+        if (schedule_ == MpiSchedule::Dynamic) {
+            while (out.size() < n && cursor_ < tiles_.size()) out.push_back(tiles_[cursor_++]);
+        } else {
+            std::size_t& p = next_[std::size_t(rank)];
+            for (; out.size() < n && p < tiles_.size(); p += std::size_t(ranks_)) out.push_back(tiles_[p]);
+        }
+        return out;
+    }
+    /// The size of a worker's next chunk: large while much is left (fewer messages), down to
+    /// one tile per thread at the end (ranks finish together).
+    std::size_t chunk(int jobs) const {
+        std::lock_guard<std::mutex> lock(mutex_);
+        const std::size_t left = tiles_.size() - std::min(cursor_, tiles_.size());
+        const std::size_t j = std::size_t(std::max(1, jobs));
+        if (schedule_ == MpiSchedule::Static) return 4 * j;
+        return std::clamp(left / (2 * std::size_t(ranks_)), j, 8 * j);
+    }
+
+  private:
+    std::span<const int> tiles_;
+    int ranks_;
+    MpiSchedule schedule_;
+    std::size_t cursor_ = 0;
+    std::vector<std::size_t> next_;
+    mutable std::mutex mutex_;
+};
+
+std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& prepared, Parallelism& par,
+                                       std::span<const int> tiles, MpiSchedule schedule, const TileSink& sink,
+                                       RenderProgress& progress, StreamProfile* profile) {
+    const auto start = Clock::now();
+    TileQueue queue(tiles, mpi.size(), schedule);
+    std::vector<RankStats> stats(std::size_t(mpi.size()));
+    for (int r = 0; r < mpi.size(); ++r) stats[std::size_t(r)].rank = r;
+    RankStats& mine = stats[0];
+    // Rank 0's threads take one tile at a time from the same queue, on a thread of their
+    // own: the main thread stays free for MPI (MPI_THREAD_FUNNELED).
+    std::atomic<bool> local_done{false};
+    std::thread local([&] {
+        const auto t0 = Clock::now();
+        std::atomic<std::uint64_t> count{0};
+        render_tiles(
+            prepared, par,
+            [&] {
+                const auto t = queue.take(0, 1);
+                return t.empty() ? -1 : t[0];
+            },
+            [&](const TileOutput& t) {
+                sink(t);
+                ++count;
+            },
+            &progress);
+        mine.busy_seconds = since(t0);
+        mine.tiles = count.load();
+        local_done = true;
+    });
+    int working = mpi.size() - 1;
+    std::vector<char> buffer;
+    while (working > 0) {
+        MPI_Status status;
+        int flag = 0;
+        MPI_Iprobe(MPI_ANY_SOURCE, kTagResult, MPI_COMM_WORLD, &flag, &status);
+        if (!flag) {
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
+            continue;
+        }
+        const std::vector<char> msg = receive<char>(status.MPI_SOURCE, kTagResult);
+        const int from = status.MPI_SOURCE;
+        std::int32_t jobs = 1;
+        std::memcpy(&jobs, msg.data(), sizeof jobs);
+        // A rank that was interrupted (its own Ctrl-C or SIGTERM) stops the whole job.
+        if (jobs <= 0 && progress.cancel) progress.cancel->store(true);
+        const std::string_view records(msg.data() + sizeof jobs, msg.size() - sizeof jobs);
+        RankStats& theirs = stats[std::size_t(from)];
+        read_tile_records(records, prepared.width, prepared.height, [&](const TileOutput& t) {
+            sink(t);
+            progress.add(t.counts);
+            ++theirs.tiles;
+        });
+        // Once interrupted, every rank is told "no more" and the job winds down together.
+        const std::vector<std::int32_t> chunk =
+            progress.cancelled() ? std::vector<std::int32_t>() : queue.take(from, queue.chunk(jobs));
+        send_bytes(chunk.data(), chunk.size() * sizeof(std::int32_t), from, kTagAssign, mine.bytes_sent);
+        if (chunk.empty()) --working;
+    }
+    local.join();
+    for (int r = 1; r < mpi.size(); ++r) {
+        const std::vector<FinalMessage> f = receive<FinalMessage>(r, kTagFinal);
+        const std::uint64_t tiles_seen = stats[std::size_t(r)].tiles;
+        stats[std::size_t(r)] = f.at(0).stats;
+        stats[std::size_t(r)].tiles = tiles_seen;
+        if (profile) {
+            for (int s = 0; s < kStageCount; ++s) profile->stages[std::size_t(s)] += f[0].stages[std::size_t(s)];
+            profile->counts += f[0].counts;
+        }
+    }
+    mine.idle_seconds = std::max(0.0, since(start) - mine.busy_seconds);
+    if (profile) profile->wall_seconds = since(start);
+    return stats;
+}
+
+void render_as_worker(const MpiSession& mpi, PreparedRender& prepared, Parallelism& par, RenderProgress& progress,
+                      StreamProfile* profile) {
+    const auto start = Clock::now();
+    FinalMessage final{};
+    final.stats.rank = mpi.rank();
+    std::string msg;
+    const std::int32_t jobs = par.jobs();
+    std::mutex mutex;
+    for (;;) {
+        const std::int32_t asking = progress.cancelled() ? 0 : jobs;  // 0: interrupted
+        msg.insert(0, reinterpret_cast<const char*>(&asking), sizeof asking);
+        send_bytes(msg.data(), msg.size(), 0, kTagResult, final.stats.bytes_sent);
+        msg.clear();
+        const std::vector<std::int32_t> chunk = receive<std::int32_t>(0, kTagAssign);
+        if (chunk.empty()) break;
+        const auto t0 = Clock::now();
+        const std::vector<int> list(chunk.begin(), chunk.end());
+        render_tiles(prepared, par, std::span<const int>(list),
+                     [&](const TileOutput& t) {
+                         std::lock_guard<std::mutex> lock(mutex);
+                         append_tile_record(msg, t);
+                     },
+                     &progress);
+        final.stats.busy_seconds += since(t0);
+    }
+    final.stats.idle_seconds = std::max(0.0, since(start) - final.stats.busy_seconds);
+    final.stats.tiles = std::uint64_t(progress.tiles_done.load());
+    if (profile) {
+        final.stages = profile->stages;
+        final.counts = profile->counts;
+    }
+    std::uint64_t ignored = 0;
+    send_bytes(&final, sizeof final, 0, kTagFinal, ignored);
+}
+
+}  // namespace
+
+MpiSession::MpiSession(int& argc, char**& argv) {
+    int provided = 0;
+    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    if (provided < MPI_THREAD_FUNNELED) {
+        if (rank_ == 0) std::fprintf(stderr, "streamrt: --mpi: the MPI library does not provide MPI_THREAD_FUNNELED\n");
+        abort(2);
+    }
+}
+
+MpiSession::~MpiSession() { MPI_Finalize(); }
+
+int MpiSession::broadcast_status(int status) const {
+    MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    return status;
+}
+
+void MpiSession::broadcast_bundle(SceneBundle& bundle) const {
+    std::string bytes = rank_ == 0 ? bundle.serialize() : std::string();
+    std::uint64_t size = bytes.size();
+    MPI_Bcast(&size, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+    bytes.resize(size);
+    // In pieces below 2 GiB (MPI counts are int).
+    constexpr std::uint64_t kPiece = 1u << 30;
+    for (std::uint64_t off = 0; off < size; off += kPiece)
+        MPI_Bcast(bytes.data() + off, int(std::min(kPiece, size - off)), MPI_BYTE, 0, MPI_COMM_WORLD);
+    if (rank_ != 0) bundle = SceneBundle::deserialize(bytes);
+}
+
+int MpiSession::min_over_ranks(int value) const {
+    int out = value;
+    MPI_Allreduce(&value, &out, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    return out;
+}
+
+void MpiSession::abort(int code) const {
+    std::fflush(stdout);
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, code);
+    std::_Exit(code);
+}
+
+std::vector<RankStats> mpi_render_tiles(const MpiSession& mpi, PreparedRender& prepared, Parallelism& par,
+                                        std::span<const int> tiles, MpiSchedule schedule, const TileSink& sink,
+                                        RenderProgress& progress, StreamProfile* profile) {
+    if (mpi.rank() == 0) return render_as_rank0(mpi, prepared, par, tiles, schedule, sink, progress, profile);
+    render_as_worker(mpi, prepared, par, progress, profile);
+    return {};
+}
+
+#endif  // STREAMRT_HAVE_MPI
+
+}  // namespace streamrt

@@ -1,0 +1,135 @@
+#include "driver/render.h"
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+
+#include "baseline/recursive_renderer.h"
+#include "stream/stream_renderer.h"
+
+namespace streamrt {
+
+const char* engine_name(EngineKind e) { return e == EngineKind::Stream ? "stream" : "recursive"; }
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+class PreparedRecursive final : public PreparedRender {
+  public:
+    explicit PreparedRecursive(const Scene& scene) : renderer_(scene) {}
+    Framebuffer render(Parallelism& par, RenderProgress* progress) override { return renderer_.render(par, progress); }
+    bool reads_scene_objects() const override { return true; }
+    void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
+        for (int y = tile.y0; y < tile.y1; ++y)
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                if (cancel && cancel->cancelled()) return;
+                const ColorT<double> c = renderer_.render_pixel(x, y, counts);
+                float* px = rgb + (std::size_t(y - tile.y0) * std::size_t(tile.width()) + std::size_t(x - tile.x0)) * 3;
+                px[0] = float(c.x);
+                px[1] = float(c.y);
+                px[2] = float(c.z);
+            }
+    }
+
+  private:
+    RecursiveRenderer renderer_;
+};
+
+class PreparedStream final : public PreparedRender {
+  public:
+    PreparedStream(const Scene& scene, const EngineOptions& options)
+        : renderer_(scene, options.isa, options.shade, options.slice_rays), profile_(options.profile) {}
+    Framebuffer render(Parallelism& par, RenderProgress* progress) override {
+        return renderer_.render(par, progress, profile_);
+    }
+    bool reads_scene_objects() const override { return false; }
+    void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
+        if (!profile_) return renderer_.render_one_tile(tile, rgb, counts, nullptr, cancel);
+        StreamProfile local;
+        RayCounts c;
+        renderer_.render_one_tile(tile, rgb, c, &local, cancel);
+        counts += c;
+        std::lock_guard<std::mutex> lock(mutex_);
+        *profile_ += local;
+        profile_->counts += c;
+    }
+    void finish_tiles(double wall_seconds, int threads) override {
+        if (profile_) renderer_.describe(*profile_, wall_seconds, threads);
+    }
+
+  private:
+    StreamRenderer renderer_;
+    StreamProfile* profile_;
+    std::mutex mutex_;
+};
+
+}  // namespace
+
+std::unique_ptr<PreparedRender> prepare_render(const Scene& scene, EngineKind engine, const EngineOptions& options) {
+    // Set-up (the engine's tables, the object hierarchy) and rendering are timed apart, so
+    // that rays/s speaks of the rendering alone.
+    const auto start = Clock::now();
+    std::unique_ptr<PreparedRender> p;
+    if (engine == EngineKind::Recursive) p = std::make_unique<PreparedRecursive>(scene);
+    else p = std::make_unique<PreparedStream>(scene, options);
+    p->setup_seconds = seconds_since(start);
+    p->width = scene.settings.width;
+    p->height = scene.settings.height;
+    return p;
+}
+
+void render_tiles(PreparedRender& prepared, Parallelism& par, const TileSource& source, const TileSink& sink,
+                  RenderProgress* progress) {
+    const auto start = Clock::now();
+    // One task per thread, each pulling tiles until the source runs dry: the source decides
+    // the order (a list, or a queue shared with other processes).
+    par.for_each_index(std::size_t(par.jobs()), 1, [&](std::size_t) {
+        float rgb[kTileSize * kTileSize * 3];
+        for (int index = source(); index >= 0; index = source()) {
+            if (progress && progress->cancelled()) return;
+            TileOutput out;
+            out.index = index;
+            out.tile = tile_rect(prepared.width, prepared.height, index);
+            out.rgb = rgb;
+            const auto t0 = Clock::now();
+            prepared.render_tile(out.tile, rgb, out.counts, progress);
+            out.seconds = seconds_since(t0);
+            if (progress && progress->cancelled()) return;
+            sink(out);
+            if (progress) progress->add(out.counts);
+        }
+    });
+    prepared.finish_tiles(seconds_since(start), par.jobs());
+}
+
+void render_tiles(PreparedRender& prepared, Parallelism& par, std::span<const int> tiles, const TileSink& sink,
+                  RenderProgress* progress) {
+    std::atomic<std::size_t> next{0};
+    const auto source = [&] {
+        const std::size_t i = next.fetch_add(1);
+        return i < tiles.size() ? tiles[i] : -1;
+    };
+    render_tiles(prepared, par, source, sink, progress);
+}
+
+RenderResult render_prepared(PreparedRender& prepared, Parallelism& par, RenderProgress* progress) {
+    RenderProgress local;
+    RenderProgress& p = progress ? *progress : local;
+    RenderResult r;
+    r.setup_seconds = prepared.setup_seconds;
+    const auto start = Clock::now();
+    r.image = prepared.render(par, &p);
+    r.seconds = seconds_since(start);
+    r.counts = p.counts();
+    return r;
+}
+
+RenderResult render_scene(const Scene& scene, EngineKind engine, Parallelism& par, RenderProgress* progress,
+                          const EngineOptions& options) {
+    const auto prepared = prepare_render(scene, engine, options);
+    return render_prepared(*prepared, par, progress);
+}
+
+}  // namespace streamrt

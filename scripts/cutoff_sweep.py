@@ -1,0 +1,55 @@
+#!/usr/bin/python3
+"""The weight cut-off's effect on time and error (docs/performance.md, "Weight cut-off").
+
+usage: /usr/bin/python3 scripts/cutoff_sweep.py [--scene scenes/whitted.cfg] [--depth 16]
+           [--cutoffs 0,0.001,0.01,0.05,0.1,0.2] [--runs 5] [--jobs 2] [--build build]
+
+Renders the scene with each cut-off (image cutoff=, --cutoff) with both engines, and reports
+each picture's error against the same engine's exact picture (cut-off 0), the render time
+(streamrt's render clock, median of --runs) and the secondary rays traced.
+"""
+import argparse
+import os
+import sys
+import tempfile
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import perf_common as pc  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scene", default=os.path.join(pc.ROOT, "scenes", "whitted.cfg"))
+    ap.add_argument("--depth", type=int, default=16)
+    ap.add_argument("--width", type=int, default=1280)
+    ap.add_argument("--height", type=int, default=720)
+    ap.add_argument("--spp", type=int, default=4)
+    ap.add_argument("--cutoffs", default="0,0.001,0.01,0.05,0.1,0.2")
+    ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"))
+    a = ap.parse_args()
+    exe = pc.binary(a.build)
+    cutoffs = [float(c) for c in a.cutoffs.split(",")]
+    print(f"{os.path.relpath(a.scene, pc.ROOT)} {a.width}x{a.height} spp {a.spp} depth {a.depth} -j{a.jobs}, "
+          f"median of {a.runs}")
+    print("| engine | cut-off | render s | rays | PSNR vs exact (dB) | RMSE |")
+    print("|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for engine in ("stream", "recursive"):
+            exact = os.path.join(tmp, f"{engine}_exact.pfm")
+            for c in cutoffs:
+                out = exact if c == 0 else os.path.join(tmp, f"{engine}_{c}.pfm")
+                runs = [pc.run_streamrt(exe, a.scene, out, engine=engine, jobs=a.jobs, spp=a.spp, width=a.width,
+                                        height=a.height, depth=a.depth, extra=("--cutoff", str(c)))
+                        for _ in range(a.runs if engine == "stream" else 1)]
+                seconds = pc.median([r["seconds"] for r in runs])
+                err = pc.image_error(out, exact)
+                psnr = "exact" if c == 0 else f"{err['psnr']:.1f}"
+                print(f"| {engine} | {c:g} | {seconds:.3f} | {runs[0]['rays']} | {psnr} | {err['rmse']:.2e} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,325 @@
+#!/usr/bin/env python3
+"""streamrt across processes, end to end (docs/distributed.md): every picture compared byte
+for byte (PFM) with the single-process render of the same settings.
+
+    check_distributed.py --streamrt BIN [--mpirun MPIRUN] GROUP
+
+GROUP: usage | shard | checkpoint | mpi-usage | mpi-scenes | mpi-ranks | mpi-faults
+Exits 1 with one line per failure; 0 when everything holds.
+"""
+import argparse
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SCENES = ROOT / "scenes"
+SIZE = ["--width", "64", "--height", "48"]
+SMALL = SIZE + ["--spp", "2", "-q"]
+failures = []
+
+
+def check(ok, what):
+    if not ok:
+        failures.append(what)
+        print("FAIL:", what, flush=True)
+
+
+def run(cmd, env=None, timeout=60):
+    e = dict(os.environ)
+    # The tests run as root in CI containers; Open MPI refuses that unless told.
+    e.update({"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"})
+    for k in list(e):
+        if k.startswith(("OMPI_COMM_WORLD", "PMI_", "PMIX_")) and not (env and k in env):
+            del e[k]
+    if env:
+        e.update(env)
+    return subprocess.run([str(c) for c in cmd], capture_output=True, text=True, env=e, timeout=timeout)
+
+
+def is_mpich(args):
+    r = subprocess.run([str(args.mpirun), "--version"], capture_output=True, text=True)
+    return "HYDRA" in r.stdout or "MPICH" in r.stdout
+
+
+def mpirun(args, n):
+    if args.mpich:  # MPICH's Hydra: shared memory on one host, no options needed
+        return [args.mpirun, "-np", str(n), args.streamrt]
+    # Open MPI: loopback TCP only, so it works in a bare container; more ranks than cores.
+    return [args.mpirun, "--oversubscribe", "-np", str(n), "--mca", "btl", "self,tcp",
+            "--mca", "btl_tcp_if_include", "lo", "--mca", "oob_tcp_if_include", "lo", args.streamrt]
+
+
+def rank_pids(pid):
+    """The streamrt processes below a launcher (Open MPI: children; MPICH: grandchildren)."""
+    found, todo = [], [str(pid)]
+    while todo:
+        children = subprocess.run(["pgrep", "-P", todo.pop()], capture_output=True, text=True).stdout.split()
+        for c in children:
+            try:
+                comm = pathlib.Path(f"/proc/{c}/comm").read_text().strip()
+            except OSError:
+                continue
+            (found if comm == "streamrt" else todo).append(c)
+    return sorted(found, key=int)
+
+
+def one_line(r):
+    return len(r.stderr.strip().splitlines()) == 1
+
+
+def one_streamrt_line(r):
+    """Under mpirun: one line from streamrt (mpirun adds its own notice between dashes)."""
+    return len([line for line in r.stderr.splitlines() if line.startswith("streamrt")]) == 1
+
+
+def scenes():
+    """Every scene of scenes/ (top level, meshes/ and one of degrees/: includes and meshes)."""
+    return sorted(SCENES.glob("*.cfg")) + [SCENES / "meshes" / "mesh.cfg", SCENES / "degrees" / "degree5.cfg"]
+
+
+def reference(args, scene, out, extra=(), size=SIZE, spp="2"):
+    r = run([args.streamrt, "-j2", scene, "-o", out, *size, "--spp", spp, "-q", *extra])
+    check(r.returncode == 0, f"{scene.name}: single-process render failed: {r.stderr.strip()}")
+    return out.read_bytes() if out.exists() else b""
+
+
+def group_usage(args, tmp):
+    scene = SCENES / "whitted.cfg"
+    for bad in (["--shard", "3/2"], ["--shard", "0/0"], ["--shard", "x"], ["--shard", "-1/2"],
+                ["--resume"], ["--mpi"]):
+        r = run([args.streamrt, scene, "-o", tmp / "u.pfm", *SMALL, *bad])
+        check(r.returncode == 2 and one_line(r), f"{' '.join(bad)}: want exit 2 and one line, got "
+              f"{r.returncode}: {r.stderr.strip()!r}")
+        check(not (tmp / "u.pfm").exists(), f"{' '.join(bad)}: wrote an image")
+    # As if started by mpirun with 2 ranks, without --mpi.
+    for var in ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE"):
+        r = run([args.streamrt, scene, "-o", tmp / "u.pfm", *SMALL], env={var: "2"})
+        check(r.returncode == 2 and one_line(r) and "--mpi" in r.stderr,
+              f"{var}=2 without --mpi: want exit 2, one line, got {r.returncode}: {r.stderr.strip()!r}")
+    r = run([args.streamrt, "merge", "-o", tmp / "m.pfm", tmp / "none.part"])
+    check(r.returncode == 2 and one_line(r), f"merge of a missing file: got {r.returncode}: {r.stderr.strip()!r}")
+
+
+def group_shard(args, tmp):
+    for scene in [SCENES / "whitted.cfg", SCENES / "meshes" / "mesh.cfg"]:
+        want = reference(args, scene, tmp / "ref.pfm")
+        parts = []
+        for k in range(3):
+            part = tmp / f"part_{k}.pfm"
+            r = run([args.streamrt, "-j1", scene, "-o", part, *SMALL, "--shard", f"{k}/3"])
+            check(r.returncode == 0, f"{scene.name}: --shard {k}/3 failed: {r.stderr.strip()}")
+            parts.append(part)
+        r = run([args.streamrt, "merge", *reversed(parts), "-o", tmp / "merged.pfm"])
+        check(r.returncode == 0, f"{scene.name}: merge failed: {r.stderr.strip()}")
+        check((tmp / "merged.pfm").exists() and (tmp / "merged.pfm").read_bytes() == want,
+              f"{scene.name}: merged shards differ from the single-process render")
+        # A missing part, a repeated part.
+        r = run([args.streamrt, "merge", parts[0], parts[2], "-o", tmp / "m2.pfm"])
+        check(r.returncode == 2 and one_line(r) and "missing part" in r.stderr,
+              f"{scene.name}: merge with a part missing: {r.returncode}: {r.stderr.strip()!r}")
+        r = run([args.streamrt, "merge", parts[0], parts[0], parts[1], "-o", tmp / "m2.pfm"])
+        check(r.returncode == 2 and one_line(r), f"{scene.name}: merge with a part twice: {r.stderr.strip()!r}")
+        check(not (tmp / "m2.pfm").exists(), f"{scene.name}: a refused merge wrote an image")
+    # A part of another render (other spp) does not belong.
+    foreign = tmp / "foreign.part"
+    r = run([args.streamrt, SCENES / "whitted.cfg", "-o", foreign, "--width", "64", "--height", "48", "--spp", "3",
+             "--shard", "1/3"])
+    check(r.returncode == 0, f"foreign part: {r.stderr.strip()}")
+    r = run([args.streamrt, "merge", tmp / "part_0.pfm", foreign, tmp / "part_2.pfm", "-o", tmp / "m3.pfm"])
+    check(r.returncode == 2 and one_line(r) and "does not belong" in r.stderr,
+          f"merge with a foreign part: {r.returncode}: {r.stderr.strip()!r}")
+    # A damaged (truncated) part.
+    data = (tmp / "part_1.pfm").read_bytes()
+    (tmp / "cut.part").write_bytes(data[: len(data) - 100])
+    r = run([args.streamrt, "merge", tmp / "part_0.pfm", tmp / "cut.part", tmp / "part_2.pfm", "-o", tmp / "m4.pfm"])
+    check(r.returncode == 2 and one_line(r), f"merge with a truncated part: {r.returncode}: {r.stderr.strip()!r}")
+
+
+def group_checkpoint(args, tmp):
+    scene = SCENES / "whitted.cfg"
+    size = ["--width", "640", "--height", "480", "-q"]
+    big = size + ["--spp", "64"]
+    ref = tmp / "ref.pfm"
+    r = run([args.streamrt, "-j2", scene, "-o", ref, *big])
+    check(r.returncode == 0, f"reference render failed: {r.stderr.strip()}")
+    journal, out = tmp / "render.journal", tmp / "out.pfm"
+    # Interrupted (Ctrl-C) part way: exit 130, no image, the journal keeps finished tiles.
+    p = subprocess.Popen([str(args.streamrt), "-j1", str(scene), "-o", str(out), *big, "--checkpoint", str(journal)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(0.6)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=30)
+    if p.returncode == 0:
+        print("note: the render finished before the interrupt; resuming a finished journal instead")
+    else:
+        check(p.returncode == 130, f"interrupted checkpointed render: exit {p.returncode}: {err.strip()!r}")
+        check(not out.exists(), "an interrupted render left an image")
+        check(journal.exists() and journal.stat().st_size > 100, "the journal is missing or empty after Ctrl-C")
+        # Torn last record (as if killed while appending): cut a few bytes off.
+        data = journal.read_bytes()
+        journal.write_bytes(data[: len(data) - 7])
+        # Another scene's or other settings' journal is refused, and left alone.
+        for other in (["--spp", "63"], ["--spp", "64", "--sampler", "grid"]):
+            r = run([args.streamrt, "-j2", scene, "-o", out, *size, *other, "--checkpoint", journal, "--resume"])
+            check(r.returncode == 2 and one_line(r) and "other settings" in r.stderr,
+                  f"mismatched journal ({' '.join(other)}): {r.returncode}: {r.stderr.strip()!r}")
+        r = run([args.streamrt, "-j2", SCENES / "cornell.cfg", "-o", out, *big, "--checkpoint", journal, "--resume"])
+        check(r.returncode == 2 and one_line(r) and "another scene" in r.stderr,
+              f"journal of another scene: {r.returncode}: {r.stderr.strip()!r}")
+        # Without --resume an existing journal is not overwritten.
+        r = run([args.streamrt, "-j2", scene, "-o", out, *big, "--checkpoint", journal])
+        check(r.returncode == 2 and one_line(r), f"existing journal without --resume: {r.stderr.strip()!r}")
+        check(not out.exists(), "a refused resume wrote an image")
+        r = run([args.streamrt, "-j2", scene, "-o", out, *big, "--checkpoint", journal, "--resume"])
+        check(r.returncode == 0, f"resume failed: {r.stderr.strip()}")
+        check(out.exists() and out.read_bytes() == ref.read_bytes(), "the resumed render differs from the uninterrupted one")
+        check(not journal.exists(), "the journal is left after the image was written")
+    # Tile costs: one line per tile, rays and seconds.
+    costs = tmp / "costs.csv"
+    r = run([args.streamrt, "-j2", scene, "-o", tmp / "c.pfm", *SMALL, "--tile-costs", costs])
+    lines = costs.read_text().splitlines() if costs.exists() else []
+    check(r.returncode == 0 and len(lines) == 1 + 4 * 3 and lines[0] == "index,x0,y0,x1,y1,rays,seconds",
+          f"--tile-costs: {len(lines)} lines: {lines[:2]}")
+    check(all(int(line.split(",")[5]) > 0 for line in lines[1:]), "--tile-costs: a tile with no rays")
+
+
+def group_mpi_usage(args, tmp):
+    scene = SCENES / "whitted.cfg"
+    r = run(mpirun(args, 2) + [scene, "-o", tmp / "u.pfm", *SMALL], timeout=60)
+    check(r.returncode == 2 and one_streamrt_line(r) and "--mpi" in r.stderr,
+          f"mpirun without --mpi: want exit 2 and one line, got {r.returncode}: {r.stderr.strip()!r}")
+    check(not (tmp / "u.pfm").exists(), "mpirun without --mpi wrote an image")
+    # A scene error is reported once, by rank 0, in file:line:col form; every rank exits 2.
+    bad = tmp / "bad.cfg"
+    bad.write_text("image width=64 height=48\nsphere radius=oops\n")
+    r = run(mpirun(args, 3) + ["--mpi", bad, "-o", tmp / "u.pfm", "-q"], timeout=60)
+    check(r.returncode == 2 and one_streamrt_line(r) and "bad.cfg:2:" in r.stderr,
+          f"bad scene under MPI: want exit 2, one line, got {r.returncode}: {r.stderr.strip()!r}")
+    r = run(mpirun(args, 2) + ["--mpi", scene, "-o", tmp / "nofolder" / "u.pfm", "-q"], timeout=60)
+    check(r.returncode == 2 and one_streamrt_line(r), f"bad output under MPI: {r.returncode}: {r.stderr.strip()!r}")
+
+
+def compare_mpi(args, tmp, scene, ranks, schedule, want, extra=(), jobs="1", size=SIZE):
+    out = tmp / f"mpi_{ranks}_{schedule}.pfm"
+    r = run(mpirun(args, ranks) + ["--mpi", "--mpi-schedule", schedule, f"-j{jobs}", scene, "-o", out, *size,
+                                   "--spp", "2", "-q", *extra],
+            timeout=60)
+    check(r.returncode == 0, f"{scene.name}: {ranks} ranks ({schedule}) failed: {r.returncode}: {r.stderr.strip()!r}")
+    check(out.exists() and out.read_bytes() == want,
+          f"{scene.name}: {ranks} ranks ({schedule}) differ from the single-process render")
+    if out.exists():
+        out.unlink()
+
+
+def group_mpi_scenes(args, tmp):
+    for i, scene in enumerate(scenes()):
+        want = reference(args, scene, tmp / "ref.pfm")
+        compare_mpi(args, tmp, scene, 2 + i % 3, "dynamic", want)
+        compare_mpi(args, tmp, scene, 4 - i % 3, "static", want)
+
+
+def group_mpi_ranks(args, tmp):
+    scene = SCENES / "whitted.cfg"
+    want = reference(args, scene, tmp / "ref.pfm")
+    for ranks in (1, 2, 3, 4):
+        for schedule in ("dynamic", "static"):
+            compare_mpi(args, tmp, scene, ranks, schedule, want)
+    # The recursive engine, and -j2 in each rank.
+    want = reference(args, scene, tmp / "ref_rec.pfm", ["--engine", "recursive"])
+    compare_mpi(args, tmp, scene, 3, "dynamic", want, ["--engine", "recursive"], jobs="2")
+    # More ranks than tiles: 2 tiles, 5 ranks.
+    tiny = ["--width", "32", "--height", "16"]
+    want = reference(args, scene, tmp / "ref_tiny.pfm", size=tiny)
+    for schedule in ("dynamic", "static"):
+        compare_mpi(args, tmp, scene, 5, schedule, want, size=tiny)
+    # PNG through the atomic writer, and the profile's per-rank table.
+    r = run(mpirun(args, 2) + ["--mpi", scene, "-o", tmp / "p.png", *SMALL[:-1], "--profile"], timeout=60)
+    check(r.returncode == 0 and (tmp / "p.png").exists(), f"png under MPI: {r.stderr.strip()!r}")
+    check("2 ranks (dynamic)" in r.stdout and "isa " in r.stdout, f"summary line: {r.stdout!r}")
+    rows = [line.split() for line in r.stdout.splitlines() if line[:4].strip().isdigit() and len(line.split()) == 5]
+    check(len(rows) == 2 and sum(int(row[1]) for row in rows) == 12, f"per-rank tiles: {rows}")
+
+
+def group_mpi_faults(args, tmp):
+    scene = SCENES / "whitted.cfg"
+    out = tmp / "killed.pfm"
+    cmd = mpirun(args, 3) + ["--mpi", "-j1", scene, "-o", out, "--width", "1280", "--height", "720", "--spp", "128",
+                             "-q"]
+    e = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    p = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=e)
+    # Once the 3 ranks run, give them a second to start rendering, then kill the last one.
+    victims = []
+    for _ in range(100):
+        victims = rank_pids(p.pid)
+        if len(victims) == 3:
+            break
+        time.sleep(0.1)
+    time.sleep(1.0)
+    check(len(victims) == 3, f"expected 3 rank processes under mpirun, found {victims}")
+    if victims:
+        os.kill(int(victims[-1]), signal.SIGKILL)
+    start = time.time()
+    try:
+        stdout, err = p.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        check(False, "the job did not end after a rank was killed")
+        return
+    took = time.time() - start
+    check(p.returncode != 0, f"a killed rank: exit {p.returncode}")
+    check(took < 15, f"a killed rank: the job took {took:.1f} s to end")
+    # The launcher reports it: Open MPI "mpirun noticed that process rank 2 ... exited on
+    # signal 9", MPICH's Hydra "BAD TERMINATION OF ONE OF YOUR APPLICATION PROCESSES / PID".
+    check("process rank" in err or "BAD TERMINATION" in stdout, f"a killed rank: the launcher's message: {err.strip()!r}")
+    check(not out.exists(), "a killed rank: an image was written")
+    leftovers = [f.name for f in tmp.iterdir() if f.name.startswith(".killed")]
+    check(not leftovers, f"a killed rank: temporary files left: {leftovers}")
+
+    # Ctrl-C reaches the ranks (a terminal sends it to the whole foreground group): the job
+    # winds down together, exit 130, no image; the journal is resumed by 3 ranks, same bytes.
+    big = ["--width", "640", "--height", "480", "--spp", "128", "-q"]
+    want = reference(args, scene, tmp / "ref_big.pfm", size=big[:4], spp="128")
+    journal, out = tmp / "mpi.journal", tmp / "interrupted.pfm"
+    cmd = mpirun(args, 2) + ["--mpi", "-j1", scene, "-o", out, *big, "--checkpoint", journal]
+    p = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=e)
+    time.sleep(2.5)
+    for child in rank_pids(p.pid):
+        os.kill(int(child), signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    if p.returncode == 0:
+        print("note: the MPI render finished before the interrupt")
+        return
+    check(p.returncode == 130, f"Ctrl-C under MPI: exit {p.returncode}: {err.strip()!r}")
+    check(len([line for line in err.splitlines() if line.startswith("streamrt")]) == 1,
+          f"Ctrl-C under MPI: want one line from streamrt: {err.strip()!r}")
+    check(not out.exists(), "Ctrl-C under MPI: an image was written")
+    check(journal.exists(), "Ctrl-C under MPI: no journal")
+    r = run(mpirun(args, 3) + ["--mpi", "-j1", scene, "-o", out, *big, "--checkpoint", journal, "--resume"], timeout=90)
+    check(r.returncode == 0, f"MPI resume failed: {r.stderr.strip()!r}")
+    check(out.exists() and out.read_bytes() == want, "the MPI render resumed by 3 ranks differs from the one-process one")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--streamrt", required=True, type=pathlib.Path)
+    ap.add_argument("--mpirun", default="mpirun")
+    ap.add_argument("group")
+    args = ap.parse_args()
+    args.mpich = args.group.startswith("mpi") and is_mpich(args)
+    groups = {"usage": group_usage, "shard": group_shard, "checkpoint": group_checkpoint,
+              "mpi-usage": group_mpi_usage, "mpi-scenes": group_mpi_scenes, "mpi-ranks": group_mpi_ranks,
+              "mpi-faults": group_mpi_faults}
+    start = time.time()
+    with tempfile.TemporaryDirectory(prefix="streamrt_dist_") as d:
+        groups[args.group](args, pathlib.Path(d))
+    print(f"{args.group}: {len(failures)} failure(s), {time.time() - start:.1f} s")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
