@@ -50,7 +50,9 @@ case "$kind" in
     extra=(-DCMAKE_CXX_FLAGS="$flags")
     # Suppressions (each with its reason) live in tests/tsan.supp.
     export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/tsan.supp"
-    filter=()
+    # Two tests cannot pass under TSan, for reasons that are not races: one bounds the peak
+    # RSS (TSan's shadow memory adds ~12 MB), one gives a 640x480 spp 64 render 60 s.
+    filter=(-E "peak memory at depth 16 and 32|distributed_checkpoint")
     ;;
   *) echo "usage: scripts/sanitize.sh asan|tsan|tsan-std [ctest args]" >&2; exit 2 ;;
 esac
