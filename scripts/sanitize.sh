@@ -4,7 +4,8 @@
 #                                               into build-asan/, every test
 #   scripts/sanitize.sh tsan [ctest args]      ThreadSanitizer into build-tsan/, against a
 #                                               oneTBB built with -fsanitize=thread from
-#                                               Debian's source package (below), every test;
+#                                               Debian's source package (below), every test
+#                                               but two that TSan cannot pass (below);
 #                                               the threaded ones alone (quicker):
 #                                               -R "render threads|cli:|bit-identical|BVH"
 #   scripts/sanitize.sh tsan-std [ctest args]  fallback for a machine that cannot fetch the
