@@ -1,12 +1,14 @@
 #pragma once
 // The one owner of threads: every parallel loop goes through here, so -j is honoured.
 // The only header that includes TBB.
-#if defined(__SANITIZE_THREAD__)
-// ThreadSanitizer builds run every loop on plain std::threads: Debian's libtbb is not
-// instrumented, so TSan cannot see its synchronisation and reports its hand-offs as races.
-// With std::thread and std::atomic it sees every edge, and checks what matters here: the
-// render code inside the loop bodies. Same tiles, same results.
-#define STREAMRT_STD_THREADS 1
+// STREAMRT_STD_THREADS=1 (only scripts/sanitize.sh tsan-std sets it) runs every loop on
+// plain std::threads instead: the ThreadSanitizer fallback for a machine that cannot build
+// oneTBB with TSan. ThreadSanitizer builds normally use oneTBB built with -fsanitize=thread
+// (scripts/sanitize.sh tsan), so the scheduling that ships is the one checked.
+#ifndef STREAMRT_STD_THREADS
+#define STREAMRT_STD_THREADS 0
+#endif
+#if STREAMRT_STD_THREADS
 #include <atomic>
 #include <thread>
 #include <vector>
