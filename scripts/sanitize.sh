@@ -13,7 +13,8 @@
 #                                               build-tsan-std/ with the loops on std::thread
 #                                               instead of oneTBB (STREAMRT_STD_THREADS in
 #                                               engine/parallel/parallelism.h)
-# Debug-ish flags (-O1 -g) keep the build quick on 2 cores; the perf targets are not built.
+# RelWithDebInfo: the top-level CMakeLists.txt sets its flags (-O3 -g -DNDEBUG), so the sanitizers
+# see the code that ships; the perf targets are not built.
 # JOBS (default 1) sets the build parallelism: sanitizer builds need much memory per job.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,23 +33,9 @@ case "$kind" in
   tsan|tsan-std)
     dir=build-$kind
     sanitize="thread"
-    # GCC instruments the load-time resolver of a target_clones function (row_to_bytes in
-    # engine/image/image_io.cpp) with TSan's function entry hook, and the resolver runs while
-    # the program is relocated, before the TSan runtime is set up: every TSan binary died with
-    # SIGSEGV before main. So TSan builds compile that function once, for the baseline ISA
-    # (what its "default" clone is), kept out of line like the clones, by a header included
-    # before every source (no header of the system or of a dependency names target_clones).
-    # Rewritten only when it changes: a new date would rebuild every file.
-    mkdir -p "$dir"
-    printf '%s\n' '// Written by scripts/sanitize.sh: no load-time resolvers under ThreadSanitizer.' \
-      '#define target_clones(...) noinline' >"$dir/tsan_no_clones.h.new"
-    if cmp -s "$dir/tsan_no_clones.h.new" "$dir/tsan_no_clones.h"; then
-      rm "$dir/tsan_no_clones.h.new"
-    else
-      mv "$dir/tsan_no_clones.h.new" "$dir/tsan_no_clones.h"
-    fi
-    flags="-include $PWD/$dir/tsan_no_clones.h"
-    extra=(-DCMAKE_CXX_FLAGS="$flags")
+    # (engine/image/image_io.cpp builds its one target_clones function without clones under TSan:
+    # GCC instruments the clones' load-time resolver, which runs before the TSan runtime.)
+    extra=()
     # Suppressions (each with its reason) live in tests/tsan.supp.
     export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/tsan.supp"
     # Two tests cannot pass under TSan, for reasons that are not races: one bounds the peak
@@ -115,7 +102,7 @@ SOURCES
   fi
   extra+=(-DTBB_DIR="$tbb_prefix/lib/cmake/TBB")
 elif [[ $kind == tsan-std ]]; then
-  extra=(-DCMAKE_CXX_FLAGS="$flags -DSTREAMRT_STD_THREADS=1")
+  extra=(-DCMAKE_CXX_FLAGS="-DSTREAMRT_STD_THREADS=1")
 fi
 tbb_built=$(date +%s)
 

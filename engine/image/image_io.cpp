@@ -81,13 +81,21 @@ float calibration_scale(const Framebuffer& fb, Calibration how, Parallelism* par
     return peak > 0.f ? 1.f / peak : 1.f;
 }
 
+// ThreadSanitizer instruments the clones' load-time resolver, which then runs before TSan is
+// set up and crashes every binary: TSan builds take the one default version.
+#if defined(__SANITIZE_THREAD__)
+#define STREAMRT_ROW_CLONES
+#else
+#define STREAMRT_ROW_CLONES __attribute__((target_clones("avx2", "default")))
+#endif
+
 // calibrate() and lround(c * 255) fused, one row at a time, in a form GCC vectorises:
 // |v| <= FLT_MAX is isfinite, and for y >= 0 "trunc, plus one if the exact remainder is at
 // least a half" is lround (y + 0.5f would round wrongly just below a half). The file is built
 // with -fno-trapping-math (engine/CMakeLists.txt) so that GCC turns the selects into blends;
 // an AVX2 clone (chosen at load time) converts 3x faster than SSE2 (docs/performance.md).
 // Exact integer rounding and one multiply: every clone gives the same bytes.
-__attribute__((target_clones("avx2", "default"))) void row_to_bytes(const Framebuffer& fb, int y, float scale,
+STREAMRT_ROW_CLONES void row_to_bytes(const Framebuffer& fb, int y, float scale,
                                                                     unsigned char* __restrict out) {
     const float* __restrict v = fb.pixel(0, y);
     const std::size_t n = std::size_t(fb.width) * 3;
