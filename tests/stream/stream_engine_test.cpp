@@ -136,6 +136,20 @@ std::string worst_pixels(const Framebuffer& a, const Framebuffer& b, int n = 8) 
     return s.str();
 }
 
+/// Calls f(scene, isa) for every scene under scenes/ and every ISA level this CPU has.
+template <class F>
+void for_each_scene_and_isa(F&& f) {
+    for (const auto& ls : loaded_scenes()) {
+        CAPTURE(ls.name);
+        for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
+            if (!isa_supported(isa)) continue;
+            const std::string isa_str = isa_name(isa);
+            CAPTURE(isa_str);
+            f(ls, isa);
+        }
+    }
+}
+
 }  // namespace
 
 TEST_CASE("stream engine: every scene under scenes/ loads (or is an include fragment)") {
@@ -225,44 +239,32 @@ TEST_CASE("stream engine: hits regrouped by material and kind (gathered) give th
     // Per lane the gathered kernel does the same arithmetic on the same values as a run of one
     // object; only the order in which a pixel's contributions are summed differs. A pixel sums
     // at most a few dozen terms below 1 in float: rounding differences stay under 1e-5.
-    for (const auto& ls : loaded_scenes()) {
-        CAPTURE(ls.name);
-        for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
-            if (!isa_supported(isa)) continue;
-            const std::string isa_str = isa_name(isa);
-            CAPTURE(isa_str);
-            const Framebuffer sorted = render_with(ls.scene, EngineKind::Stream, 2, isa, ShadeMode::Sorted);
-            const Framebuffer gathered = render_with(ls.scene, EngineKind::Stream, 2, isa, ShadeMode::Gathered);
-            const ImageDifference d = compare_images(gathered, sorted);
-            CAPTURE(d.max_abs);
-            CHECK(d.max_abs <= 1e-5);
-        }
-    }
+    for_each_scene_and_isa([](const LoadedScene& ls, Isa isa) {
+        const Framebuffer sorted = render_with(ls.scene, EngineKind::Stream, 2, isa, ShadeMode::Sorted);
+        const Framebuffer gathered = render_with(ls.scene, EngineKind::Stream, 2, isa, ShadeMode::Gathered);
+        const ImageDifference d = compare_images(gathered, sorted);
+        CAPTURE(d.max_abs);
+        CHECK(d.max_abs <= 1e-5);
+    });
 }
 
 TEST_CASE("stream engine: the scalar shade path gives the picture of the SIMD path on every scene, every ISA") {
     // Both paths run render/shading.h's shade_hit on the same arithmetic; the bound on the
     // share of pixels and the PSNR are those the engines are held to against each other, the
     // largest difference is held to the summation-order rounding measured below.
-    for (const auto& ls : loaded_scenes()) {
-        CAPTURE(ls.name);
-        for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
-            if (!isa_supported(isa)) continue;
-            const std::string isa_str = isa_name(isa);
-            CAPTURE(isa_str);
-            const Framebuffer simd = render_with(ls.scene, EngineKind::Stream, 2, isa, ShadeMode::Sorted);
-            const Framebuffer scalar = render_with(ls.scene, EngineKind::Stream, 2, isa, ShadeMode::Scalar);
-            const ImageDifference d = compare_images(scalar, simd);
-            MESSAGE(ls.name << " " << isa_str << ": scalar vs SIMD shade max " << d.max_abs << ", over 1/255 "
-                            << d.share_over * 100 << "%");
-            CAPTURE(d.max_abs);
-            CAPTURE(d.share_over);
-            // The arithmetic is the same at every level (unfused multiply-adds, one pow
-            // rounding): what is left is the order of a pixel's sums. Measured (160x120,
-            // 2 spp): at most 1.19e-7, one float ulp at 1, on 28 of 48 scene x level pairs.
-            CHECK(d.max_abs <= 1.2e-7);
-            CHECK(d.psnr >= kMinPsnr);
-            CHECK(d.share_over <= kMaxShareOver);
-        }
-    }
+    for_each_scene_and_isa([](const LoadedScene& ls, Isa isa) {
+        const Framebuffer simd = render_with(ls.scene, EngineKind::Stream, 2, isa, ShadeMode::Sorted);
+        const Framebuffer scalar = render_with(ls.scene, EngineKind::Stream, 2, isa, ShadeMode::Scalar);
+        const ImageDifference d = compare_images(scalar, simd);
+        MESSAGE(ls.name << " " << isa_name(isa) << ": scalar vs SIMD shade max " << d.max_abs << ", over 1/255 "
+                        << d.share_over * 100 << "%");
+        CAPTURE(d.max_abs);
+        CAPTURE(d.share_over);
+        // The arithmetic is the same at every level (unfused multiply-adds, one pow rounding):
+        // what is left is the order of a pixel's sums. Measured (160x120, 2 spp): at most
+        // 1.19e-7, one float ulp at 1, on 28 of 48 scene x level pairs.
+        CHECK(d.max_abs <= 1.2e-7);
+        CHECK(d.psnr >= kMinPsnr);
+        CHECK(d.share_over <= kMaxShareOver);
+    });
 }
