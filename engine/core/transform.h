@@ -20,10 +20,6 @@ inline glm::dvec3 transform_point(const glm::dmat4& m, const glm::dvec3& p) {
 inline glm::dvec3 transform_vector(const glm::dmat4& m, const glm::dvec3& v) {
     return glm::dmat3(m) * v;
 }
-/// Mn n = (Mi's linear part)^T n, normalised: n times that part as a row vector.
-inline glm::dvec3 transform_normal(const glm::dmat4x3& mi, const glm::dvec3& n) {
-    return glm::normalize(n * glm::dmat3(mi));
-}
 
 /// An affine map's top three rows read row-major, m[4 r + c] = row r, column c, from a glm
 /// dmat4x3 (stored by columns): the form apply_point / apply_vector / apply_normal read.

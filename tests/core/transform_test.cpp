@@ -21,7 +21,10 @@ TEST_CASE("Md x affine_inverse(Md) is the identity and Mn keeps normals perpendi
         // A tangent t and normal n of a canonical surface stay perpendicular in the world.
         const glm::dvec3 n = glm::normalize(glm::dvec3(u(rng), u(rng), u(rng)));
         const glm::dvec3 t = glm::cross(n, glm::dvec3(0.3, 0.5, 0.7));
-        const glm::dvec3 tw = transform_vector(md, t), nw = transform_normal(mi, n);
+        // The engines' Mn: apply_normal over Mi's rows (its linear part transposed).
+        const glm::dvec3 tw = transform_vector(md, t);
+        const Vec3d nv = apply_normal(RowsOf{mi}, Vec3d{n.x, n.y, n.z});
+        const glm::dvec3 nw{nv.x, nv.y, nv.z};
         CHECK(glm::dot(tw, nw) == doctest::Approx(0.0).epsilon(1e-12));
         CHECK(glm::length(nw) == doctest::Approx(1.0));
     }
