@@ -1,6 +1,6 @@
 // Timing program for image output (docs/performance.md, "## Image output"). Not a test.
 //
-//   image_bench [SCENE [WIDTH HEIGHT]]
+//   image_bench [SCENE [WIDTH HEIGHT [display]]]
 //
 // Renders SCENE (default scenes/whitted.cfg, 2560x1440, 1 spp) once, then times encoding
 // its picture to PNG in memory, median of 5, with: the old pipeline (calibrated float copy,
@@ -8,6 +8,9 @@
 // forced filter, libdeflate at level 1 on the whole image (one thread: it cannot cut a
 // stream into independent pieces), and streamrt's banded zlib writer at several levels,
 // strategies and filters on -j1 and -j2. Then PPM, PFM and the whole write_image to a file.
+// With "display" (docs/performance.md, "## Display colour and EXR"): only the 8-bit
+// conversion for each display setting (PPM in memory, the conversion is most of its cost),
+// against a straightforward per-value pow, and EXR files, on -j1 and -j2.
 #include <zlib.h>
 
 #include <ctime>
@@ -16,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -97,12 +101,59 @@ std::size_t libdeflate_up(const Framebuffer& fb, int level) {
 }
 #endif
 
-std::size_t streamrt_encode(const Framebuffer& fb, ImageFormat format, const WriteOptions& o) {
+std::size_t streamrt_encode(const Framebuffer& fb, ImageFormat format, const Display& d, const WriteOptions& o) {
     std::size_t n = 0;
-    encode_image(fb, format, Calibration::Clamp, [&](std::span<const iovec> p) {
+    encode_image(fb, format, d, [&](std::span<const iovec> p) {
         for (const iovec& v : p) n += v.iov_len;
     }, o);
     return n;
+}
+
+// The handout's linear output, as before the display colour keys.
+std::size_t streamrt_encode(const Framebuffer& fb, ImageFormat format, const WriteOptions& o) {
+    return streamrt_encode(fb, format, Display::raw(Calibration::Clamp), o);
+}
+
+// The straightforward sRGB conversion the table replaces: clamp, the IEC curve by pow, lround.
+std::size_t pow_srgb_bytes(const Framebuffer& fb, std::vector<unsigned char>& out) {
+    out.resize(fb.rgb.size());
+    for (std::size_t i = 0; i < fb.rgb.size(); ++i) {
+        const float v = fb.rgb[i];
+        const double c = std::isfinite(v) ? std::clamp(double(v), 0.0, 1.0) : 0.0;
+        out[i] = static_cast<unsigned char>(std::lround(255.0 * srgb_oetf(c)));
+    }
+    return out.size();
+}
+
+void display_rows(const Framebuffer& fb) {
+    std::vector<unsigned char> bytes;
+    report("straightforward pow sRGB + lround, 1 thread", [&] { return pow_srgb_bytes(fb, bytes); });
+    for (int jobs : {1, 2}) {
+        Parallelism par(jobs);
+        WriteOptions o;
+        o.par = &par;
+        const std::string j = ", -j" + std::to_string(jobs);
+        Display srgb, reinhard, normalize;
+        reinhard.tonemap = Tonemap::Reinhard;
+        normalize.tonemap = Tonemap::Reinhard;
+        normalize.calibration = Calibration::Normalize;
+        report(("PPM linear clamp (handout)" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Ppm, o); });
+        report(("PPM srgb clamp (default)" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Ppm, srgb, o); });
+        report(("PPM srgb reinhard" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Ppm, reinhard, o); });
+        report(("PPM srgb reinhard normalize" + j).c_str(),
+               [&] { return streamrt_encode(fb, ImageFormat::Ppm, normalize, o); });
+        report(("PNG linear clamp (handout)" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Png, o); });
+        report(("PNG srgb clamp (default)" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Png, srgb, o); });
+        for (const ExrPixels px : {ExrPixels::Half, ExrPixels::Float}) {
+            Display d;
+            d.exr = px;
+            report(((px == ExrPixels::Half ? "write_image .exr half" : "write_image .exr float") + j).c_str(), [&] {
+                write_image("/tmp/streamrt_image_bench.exr", fb, d, o);
+                return std::size_t(std::filesystem::file_size("/tmp/streamrt_image_bench.exr"));
+            });
+        }
+    }
+    std::remove("/tmp/streamrt_image_bench.exr");
 }
 
 }  // namespace
@@ -118,6 +169,10 @@ int main(int argc, char** argv) {
         fb = render_scene(scene, EngineKind::Stream, par).image;
     }
     std::printf("%dx%d, median of 5\n", fb.width, fb.height);
+    if (argc > 4 && std::string(argv[4]) == "display") {
+        display_rows(fb);
+        return 0;
+    }
     report("old: calibrate + lround copy + stb level 8 (default)", [&] { return stb_png(fb, 8, -1); });
     report("stb level 1", [&] { return stb_png(fb, 1, -1); });
     report("stb level 1, filter Up forced", [&] { return stb_png(fb, 1, 2); });
@@ -153,7 +208,7 @@ int main(int argc, char** argv) {
         report(("streamrt PPM, -j" + std::to_string(jobs)).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Ppm, o); });
         report(("streamrt PFM, -j" + std::to_string(jobs)).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Pfm, o); });
         report(("write_image to /tmp .png (default), -j" + std::to_string(jobs)).c_str(), [&] {
-            write_image("/tmp/streamrt_image_bench.png", fb, Calibration::Clamp, o);
+            write_image("/tmp/streamrt_image_bench.png", fb, Display::raw(Calibration::Clamp), o);
             return std::size_t(0);
         });
     }

@@ -70,6 +70,9 @@ struct Options {
     std::string checkpoint;
     bool resume = false;
     std::string tile_costs;
+    // Display colour overrides of the image keys (docs/scene-format.md, "Output and display colour").
+    std::string colorspace, tonemap;
+    std::optional<double> exposure;
     /// Rendered tile by tile (render_tiles) rather than as one image.
     bool tiled() const { return mpi || shard_n > 0 || !checkpoint.empty() || !tile_costs.empty(); }
 };
@@ -105,7 +108,7 @@ void check_writable_path(const std::string& out, const std::string& scene_path) 
 
 void check_output_path(const std::string& out, const std::string& scene_path) {
     if (!image_format_for(out))
-        throw UsageError("output '" + out + "': unknown image format (expected .ppm, .png or .pfm)");
+        throw UsageError("output '" + out + "': unknown image format (expected .ppm, .png, .pfm or .exr)");
     check_writable_path(out, scene_path);
 }
 
@@ -209,6 +212,9 @@ Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
     if (opt.sampler == "random") s.pattern = SamplePattern::Random;
     if (opt.sampler == "stratified") s.pattern = SamplePattern::Stratified;
     if (!opt.output.empty()) s.output = opt.output;
+    if (!opt.colorspace.empty()) s.colorspace = opt.colorspace == "linear" ? ColorSpace::Linear : ColorSpace::Srgb;
+    if (!opt.tonemap.empty()) s.tonemap = opt.tonemap == "reinhard" ? Tonemap::Reinhard : Tonemap::Clamp;
+    if (opt.exposure) s.exposure = *opt.exposure;
     if (writes) {
         // A shard part is a tile file (docs/distributed.md), whatever its name.
         if (opt.shard_n > 0) check_writable_path(s.output, opt.scene_path);
@@ -327,7 +333,7 @@ int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBund
         WriteOptions wo;
         wo.par = &par;
         wo.cancel = &g_cancel;
-        if (!write_image(s.output, assembly.image(), s.calibration, wo)) throw Interrupted{};
+        if (!write_image(s.output, assembly.image(), display_of(s), wo)) throw Interrupted{};
     }
     const double write_seconds = since(write_start);
     if (!opt.tile_costs.empty()) write_text_file(opt.tile_costs, assembly.costs_csv());
@@ -418,7 +424,7 @@ int run_merge(int argc, char** argv) {
     std::string output;
     bool quiet = false;
     app.add_option("parts", parts, "The parts (all N of them)")->required();
-    app.add_option("-o,--output", output, "Output image (.ppm, .png or .pfm)")->required();
+    app.add_option("-o,--output", output, "Output image (.ppm, .png, .pfm or .exr)")->required();
     app.add_flag("-q,--quiet", quiet, "No summary line");
     try {
         app.parse(argc, argv);
@@ -430,11 +436,12 @@ int run_merge(int argc, char** argv) {
     check_output_path(output, "");
     TileFileHeader header;
     const Framebuffer image = merge_parts(parts, header);
-    const Calibration how = header.setting("calibration") == "normalize" ? Calibration::Normalize : Calibration::Clamp;
+    RenderSettings display;
+    apply_display_settings(header, display);
     Parallelism par(0);
     WriteOptions wo;
     wo.par = &par;
-    if (!write_image(output, image, how, wo)) throw Interrupted{};
+    if (!write_image(output, image, display_of(display), wo)) throw Interrupted{};
     if (!quiet)
         std::printf("merged %zu parts (%dx%d, %d tiles, scene %s) -> %s\n", parts.size(), header.width, header.height,
                     header.tiles, header.scene.c_str(), output.c_str());
@@ -448,7 +455,7 @@ int run(int argc, char** argv) {
     app.footer("Also: streamrt merge PART... -o OUT (the parts of --shard renders)");
     app.add_option("scene", opt.scene_path, "Scene file (.cfg)")->required();
     app.add_option("-j,--jobs", opt.jobs, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
-    app.add_option("-o,--output", opt.output, "Output image (.ppm, .png or .pfm); overrides the scene's");
+    app.add_option("-o,--output", opt.output, "Output image (.ppm, .png, .pfm or .exr); overrides the scene's");
     app.add_option("--spp", opt.spp, "Samples per pixel")->check(CLI::Range(1, 65536));
     app.add_option("--width", opt.width, "Image width in pixels")->check(CLI::Range(1, 32768));
     app.add_option("--height", opt.height, "Image height in pixels")->check(CLI::Range(1, 32768));
@@ -472,6 +479,12 @@ int run(int argc, char** argv) {
                    "Stream shade stage: simd (default: hits regrouped by object up to 8192 objects, by material and "
                    "kind above), sorted, gathered or scalar (for measurement)")
         ->check(CLI::IsMember({"simd", "sorted", "gathered", "scalar"}));
+    app.add_option("--colorspace", opt.colorspace, "8-bit output encoding: srgb (default) or linear (the handout's)")
+        ->check(CLI::IsMember({"srgb", "linear"}));
+    app.add_option("--tonemap", opt.tonemap, "Tone curve before calibration: clamp (default) or reinhard")
+        ->check(CLI::IsMember({"clamp", "reinhard"}));
+    app.add_option("--exposure", opt.exposure, "Multiplier of the linear values before the tone curve")
+        ->check(CLI::Range(1e-6, 1e6));
     app.add_flag("--compare", opt.compare, "Render with both engines and report times, speedup and image difference");
     app.add_option("--sampler", opt.sampler, "Pixel sampling: stratified, grid or random")
         ->check(CLI::IsMember({"stratified", "grid", "random"}));
@@ -565,7 +578,7 @@ int run(int argc, char** argv) {
         const RenderResult base = render_once(EngineKind::Recursive, true);
         eo.profile = stream_profile;
         const RenderResult str = render_once(EngineKind::Stream, true);
-        if (!write_image(s.output, str.image, s.calibration, wo)) throw Interrupted{};
+        if (!write_image(s.output, str.image, display_of(s), wo)) throw Interrupted{};
         const ImageDifference d = compare_images(str.image, base.image);
         std::printf("%s: %dx%d, spp %d, degree %d, -j%d, isa %s\n", opt.scene_path.c_str(), s.width, s.height, s.spp,
                     s.degree, par.jobs(), isa_name(eo.isa));
@@ -584,7 +597,7 @@ int run(int argc, char** argv) {
 
     const RenderResult r = render_once(engine, true);
     phase_start = Clock::now();
-    if (!write_image(s.output, r.image, s.calibration, wo)) throw Interrupted{};
+    if (!write_image(s.output, r.image, display_of(s), wo)) throw Interrupted{};
     const double write_seconds = since(phase_start);
     report_profile(opt, job.profile.get());
     print_summary(opt, job, par.jobs(), "", r.seconds, r.counts, r.setup_seconds, write_seconds);

@@ -40,6 +40,11 @@ struct TileFileHeader {
 std::string render_settings_token(const RenderSettings& s, EngineKind engine, const EngineOptions& options,
                                   const std::string& accel);
 
+/// The display colour part of that token (",colorspace=...,tonemap=...,exposure=...,exr=..."),
+/// and the settings a merge writes the image with, read back from a part's header.
+std::string display_settings_token(const RenderSettings& s);
+void apply_display_settings(const TileFileHeader& h, RenderSettings& s);
+
 /// Reads shard parts (streamrt --shard) and puts the image together. Throws UsageError, one
 /// line, when a part is unreadable, foreign (another scene, other settings, another N),
 /// repeated, incomplete, or when a part is missing. `header` receives the common header.

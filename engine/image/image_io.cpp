@@ -21,6 +21,7 @@
 #include <system_error>
 
 #include "core/error.h"
+#include "image/exr_io.h"
 #include "parallel/parallelism.h"
 
 // The only translation unit that includes stb (for reading PNG back).
@@ -38,8 +39,21 @@ std::optional<ImageFormat> image_format_for(const std::string& path) {
     if (ext == ".ppm") return ImageFormat::Ppm;
     if (ext == ".png") return ImageFormat::Png;
     if (ext == ".pfm") return ImageFormat::Pfm;
+    if (ext == ".exr") return ImageFormat::Exr;
     return std::nullopt;
 }
+
+Display display_of(const RenderSettings& s) {
+    Display d;
+    d.calibration = s.calibration;
+    d.colorspace = s.colorspace;
+    d.tonemap = s.tonemap;
+    d.exposure = float(s.exposure);
+    d.exr = s.exr;
+    return d;
+}
+
+double srgb_oetf(double c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055; }
 
 Framebuffer calibrate(const Framebuffer& fb, Calibration how) {
     Framebuffer out = fb;
@@ -66,9 +80,8 @@ void for_each(Parallelism* par, std::size_t n, std::size_t grain, Body&& body) {
         for (std::size_t i = 0; i < n; ++i) body(i);
 }
 
-// The scale calibrate() applies: one read pass for the maximum when normalising.
-float calibration_scale(const Framebuffer& fb, Calibration how, Parallelism* par) {
-    if (how != Calibration::Normalize) return 1.f;
+// The largest finite value of the framebuffer (0 if none is positive): one read pass.
+float finite_peak(const Framebuffer& fb, Parallelism* par) {
     const std::size_t rows = std::size_t(fb.height), row_floats = std::size_t(fb.width) * 3;
     std::vector<float> row_peak(rows, 0.f);
     for_each(par, rows, 16, [&](std::size_t y) {
@@ -77,8 +90,7 @@ float calibration_scale(const Framebuffer& fb, Calibration how, Parallelism* par
             if (std::isfinite(*v)) peak = std::max(peak, *v);
         row_peak[y] = peak;
     });
-    const float peak = rows ? *std::max_element(row_peak.begin(), row_peak.end()) : 0.f;
-    return peak > 0.f ? 1.f / peak : 1.f;
+    return rows ? *std::max_element(row_peak.begin(), row_peak.end()) : 0.f;
 }
 
 // ThreadSanitizer instruments the clones' load-time resolver, which then runs before TSan is
@@ -111,6 +123,115 @@ STREAMRT_ROW_CLONES void row_to_bytes(const Framebuffer& fb, int y, float scale,
     }
 }
 
+// ---- display colour (docs/scene-format.md, "Output and display colour") ----------------
+// The sRGB OETF and 8-bit rounding, exactly lround(255 srgb_oetf(c)) in double for every
+// float c in [0, 1], from two small tables: the code at the start of each 1/4096 step of c,
+// and for each code the smallest float c that rounds to the next one. The curve rises by
+// at most 255 * 12.92 / 4096 = 0.80 codes per step, so a step crosses one threshold at most:
+// code = start[i] + (c >= up[start[i]]). int32 tables: the AVX2 clone gathers from them.
+struct SrgbTables {
+    static constexpr int kSteps = 4096;
+    std::int32_t start[kSteps + 1];
+    float up[256];  // up[255] is above every c
+
+    SrgbTables() {
+        const auto code = [](float c) { return int(std::lround(255.0 * srgb_oetf(double(c)))); };
+        for (int k = 0; k < 255; ++k) {
+            // Floats in [0, 1] are ordered like their bit patterns: bisect on those.
+            std::uint32_t lo = 0, hi = std::bit_cast<std::uint32_t>(1.f);  // code(lo) <= k < code(hi)
+            while (hi - lo > 1) {
+                const std::uint32_t mid = lo + (hi - lo) / 2;
+                (code(std::bit_cast<float>(mid)) > k ? hi : lo) = mid;
+            }
+            up[k] = std::bit_cast<float>(hi);
+        }
+        up[255] = 2.f;
+        for (int i = 0; i <= kSteps; ++i) start[i] = code(float(i) / kSteps);
+    }
+};
+
+const SrgbTables& srgb_tables() {
+    static const SrgbTables tables;
+    return tables;
+}
+
+// One row of exposure, tone curve, calibration, encoding and rounding, in the vectorisable
+// form of row_to_bytes (inlined into each clone below, so it is compiled for each target).
+// `pre` multiplies first (the exposure, or the whole clamp-and-scale factor), `post` after
+// the tone curve (normalize's 1 / max). Values above 1e30 are taken as 1e30 (Reinhard of
+// them is 1), NaN and infinities as 0.
+template <bool kReinhard, bool kSrgb>
+[[gnu::always_inline]] inline void display_row_body(const Framebuffer& fb, int y, float pre, float post,
+                                                    const SrgbTables& t, unsigned char* __restrict out) {
+    const float* __restrict v = fb.pixel(0, y);
+    const std::size_t n = std::size_t(fb.width) * 3;
+    for (std::size_t i = 0; i < n; ++i) {
+        const bool finite = (std::bit_cast<std::uint32_t>(v[i]) & 0x7f800000u) != 0x7f800000u;
+        const float x = v[i] * pre;
+        float low = x < 0.f ? 0.f : x;
+        if constexpr (kReinhard) {
+            low = low > 1e30f ? 1e30f : low;
+            low = low / (1.f + low) * post;
+        }
+        const float high = low > 1.f ? 1.f : low;
+        const float c = finite ? high : 0.f;
+        if constexpr (kSrgb) {
+            const std::int32_t code = t.start[static_cast<int>(c * float(SrgbTables::kSteps))];
+            out[i] = static_cast<unsigned char>(code + (c >= t.up[code] ? 1 : 0));
+        } else {
+            const float scaled = c * 255.f;
+            const int whole = static_cast<int>(scaled);
+            out[i] = static_cast<unsigned char>(whole + (scaled - float(whole) >= 0.5f ? 1 : 0));
+        }
+    }
+}
+
+STREAMRT_ROW_CLONES void row_clamp_srgb(const Framebuffer& fb, int y, float pre, float post, const SrgbTables& t,
+                                        unsigned char* __restrict out) {
+    display_row_body<false, true>(fb, y, pre, post, t, out);
+}
+STREAMRT_ROW_CLONES void row_reinhard_srgb(const Framebuffer& fb, int y, float pre, float post, const SrgbTables& t,
+                                           unsigned char* __restrict out) {
+    display_row_body<true, true>(fb, y, pre, post, t, out);
+}
+STREAMRT_ROW_CLONES void row_reinhard_linear(const Framebuffer& fb, int y, float pre, float post, const SrgbTables& t,
+                                             unsigned char* __restrict out) {
+    display_row_body<true, false>(fb, y, pre, post, t, out);
+}
+
+// The 8-bit rows of one image for one Display, its factors found once (the normalize
+// maximum's pass included). Linear, clamp, exposure 1 is the handout's row_to_bytes.
+class EightBitRows {
+  public:
+    EightBitRows(const Framebuffer& fb, const Display& d, Parallelism* par) : fb_(fb) {
+        const bool normalize = d.calibration == Calibration::Normalize;
+        const float peak = normalize ? finite_peak(fb, par) : 0.f;
+        if (d.tonemap == Tonemap::Clamp) {
+            // v * e clamped, or v * e / max(v * e) = v / max(v): one factor.
+            pre_ = normalize ? (peak > 0.f ? 1.f / peak : 1.f) : d.exposure;
+            row_ = d.colorspace == ColorSpace::Srgb ? &row_clamp_srgb : nullptr;
+        } else {
+            // Reinhard is increasing: the maximum after the curve is the curve of the maximum.
+            pre_ = d.exposure;
+            const float x = std::min(peak * d.exposure, 1e30f), top = x / (1.f + x);
+            post_ = normalize && top > 0.f ? 1.f / top : 1.f;
+            row_ = d.colorspace == ColorSpace::Srgb ? &row_reinhard_srgb : &row_reinhard_linear;
+        }
+        if (d.colorspace == ColorSpace::Srgb) tables_ = &srgb_tables();
+    }
+    void operator()(int y, unsigned char* out) const {
+        if (row_) row_(fb_, y, pre_, post_, *tables_, out);
+        else row_to_bytes(fb_, y, pre_, out);
+    }
+
+  private:
+    using Row = void (*)(const Framebuffer&, int, float, float, const SrgbTables&, unsigned char*);
+    const Framebuffer& fb_;
+    float pre_ = 1.f, post_ = 1.f;
+    Row row_ = nullptr;
+    const SrgbTables* tables_ = nullptr;
+};
+
 constexpr std::size_t kPpmChunkBytes = std::size_t(4) << 20;  // one write() per 4 MiB
 constexpr std::size_t kPngBandBytes = std::size_t(128) << 10;
 constexpr std::size_t kPngBandsInFlight = 16;  // encoded together, then written in order
@@ -126,14 +247,14 @@ std::string ppm_pfm_header(const char* magic, const Framebuffer& fb, const char*
            "\n";
 }
 
-void encode_ppm(const Framebuffer& fb, float scale, const ByteSink& sink, const WriteOptions& o) {
+void encode_ppm(const Framebuffer& fb, const EightBitRows& to_bytes, const ByteSink& sink, const WriteOptions& o) {
     const std::string header = ppm_pfm_header("P6", fb, "255");
     const std::size_t stride = std::size_t(fb.width) * 3, chunk = ppm_chunk_rows(fb.width);
     std::vector<unsigned char> buf(std::min(chunk, std::size_t(fb.height)) * stride);
     for (std::size_t y0 = 0; y0 < std::size_t(fb.height); y0 += chunk) {
         if (o.cancel && o.cancel->load()) throw Cancelled{};
         const std::size_t rows = std::min(chunk, std::size_t(fb.height) - y0);
-        for_each(o.par, rows, 16, [&](std::size_t r) { row_to_bytes(fb, int(y0 + r), scale, &buf[r * stride]); });
+        for_each(o.par, rows, 16, [&](std::size_t r) { to_bytes(int(y0 + r), &buf[r * stride]); });
         iovec pieces[2] = {{const_cast<char*>(header.data()), header.size()}, {buf.data(), rows * stride}};
         if (y0 == 0) sink(pieces);
         else sink(std::span<const iovec>(pieces + 1, 1));
@@ -183,16 +304,17 @@ struct PngBand {
     std::size_t raw_bytes = 0;
 };
 
-void encode_png_band(const Framebuffer& fb, float scale, int y0, int y1, const PngOptions& o, PngBand& band) {
+void encode_png_band(const Framebuffer& fb, const EightBitRows& to_bytes, int y0, int y1, const PngOptions& o,
+                     PngBand& band) {
     const std::size_t stride = std::size_t(fb.width) * 3;
     std::vector<unsigned char> rows(2 * stride), filtered(std::size_t(y1 - y0) * (stride + 1));
     unsigned char *prev = rows.data(), *cur = rows.data() + stride;
     // Up reads the row above, also across the band's top edge (it is in the framebuffer).
-    if (y0 > 0 && o.filter == PngFilter::Up) row_to_bytes(fb, y0 - 1, scale, prev);
+    if (y0 > 0 && o.filter == PngFilter::Up) to_bytes(y0 - 1, prev);
     else std::fill_n(prev, stride, 0);
     unsigned char* out = filtered.data();
     for (int y = y0; y < y1; ++y) {
-        row_to_bytes(fb, y, scale, cur);
+        to_bytes(y, cur);
         *out++ = static_cast<unsigned char>(o.filter);
         if (o.filter == PngFilter::Up)
             for (std::size_t i = 0; i < stride; ++i) out[i] = static_cast<unsigned char>(cur[i] - prev[i]);
@@ -221,7 +343,7 @@ void encode_png_band(const Framebuffer& fb, float scale, int y0, int y1, const P
     if (!done) throw RenderError("PNG encoding failed (zlib " + std::to_string(rc) + ")");
 }
 
-void encode_png(const Framebuffer& fb, float scale, const ByteSink& sink, const WriteOptions& o) {
+void encode_png(const Framebuffer& fb, const EightBitRows& to_bytes, const ByteSink& sink, const WriteOptions& o) {
     static const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     unsigned char ihdr[13];
     put_be32(ihdr, std::uint32_t(fb.width));
@@ -246,7 +368,7 @@ void encode_png(const Framebuffer& fb, float scale, const ByteSink& sink, const 
         const std::size_t n = std::min(group.size(), bands - b0);
         for_each(o.par, n, 1, [&](std::size_t i) {
             const int y0 = int(b0 + i) * band_rows;
-            encode_png_band(fb, scale, y0, std::min(fb.height, y0 + band_rows), o.png, group[i]);
+            encode_png_band(fb, to_bytes, y0, std::min(fb.height, y0 + band_rows), o.png, group[i]);
         });
         // One IDAT per band: the first carries the zlib header, the last the Adler-32.
         frames.clear();
@@ -314,17 +436,18 @@ double image_write_buffer_bytes(int width, int height) {
     const double png = double(std::min(kPngBandsInFlight, bands)) * band;
     const double ppm = double(std::min(ppm_chunk_rows(width), std::size_t(height))) * stride;
     const double pfm = (double(height) + 1) * sizeof(iovec);
-    return std::max({png, ppm, pfm});
+    return std::max({png, ppm, pfm, exr_write_buffer_bytes(width, height)});
 }
 
-bool encode_image(const Framebuffer& fb, ImageFormat format, Calibration how, const ByteSink& sink,
+bool encode_image(const Framebuffer& fb, ImageFormat format, const Display& display, const ByteSink& sink,
                   const WriteOptions& options) {
     if (fb.width <= 0 || fb.height <= 0) throw RenderError("cannot encode an empty image");
+    if (format == ImageFormat::Exr) throw RenderError("EXR is written to files only (write_image)");
     try {
-        // PFM keeps the linear values for error measurement; the 8-bit formats are calibrated.
+        // PFM keeps the linear values for error measurement; the 8-bit formats are for display.
         if (format == ImageFormat::Pfm) encode_pfm(fb, sink);
-        else if (format == ImageFormat::Ppm) encode_ppm(fb, calibration_scale(fb, how, options.par), sink, options);
-        else encode_png(fb, calibration_scale(fb, how, options.par), sink, options);
+        else if (format == ImageFormat::Ppm) encode_ppm(fb, EightBitRows(fb, display, options.par), sink, options);
+        else encode_png(fb, EightBitRows(fb, display, options.par), sink, options);
     } catch (const Cancelled&) {
         return false;
     }
@@ -333,7 +456,7 @@ bool encode_image(const Framebuffer& fb, ImageFormat format, Calibration how, co
 
 namespace {
 
-/// Through a temporary name in the same folder (so the rename is atomic): fill(sink) writes
+/// Through a temporary name in the same folder (so the rename is atomic): fill(fd) writes
 /// the content; whatever stops it (an error, bad_alloc, Ctrl-C: fill returns false) leaves no
 /// temporary behind and no file at `path`. `cancel` is looked at once more after the last
 /// byte: a Ctrl-C that arrives during the final write still leaves no file.
@@ -347,7 +470,7 @@ bool write_atomically(const std::string& path, const std::atomic<bool>* cancel, 
     if (fd < 0) throw RenderError(path + ": cannot write: " + std::strerror(errno));
     bool written = false;
     try {
-        written = fill([fd](std::span<const iovec> p) { write_all(fd, p); });
+        written = fill(fd);
     } catch (const std::system_error& e) {
         ::close(fd);
         ::unlink(tmp.c_str());
@@ -376,16 +499,23 @@ bool write_atomically(const std::string& path, const std::atomic<bool>* cancel, 
 
 }  // namespace
 
-bool write_image(const std::string& path, const Framebuffer& fb, Calibration how, const WriteOptions& options) {
+bool write_image(const std::string& path, const Framebuffer& fb, const Display& display,
+                 const WriteOptions& options) {
     const auto format = image_format_for(path);
-    if (!format) throw RenderError(path + ": unknown image format (expected .ppm, .png or .pfm)");
-    return write_atomically(path, options.cancel, [&](auto&& sink) { return encode_image(fb, *format, how, sink, options); });
+    if (!format) throw RenderError(path + ": unknown image format (expected .ppm, .png, .pfm or .exr)");
+    if (*format == ImageFormat::Exr) {
+        if (fb.width <= 0 || fb.height <= 0) throw RenderError("cannot encode an empty image");
+        return write_atomically(path, options.cancel, [&](int fd) { return write_exr(fd, path, fb, display.exr, options); });
+    }
+    return write_atomically(path, options.cancel, [&](int fd) {
+        return encode_image(fb, *format, display, [fd](std::span<const iovec> p) { write_all(fd, p); }, options);
+    });
 }
 
 void write_text_file(const std::string& path, std::string_view text) {
-    write_atomically(path, nullptr, [&](auto&& sink) {
+    write_atomically(path, nullptr, [&](int fd) {
         const iovec piece{const_cast<char*>(text.data()), text.size()};
-        sink(std::span<const iovec>(&piece, 1));
+        write_all(fd, std::span<const iovec>(&piece, 1));
         return true;
     });
 }
@@ -425,6 +555,7 @@ struct HeaderReader {
 Framebuffer read_image(const std::string& path) {
     const auto format = image_format_for(path);
     if (!format) throw RenderError(path + ": unknown image format");
+    if (*format == ImageFormat::Exr) return read_exr(path);
     if (*format == ImageFormat::Png) {
         int w = 0, h = 0, n = 0;
         unsigned char* px = stbi_load(path.c_str(), &w, &h, &n, 3);

@@ -321,7 +321,8 @@ const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rota
                                                       "translate"};
 const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
                                                   "depth",  "degree",  "output",
-                                                  "sampler", "calibration", "cutoff"};
+                                                  "sampler", "calibration", "cutoff",
+                                                  "colorspace", "exposure", "tonemap", "exr"};
 const std::vector<std::string_view> kLookAtKeys = {"eye", "look", "up", "fov"};
 const std::vector<std::string_view> kExplicitCameraKeys = {"rx",       "ry",       "df",
                                                            "scale",    "rotate_x", "rotate_y",
@@ -775,7 +776,33 @@ class Parser {
                 else
                     st.fail(a.value_col,
                             "expected clamp or normalize for 'calibration', got " + quote(a.value));
+            } else {
+                display_key(st, a, s);
             }
+        }
+    }
+
+    // The display colour keys of `image` (docs/scene-format.md, "Output and display colour").
+    static void display_key(const Statement& st, const Arg& a, RenderSettings& s) {
+        const auto k = a.key;
+        if (k == "exposure") {
+            // Bounded so that it stays a normal float factor for the 8-bit conversion.
+            const double v = st.number(a);
+            if (!(v >= 1e-6 && v <= 1e6))
+                st.fail(a.value_col, "'exposure' must be a multiplier > 0, in [1e-6, 1e6], got " + quote(a.value));
+            s.exposure = v;
+        } else if (k == "colorspace") {
+            if (a.value == "srgb") s.colorspace = ColorSpace::Srgb;
+            else if (a.value == "linear") s.colorspace = ColorSpace::Linear;
+            else st.fail(a.value_col, "expected srgb or linear for 'colorspace', got " + quote(a.value));
+        } else if (k == "tonemap") {
+            if (a.value == "clamp") s.tonemap = Tonemap::Clamp;
+            else if (a.value == "reinhard") s.tonemap = Tonemap::Reinhard;
+            else st.fail(a.value_col, "expected clamp or reinhard for 'tonemap', got " + quote(a.value));
+        } else if (k == "exr") {
+            if (a.value == "half") s.exr = ExrPixels::Half;
+            else if (a.value == "float") s.exr = ExrPixels::Float;
+            else st.fail(a.value_col, "expected half or float for 'exr', got " + quote(a.value));
         }
     }
 

@@ -96,6 +96,10 @@ struct Camera {
 
 enum class Calibration : std::uint8_t { Clamp, Normalize };
 enum class SamplePattern : std::uint8_t { Stratified, Grid, Random };
+// Display colour of the 8-bit outputs (docs/scene-format.md, "Output and display colour").
+enum class ColorSpace : std::uint8_t { Srgb, Linear };
+enum class Tonemap : std::uint8_t { Clamp, Reinhard };
+enum class ExrPixels : std::uint8_t { Half, Float };
 
 struct RenderSettings {
     int width = 640;
@@ -111,6 +115,12 @@ struct RenderSettings {
     Calibration calibration = Calibration::Clamp;
     SamplePattern pattern = SamplePattern::Stratified;
     std::string output = "out.png";
+    // Display colour (docs/scene-format.md, "Output and display colour"): how the linear
+    // framebuffer becomes 8-bit PNG/PPM values; PFM and EXR keep the linear values.
+    ColorSpace colorspace = ColorSpace::Srgb;
+    Tonemap tonemap = Tonemap::Clamp;
+    double exposure = 1.0;  ///< > 0, multiplies the linear values before the tone curve
+    ExrPixels exr = ExrPixels::Half;
 };
 
 struct Scene {

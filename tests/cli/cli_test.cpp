@@ -323,9 +323,12 @@ void check_pixel(const Rgb8& img, int x, int y, std::array<double, 3> want, doub
 TEST_CASE("cli: a render writes the image with the scene's colours and leaves no temporary file") {
     Dir d;
     const fs::path scene = d.write("s.cfg", kFlatScene);
-    for (const std::string ext : {".png", ".ppm", ".pfm"}) {
+    // PNG and PPM are sRGB-encoded by default; "--colorspace linear" gives the handout's
+    // bytes, the linear colour itself; PFM holds the linear floats.
+    for (const std::string ext : {".png", ".ppm", ".pfm", "_linear.ppm"}) {
         const fs::path out = d.path / ("img" + ext);
-        const Run r = run_streamrt("-q -j2 " + q(scene) + " -o " + q(out));
+        const bool linear = ext == ".pfm" || ext == "_linear.ppm";
+        const Run r = run_streamrt("-q -j2 " + q(scene) + " -o " + q(out) + (linear ? " --colorspace linear" : ""));
         INFO(ext, ": ", r.err);
         REQUIRE(r.code == 0);
         const Rgb8 img = read_back(out);
@@ -333,13 +336,45 @@ TEST_CASE("cli: a render writes the image with the scene's colours and leaves no
         REQUIRE(img.h == 33);
         // 8-bit: the exact byte; PFM: the float colour (exact: degree 0 copies C).
         const double tol = ext == ".pfm" ? 1e-6 : 0.1 / 255;
-        const std::array<double, 3> bg{0.2, 0.4, 0.6}, red{1, 0.2, 0}, green{0, 1, 0};
+        std::array<double, 3> bg{0.2, 0.4, 0.6}, red{1, 0.2, 0}, green{0, 1, 0};
+        if (!linear) {
+            // 255 (1.055 c^(1/2.4) - 0.055): 0.2 -> 123.55, 0.4 -> 169.63, 0.6 -> 203.42.
+            bg = {124 / 255.0, 170 / 255.0, 203 / 255.0};
+            red = {1, 124 / 255.0, 0};
+        }
         for (auto [x, y] : {std::pair{0, 0}, {32, 0}, {0, 32}, {32, 32}}) check_pixel(img, x, y, bg, tol);
         check_pixel(img, 16, 16, red, tol);
         check_pixel(img, 12, 12, green, tol);
         CHECK(img.at(12, 20)[1] < 0.5);  // the mirror image of (12,12) is not the cube
     }
-    CHECK(d.files().size() == 4);  // the scene and the three images, nothing else
+    CHECK(d.files().size() == 5);  // the scene and the four images, nothing else
+}
+
+TEST_CASE("cli: .exr output, the display colour flags and their bad values") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kFlatScene);
+    REQUIRE(run_streamrt("-q -j2 " + q(scene) + " -o " + q(d.path / "ref.pfm")).code == 0);
+    const streamrt::Framebuffer ref = streamrt::read_image((d.path / "ref.pfm").string());
+    // EXR (half by default): the linear floats to half's 11 significant bits, whatever the
+    // display flags (they concern the 8-bit formats).
+    const Run r = run_streamrt("-q -j2 --exposure 4 --tonemap reinhard " + q(scene) + " -o " + q(d.path / "img.exr"));
+    INFO(r.err);
+    REQUIRE(r.code == 0);
+    const streamrt::Framebuffer exr = streamrt::read_image((d.path / "img.exr").string());
+    REQUIRE(exr.rgb.size() == ref.rgb.size());
+    for (std::size_t i = 0; i < ref.rgb.size(); ++i) CHECK(std::abs(exr.rgb[i] - ref.rgb[i]) <= ref.rgb[i] / 2048);
+    // --exposure 2 --tonemap reinhard --colorspace linear: the background's 0.2 -> 0.4 ->
+    // 0.4 / 1.4 = 0.285714 -> 72.86 -> 73; 0.4 -> 0.8 / 1.8 -> 113.33 -> 113; 0.6 -> 1.2 / 2.2 -> 139.09 -> 139.
+    const fs::path ppm = d.path / "t.ppm";
+    REQUIRE(run_streamrt("-q --exposure 2 --tonemap reinhard --colorspace linear " + q(scene) + " -o " + q(ppm)).code == 0);
+    const std::string data = slurp(ppm);
+    CHECK(data.substr(13, 3) == std::string("\x49\x71\x8b", 3));  // "P6\n33 33\n255\n" is 13 bytes
+    for (const std::string bad : {"--exposure 0", "--exposure -1", "--tonemap aces", "--colorspace rgb"}) {
+        const Run b = run_streamrt(bad + " " + q(scene) + " -o " + q(d.path / "no.png"));
+        INFO(bad, ": ", b.err);
+        CHECK(b.code == 2);
+        CHECK(!fs::exists(d.path / "no.png"));
+    }
 }
 
 TEST_CASE("cli: the summary line gives the process's phases; releasing the scene's records changes no pixel") {

@@ -51,6 +51,7 @@ inline std::string check_scene(const Scene& sc) {
         return "spp, depth or degree out of range";
     if (!(s.ambient >= 0 && s.ambient <= 1) || !finite(s.background) || s.output.empty())
         return "ambient, background or output invalid";
+    if (!(s.exposure >= 1e-6 && s.exposure <= 1e6)) return "exposure out of range";
     for (std::size_t i = 0; i < sc.objects.size(); ++i) {
         const Object& o = sc.objects[i];
         if (!finite(o.direct()) || !finite(glm::dmat4(affine_inverse(o.md))))

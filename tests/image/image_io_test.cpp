@@ -1,4 +1,5 @@
-// Image files written and read back; calibration; atomic replacement.
+// Image files written and read back; the handout's calibration (raw linear output); atomic
+// replacement. The display colour chain and EXR: display_test.cpp.
 #include <doctest/doctest.h>
 
 #include <atomic>
@@ -65,7 +66,7 @@ std::string encoded(const Framebuffer& fb, ImageFormat format, Calibration how, 
     WriteOptions o;
     o.par = &par;
     std::string out;
-    encode_image(fb, format, how, [&](std::span<const iovec> pieces) {
+    encode_image(fb, format, Display::raw(how), [&](std::span<const iovec> pieces) {
         for (const iovec& v : pieces) out.append(static_cast<const char*>(v.iov_base), v.iov_len);
     }, o);
     return out;
@@ -77,7 +78,7 @@ TEST_CASE("PPM, PNG and PFM round-trip") {
     for (const char* ext : {"ppm", "png"}) {
         CAPTURE(ext);
         const fs::path p = temp_file(std::string("rt.") + ext);
-        write_image(p, fb, Calibration::Clamp);
+        write_image(p, fb, Display::raw(Calibration::Clamp));
         const Framebuffer back = read_image(p);
         REQUIRE(back.width == 7);
         REQUIRE(back.height == 5);
@@ -89,7 +90,7 @@ TEST_CASE("PPM, PNG and PFM round-trip") {
         fs::remove(p);
     }
     const fs::path p = temp_file("rt.pfm");
-    write_image(p, fb, Calibration::Clamp);
+    write_image(p, fb, Display::raw(Calibration::Clamp));
     const Framebuffer back = read_image(p);
     CHECK(back.rgb == fb.rgb);  // linear floats, bit for bit, not calibrated
     fs::remove(p);
@@ -99,7 +100,7 @@ TEST_CASE("PPM header is binary P6 as the handout asks") {
     Framebuffer fb(2, 1);
     fb.rgb = {1, 0, 0, 0, 0.5f, 1};
     const fs::path p = temp_file("hdr.ppm");
-    write_image(p, fb, Calibration::Clamp);
+    write_image(p, fb, Display::raw(Calibration::Clamp));
     std::ifstream in(p, std::ios::binary);
     std::string data((std::istreambuf_iterator<char>(in)), {});
     CHECK(data == std::string("P6\n2 1\n255\n\xff\x00\x00\x00\x80\xff", 17));
@@ -117,12 +118,12 @@ TEST_CASE("calibration: clamp, normalize by the maximum, NaN to 0") {
 
 TEST_CASE("a failed write leaves nothing behind and an existing file untouched") {
     const Framebuffer fb = gradient(3, 3);
-    CHECK_THROWS_AS(write_image("/nonexistent-dir/out.png", fb, Calibration::Clamp), RenderError);
-    CHECK_THROWS_AS(write_image(temp_file("x.jpg"), fb, Calibration::Clamp), RenderError);
+    CHECK_THROWS_AS(write_image("/nonexistent-dir/out.png", fb, Display::raw(Calibration::Clamp)), RenderError);
+    CHECK_THROWS_AS(write_image(temp_file("x.jpg"), fb, Display::raw(Calibration::Clamp)), RenderError);
     const fs::path p = temp_file("keep.ppm");
-    write_image(p, fb, Calibration::Clamp);
+    write_image(p, fb, Display::raw(Calibration::Clamp));
     const auto size = fs::file_size(p);
-    write_image(p, gradient(4, 4), Calibration::Clamp);  // replaced whole
+    write_image(p, gradient(4, 4), Display::raw(Calibration::Clamp));  // replaced whole
     CHECK(fs::file_size(p) > size);
     for (const auto& e : fs::directory_iterator(fs::temp_directory_path()))
         CHECK(e.path().filename().string().find(".keep.ppm.tmp") == std::string::npos);
@@ -155,7 +156,7 @@ TEST_CASE("PNG: read back by stb_image, the exact 8-bit values, at every band la
             CAPTURE(h);
             const Framebuffer fb = awkward(w, h);
             const fs::path p = temp_file("bands.png");
-            write_image(p, fb, how);
+            write_image(p, fb, Display::raw(how));
             const Framebuffer back = read_image(p);
             REQUIRE(back.width == w);
             REQUIRE(back.height == h);
@@ -183,7 +184,7 @@ TEST_CASE("PPM and PFM larger than one write chunk keep every row in place") {
     for (const char* ext : {"ppm", "pfm"}) {
         CAPTURE(ext);
         const fs::path p = temp_file(std::string("chunks.") + ext);
-        write_image(p, fb, Calibration::Clamp);
+        write_image(p, fb, Display::raw(Calibration::Clamp));
         const Framebuffer back = read_image(p);
         REQUIRE(back.rgb.size() == fb.rgb.size());
         if (std::string(ext) == "pfm") CHECK(back.rgb == fb.rgb);
@@ -208,7 +209,7 @@ TEST_CASE("a cancelled write leaves neither the image nor a temporary file") {
     o.cancel = &cancel;
     for (const char* ext : {"png", "ppm"}) {
         const fs::path p = temp_file(std::string("cancel.") + ext);
-        CHECK_FALSE(write_image(p, fb, Calibration::Clamp, o));
+        CHECK_FALSE(write_image(p, fb, Display::raw(Calibration::Clamp), o));
         CHECK_FALSE(fs::exists(p));
         for (const auto& e : fs::directory_iterator(fs::temp_directory_path()))
             CHECK(e.path().filename().string().find(".streamrt_img_cancel.") == std::string::npos);

@@ -97,6 +97,20 @@ TEST_CASE("parser: image settings") {
     CHECK(parse("image sampler=random").settings.pattern == SamplePattern::Random);
     CHECK(parse("image sampler=stratified").settings.pattern == SamplePattern::Stratified);
     CHECK(parse("image calibration=clamp").settings.calibration == Calibration::Clamp);
+    // Display colour (docs/scene-format.md, "Output and display colour"): defaults, then each key.
+    const RenderSettings def = parse("").settings;
+    CHECK(def.colorspace == ColorSpace::Srgb);
+    CHECK(def.tonemap == Tonemap::Clamp);
+    CHECK(def.exposure == 1.0);
+    CHECK(def.exr == ExrPixels::Half);
+    const RenderSettings d = parse("image colorspace=linear tonemap=reinhard exposure=2.5 exr=float").settings;
+    CHECK(d.colorspace == ColorSpace::Linear);
+    CHECK(d.tonemap == Tonemap::Reinhard);
+    CHECK(d.exposure == 2.5);
+    CHECK(d.exr == ExrPixels::Float);
+    CHECK(parse("image colorspace=srgb tonemap=clamp exr=half").settings.colorspace == ColorSpace::Srgb);
+    CHECK(parse("image exposure=1e-6").settings.exposure == 1e-6);
+    CHECK(parse("image exposure=1e6").settings.exposure == 1e6);
     // Limits are inclusive.
     const Scene lim = parse("image width=1 height=32768 spp=65536 depth=0 degree=0");
     CHECK(lim.settings.width == 1);
@@ -365,6 +379,14 @@ TEST_CASE("parser: errors carry the exact line and column") {
         expect_error("background 1,1", 1, 12, "comma-separated");
         expect_error("image sampler=halton", 1, 15, "got 'halton'");
         expect_error("image calibration=gamma", 1, 19, "got 'gamma'");
+        expect_error("image colorspace=rgb", 1, 18, "expected srgb or linear for 'colorspace', got 'rgb'");
+        expect_error("image width=8 tonemap=aces", 1, 23, "expected clamp or reinhard for 'tonemap', got 'aces'");
+        expect_error("image exr=int", 1, 11, "expected half or float for 'exr', got 'int'");
+        expect_error("image exposure=0", 1, 16, "'exposure' must be a multiplier > 0, in [1e-6, 1e6], got '0'");
+        expect_error("image exposure=-1", 1, 16, "got '-1'");
+        expect_error("image exposure=1e7", 1, 16, "got '1e7'");
+        expect_error("image exposure=9e-7", 1, 16, "got '9e-7'");
+        expect_error("\nimage  exposure=bright", 2, 17, "expected a number for 'exposure', got 'bright'");
         expect_error("sphere rotate_x=ninety", 1, 17, "expected a number");
         expect_error("sphere scale=1,2", 1, 14, "comma-separated");
         expect_error("sphere scale=big", 1, 14, "expected a number or x,y,z");
