@@ -125,6 +125,17 @@ def group_shard(args, tmp):
         r = run([args.streamrt, "merge", parts[0], parts[0], parts[1], "-o", tmp / "m2.pfm"])
         check(r.returncode == 2 and one_line(r), f"{scene.name}: merge with a part twice: {r.stderr.strip()!r}")
         check(not (tmp / "m2.pfm").exists(), f"{scene.name}: a refused merge wrote an image")
+    # The display colour settings travel in the parts' headers: the merged PNG is the
+    # single-process one, byte for byte.
+    display = ["--tonemap", "reinhard", "--exposure", "3"]
+    want = reference(args, SCENES / "whitted.cfg", tmp / "ref.png", extra=display)
+    for k in range(2):
+        r = run([args.streamrt, "-j1", SCENES / "whitted.cfg", "-o", tmp / f"disp_{k}.part", *SMALL, *display,
+                 "--shard", f"{k}/2"])
+        check(r.returncode == 0, f"--shard {k}/2 with display settings failed: {r.stderr.strip()}")
+    r = run([args.streamrt, "merge", tmp / "disp_0.part", tmp / "disp_1.part", "-o", tmp / "merged.png"])
+    check(r.returncode == 0 and (tmp / "merged.png").read_bytes() == want,
+          f"merged PNG with display settings differs from the single-process one: {r.stderr.strip()}")
     # A part of another render (other spp) does not belong.
     foreign = tmp / "foreign.part"
     r = run([args.streamrt, SCENES / "whitted.cfg", "-o", foreign, "--width", "64", "--height", "48", "--spp", "3",
