@@ -1,5 +1,6 @@
 #pragma once
-// How far two pictures are apart, on calibrated values in [0, 1].
+// How far two pictures are apart, on linear values (framebuffers, PFM or EXR files) clamped to
+// [0, 1]: never on display-encoded (sRGB) 8-bit values.
 #include "image/framebuffer.h"
 
 namespace streamrt {
