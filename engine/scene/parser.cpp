@@ -1139,6 +1139,12 @@ class Parser {
                     tr.scale.add(frame, sc);
                 } else if (same(a.key, "rotate")) tr.rotate.add(frame, rotation(st, a));
             }
+            // Md at every key of the object stays usable (interpolation stays between them).
+            for (const auto* track : {&tr.translate.frames, &tr.scale.frames, &tr.rotate.frames})
+                for (const int f : *track)
+                    if (singular(keyed_transform(tr, f) * glm::dmat4(tr.base)))
+                        st.fail_here("key: the " + who + "'s transform at frame " + std::to_string(f) +
+                                     " is singular or not finite");
         } else if (def.what == Named::Light) {
             const auto [t, fresh] = light_tracks_.try_emplace(def.index, anim.lights.size());
             if (fresh) {
@@ -1162,8 +1168,21 @@ class Parser {
                 else if (same(a.key, "look")) tr.look.add(frame, st.vec3(a));
                 else if (same(a.key, "fov")) tr.fov.add(frame, st.in_open(a, 0.0, 180.0));
             }
+            // The camera at this key's frame passes the camera statement's checks.
+            Camera c = scene.camera;
+            if (!tr.eye.empty()) c.eye = sample(tr.eye, frame);
+            if (!tr.look.empty()) c.look = sample(tr.look, frame);
+            if (!tr.fov.empty()) c.fov = sample(tr.fov, frame);
+            const glm::dvec3 fwd = c.look - c.eye;
+            if (!(glm::length(fwd) > 0.0) || !std::isfinite(glm::length(fwd)) ||
+                !(glm::length(glm::cross(glm::normalize(fwd), c.up)) > 1e-9) ||
+                singular(c.world_from_canonical(1, 1)))
+                st.fail_here("key: at frame " + std::to_string(frame) +
+                             " the camera's eye and look coincide, or the view is parallel to 'up'");
+            camera_key_ = st.where();
         }
     }
+    SourceLoc camera_key_;  // the last camera key, for an interpolated camera that degenerates
 
     /// rotate=ax,ay,az,degrees: a rotation about a non-zero axis, as a unit quaternion.
     static glm::dquat rotation(const Statement& st, const Arg& a) {
@@ -1188,7 +1207,12 @@ class Parser {
     /// After the whole text: the scene is put at frame 0 (a still picture of an animated
     /// scene is frame 0).
     void finish() {
-        if (scene.animation) set_frame(scene, 0);
+        if (!scene.animation) return;
+        try {
+            set_frame(scene, 0);
+        } catch (const UsageError& e) {
+            throw SceneError(camera_key_, e.what());
+        }
     }
 };
 

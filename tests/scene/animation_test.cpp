@@ -179,6 +179,10 @@ TEST_CASE("animation: bad names and keys at their line:col") {
     expect_error("sphere name=a\nkey a frame=1 rotate=0,0,90\n", 2, 22, "ax,ay,az,degrees");
     expect_error("sphere name=a\nkey a frame=1 scale=-1\n", 2, 21, "must be > 0");
     expect_error("sphere name=a\nkey a frame=1 translate=1,2,3 translate=1,2,3\n", 2, 31, "duplicate key");
+    expect_error("sphere name=a\nkey a frame=0 translate=1e308,0,0 scale=1e-300\n", 2, 1,
+                 "transform at frame 0 is singular or not finite");
+    expect_error("camera name=c eye=0,0,5 look=0,0,0\nkey c frame=3 eye=0,0,0\n", 2, 1,
+                 "at frame 3 the camera's eye and look coincide");
     // A key names what is defined above it (the file is read in order).
     expect_error("key a frame=1 translate=1,2,3\nsphere name=a\n", 1, 5, "unknown name");
 }
