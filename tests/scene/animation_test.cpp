@@ -89,11 +89,15 @@ TEST_CASE("animation: rotation halfway, by the shortest arc") {
         CHECK(near(column(s, 0, 0), {std::cos(a), std::sin(a), 0}));
     }
     SUBCASE("T R S order: scale, then rotate, then translate, after the statement") {
-        // Md = T(1,2,3) Rz(90) S(2) S(0.5) = T(1,2,3) Rz(90).
-        Scene s = parse("sphere name=a scale=0.5\nkey a frame=0 translate=1,2,3 rotate=0,0,1,90 scale=2\n");
+        // Md = T(1,2,3) Rz(90) S(2,1,1) S(0.5): x -> Rz(90) (1,0,0) = (0,1,0),
+        // y -> Rz(90) (0,0.5,0) = (-0.5,0,0), z -> (0,0,0.5); the statement's translation
+        // (0,0,1) goes through the keys too: T Rz S (0,0,1) = (1,2,4).
+        Scene s = parse("sphere name=a scale=0.5 translate=0,0,1\n"
+                        "key a frame=0 translate=1,2,3 rotate=0,0,1,90 scale=2,1,1\n");
         CHECK(near(column(s, 0, 0), {0, 1, 0}));
-        CHECK(near(column(s, 0, 1), {-1, 0, 0}));
-        CHECK(near(column(s, 0, 3), {1, 2, 3}));
+        CHECK(near(column(s, 0, 1), {-0.5, 0, 0}));
+        CHECK(near(column(s, 0, 2), {0, 0, 0.5}));
+        CHECK(near(column(s, 0, 3), {1, 2, 4}));
     }
 }
 
