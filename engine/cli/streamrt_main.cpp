@@ -623,6 +623,8 @@ int run(int argc, char** argv) {
     Parallelism par(opt.jobs);
     // ---- animation: --frames / image frames= (scene/animation.h) ----
     if (frames.any) return render_frames(opt, job, par, bundle, frames);
+    // A still picture of an animated scene is frame 0, also in the output name's %d.
+    if (job.scene.animation) job.scene.settings.output = frame_output_name(s.output, 0).value_or(s.output);
     std::unique_ptr<PreparedRender> prepared;
     return render_picture(opt, job, par, bundle, prepared);
 }
