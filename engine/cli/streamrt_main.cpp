@@ -76,6 +76,8 @@ struct Options {
     bool tiled() const { return mpi || shard_n > 0 || !checkpoint.empty() || !tile_costs.empty(); }
 };
 
+std::optional<std::string> frame_output_name(const std::string& pattern, int frame);  // animation, below
+
 /// This process's rank when an MPI launcher started it (0 otherwise): messages that every
 /// rank would print alike are printed by rank 0 only.
 int launcher_rank() {
@@ -382,6 +384,13 @@ int run_mpi(const Options& opt, int argc, char** argv) {
             const auto start = Clock::now();
             job.emplace(make_job(opt, load_scene_from_bundle(bundle, opt.jobs), false, false));
             job->read_seconds = since(start);
+        }
+        // An animated scene: every rank renders its one frame, image frames=F or frame 0
+        // (several frames are refused by make_job, --frames by run()).
+        if (RenderSettings& rs = job->scene.settings; job->scene.animation || rs.has_frames()) {
+            job->frame = rs.has_frames() ? rs.frames_first : 0;
+            set_frame(job->scene, job->frame);
+            rs.output = frame_output_name(rs.output, job->frame).value_or(rs.output);
         }
         // One kernel level for all: the one asked for if every rank has it, else the best
         // every rank has (float results differ in the last bits between levels).
