@@ -149,7 +149,7 @@ void StreamScene::update(const Scene& scene, const FrameChange& change) {
         }
     if (!shifted && change.objects.empty()) return;
     if (!accel) {
-        convert_flat(scene);  // few objects by construction (accel_config().min_objects)
+        convert_flat(scene);  // O(N): few objects, unless --accel flat forces the flat loops
     } else if (!accel->update(scene, change.objects, eye, shifted)) {
         accel = StreamAccel::build_for(scene, eye);
         objects = accel->objects().data();
