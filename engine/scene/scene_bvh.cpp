@@ -82,7 +82,9 @@ std::unique_ptr<SceneBvh> SceneBvh::build_for(const Scene& scene, const AccelCon
 }
 
 bool SceneBvh::refit_pays(std::size_t moved, const AccelConfig& config) const {
-    return double(moved) <= config.refit_max_share * double(bounded);
+    // Counted over every refit since the build: a tree refitted frame after frame degrades
+    // however few objects move each time, so it is rebuilt once enough have moved in all.
+    return double(refitted_ + moved) <= config.refit_max_share * double(bounded);
 }
 
 void SceneBvh::refit(const Scene& scene, std::span<const std::uint32_t> moved, std::span<const std::uint32_t> order,
@@ -92,6 +94,7 @@ void SceneBvh::refit(const Scene& scene, std::span<const std::uint32_t> moved, s
         position_.assign(scene.objects.size(), ~0u);
         for (std::size_t p = 0; p < order.size(); ++p) position_[order[p]] = std::uint32_t(p);
     }
+    refitted_ += moved.size();
     std::vector<std::uint32_t> positions;
     positions.reserve(moved.size());
     for (const std::uint32_t i : moved)

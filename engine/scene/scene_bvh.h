@@ -39,9 +39,9 @@ struct AccelConfig {
     Traversal secondary = Traversal::Packet;  ///< reflected and refracted rays (packets measured faster, docs/performance.md)
     Traversal shadow = Traversal::Packet;
     BuildOptions build;
-    /// Animation (scene/animation.h): a frame refits the hierarchy when at most this share of
-    /// its objects moved, and rebuilds it otherwise (docs/performance.md, "## Animation").
-    /// 1: always refit, 0: always rebuild (tests and measurements).
+    /// Animation (scene/animation.h): frames refit the hierarchy while the objects moved since
+    /// it was built (summed over frames) are at most this share of its objects, and rebuild
+    /// it otherwise (docs/performance.md, "## Animation"). 0: always rebuild.
     double refit_max_share = 0.25;
 };
 AccelConfig& accel_config();
@@ -62,7 +62,9 @@ struct SceneBvh {
                                            const glm::dvec3& shift = glm::dvec3(0.0));
 
     // ---- animation: per-frame update (scene/animation.h) ----
-    /// Whether moving `moved` of the hierarchy's objects is refitted (true) or rebuilt.
+    /// Whether moving `moved` more of the hierarchy's objects is refitted (true) or rebuilt:
+    /// refitted while all the objects moved since the build, these included, are at most
+    /// config.refit_max_share of the hierarchy's.
     bool refit_pays(std::size_t moved, const AccelConfig& config = accel_config()) const;
     /// Refits the boxes of the scene objects `moved` (scene indices; unbounded ones are
     /// skipped) at their current Md. `order` maps a leaf position to its scene index
@@ -73,6 +75,7 @@ struct SceneBvh {
   private:
     std::unique_ptr<BvhLinks> links_;       ///< built on the first refit
     std::vector<std::uint32_t> position_;   ///< scene index -> leaf position (~0u: unbounded)
+    std::size_t refitted_ = 0;              ///< objects moved by refits since the build (with repeats)
 };
 
 }  // namespace streamrt::accel

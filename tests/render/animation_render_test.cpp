@@ -124,3 +124,26 @@ TEST_CASE("animation: per-frame update (refit, rebuild, flat) equals a set-up ma
         }
     }
 }
+
+TEST_CASE("animation: the hierarchy is refitted until a quarter of its objects moved since its build") {
+    std::string text;
+    for (int i = 0; i < 100; ++i) text += "sphere scale=0.4 translate=" + std::to_string(i) + ",0,0\n";
+    text += "plane\n";  // unbounded: not counted
+    Scene scene = parse_scene(text, "t.cfg");
+    accel::AccelConfig config;
+    config.refit_max_share = 0.25;
+    const auto bvh = accel::SceneBvh::build(scene);
+    CHECK(bvh->bounded == 100);
+    CHECK(bvh->refit_pays(25, config));
+    CHECK(!bvh->refit_pays(26, config));
+    // 20 moved (and refitted): 5 more still pay, 6 more do not.
+    std::vector<std::uint32_t> moved;
+    for (std::uint32_t i = 0; i < 20; ++i) moved.push_back(i);
+    for (const std::uint32_t i : moved) scene.objects[i].md[3].y += 1.0;
+    bvh->refit(scene, moved, bvh->bvh.prim_index);
+    CHECK(bvh->refit_pays(5, config));
+    CHECK(!bvh->refit_pays(6, config));
+    // The refitted boxes hold the moved spheres: the root's box reaches y = 1.4.
+    CHECK(bvh->bvh.bounds.hi[1] >= 1.4f);
+    CHECK(bvh->bvh.bounds.hi[1] < 1.41f);
+}
