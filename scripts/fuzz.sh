@@ -35,7 +35,7 @@ if ((rebuild)); then
 fi
 # Seed corpus: every example scene, the fuzz seeds (tests/fuzz/corpus: mesh statements on the
 # include tree's tri.obj) and the regression inputs.
-cp -n scenes/*.cfg scenes/degrees/*.cfg tests/fuzz/corpus/*.cfg "$out/corpus/" 2>/dev/null || true
+cp -n scenes/*.cfg scenes/degrees/*.cfg scenes/anim/*.cfg tests/fuzz/corpus/*.cfg "$out/corpus/" 2>/dev/null || true
 for f in tests/fuzz/regressions/*; do [[ -f $f ]] && cp -n "$f" "$out/corpus/"; done
 echo "fuzz.sh: running for ${seconds}s (corpus $(ls "$out/corpus" | wc -l) files)"
 exec "$bin" "$out/corpus" -dict=tests/fuzz/scene.dict -max_total_time="$seconds" \

@@ -346,4 +346,68 @@ Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
     return bvh;
 }
 
+BvhLinks::BvhLinks(const Bvh& bvh, std::size_t prims)
+    : parent(bvh.nodes.size(), -1), slot(bvh.nodes.size(), 0), leaf_node(prims, -1), leaf_slot(prims, 0) {
+    for (std::size_t i = 0; i < bvh.nodes.size(); ++i) {
+        const WideNode& n = bvh.nodes[i];
+        for (int j = 0; j < kNodeWidth; ++j) {
+            if (n.child[j] < 0) continue;
+            if (n.count[j] == 0) {
+                parent[std::size_t(n.child[j])] = std::int32_t(i);
+                slot[std::size_t(n.child[j])] = std::uint8_t(j);
+            } else {
+                for (std::uint32_t k = 0; k < n.count[j]; ++k) {
+                    leaf_node[std::size_t(n.child[j]) + k] = std::int32_t(i);
+                    leaf_slot[std::size_t(n.child[j]) + k] = std::uint8_t(j);
+                }
+            }
+        }
+    }
+}
+
+namespace {
+void set_child_box(WideNode& n, int j, const Aabb& b) {
+    n.lo_x[j] = b.lo[0], n.lo_y[j] = b.lo[1], n.lo_z[j] = b.lo[2];
+    n.hi_x[j] = b.hi[0], n.hi_y[j] = b.hi[1], n.hi_z[j] = b.hi[2];
+}
+Aabb node_box(const WideNode& n) {
+    Aabb b;
+    for (int j = 0; j < kNodeWidth; ++j) {
+        if (n.child[j] < 0) continue;
+        Aabb c;
+        c.lo[0] = n.lo_x[j], c.lo[1] = n.lo_y[j], c.lo[2] = n.lo_z[j];
+        c.hi[0] = n.hi_x[j], c.hi[1] = n.hi_y[j], c.hi[2] = n.hi_z[j];
+        b.grow(c);
+    }
+    return b;
+}
+}  // namespace
+
+void refit(Bvh& bvh, const BvhLinks& links, std::span<const std::uint32_t> moved,
+           const std::function<Aabb(std::uint32_t)>& box) {
+    if (bvh.empty() || moved.empty()) return;
+    // Nodes are emitted parents first (Collapser::emit), so a descending sweep over the dirty
+    // nodes visits every child before its parent.
+    std::vector<std::uint8_t> dirty(bvh.nodes.size(), 0);
+    std::size_t top = 0;
+    for (const std::uint32_t pos : moved) {
+        const std::int32_t node = links.leaf_node[pos];
+        const int j = links.leaf_slot[pos];
+        WideNode& n = bvh.nodes[std::size_t(node)];
+        Aabb leaf;
+        for (std::uint32_t k = 0; k < n.count[j]; ++k) leaf.grow(box(std::uint32_t(n.child[j]) + k));
+        set_child_box(n, j, leaf);
+        dirty[std::size_t(node)] = 1;
+        top = std::max(top, std::size_t(node));
+    }
+    for (std::size_t i = top + 1; i-- > 0;) {
+        if (!dirty[i]) continue;
+        const std::int32_t p = links.parent[i];
+        if (p < 0) continue;
+        set_child_box(bvh.nodes[std::size_t(p)], links.slot[i], node_box(bvh.nodes[i]));
+        dirty[std::size_t(p)] = 1;
+    }
+    bvh.bounds = node_box(bvh.nodes[0]);
+}
+
 }  // namespace streamrt::accel

@@ -10,7 +10,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "core/vec3.h"
@@ -91,6 +93,25 @@ struct Bvh {
     /// and their memory is given back before the build proper starts.
     static Bvh build(std::vector<Aabb> boxes, const BuildOptions& options = {});
 };
+
+/// What refitting a hierarchy needs beside it (animation, scene/animation.h): each node's
+/// parent and its slot there, and the leaf holding each primitive position. Built on the
+/// first refit only, so a still scene never pays for it.
+struct BvhLinks {
+    std::vector<std::int32_t> parent;     ///< per node; -1 for the root
+    std::vector<std::uint8_t> slot;       ///< per node: its slot in the parent
+    std::vector<std::int32_t> leaf_node;  ///< per primitive position: the node with its leaf
+    std::vector<std::uint8_t> leaf_slot;  ///< ... and the slot of that leaf
+    BvhLinks(const Bvh& bvh, std::size_t prims);
+};
+
+/// Refits the hierarchy after some primitives moved: each leaf holding one of the positions
+/// `moved` gets the union of its primitives' boxes (box(position) for each), then every box
+/// above a changed leaf is recomputed from its node's children, deepest nodes first. The
+/// tree keeps its shape (a refit is exact, it may only be slower to traverse than a rebuild
+/// when objects moved far).
+void refit(Bvh& bvh, const BvhLinks& links, std::span<const std::uint32_t> moved,
+           const std::function<Aabb(std::uint32_t)>& box);
 
 /// Scalar slab test of one ray against child j of a node, t in [0, t_max]. inv is 1/d per
 /// component. NaN slab distances (0 * inf for a ray on a slab plane) are ignored, so a

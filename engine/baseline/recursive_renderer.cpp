@@ -187,4 +187,18 @@ Framebuffer RecursiveRenderer::render(Parallelism& par, RenderProgress* progress
     return fb;
 }
 
+// ---- animation: per-frame update ----
+void RecursiveRenderer::update(const FrameChange& change) {
+    for (const std::uint32_t i : change.objects) objects_[i].mi = affine_inverse(scene_.objects[i].md);
+    if (change.lights) {
+        lights_.clear();
+        for (const Light& l : scene_.lights) lights_.push_back(LightT<double>::from(l));
+    }
+    if (change.camera) camera_ = CameraRays<double>::from(scene_);
+    if (bvh_ && !change.objects.empty()) {
+        if (bvh_->refit_pays(change.objects.size())) bvh_->refit(scene_, change.objects, bvh_->bvh.prim_index);
+        else bvh_ = accel::SceneBvh::build(scene_, accel::accel_config().build);
+    }
+}
+
 }  // namespace streamrt

@@ -14,6 +14,7 @@
 #include "render/render_stats.h"
 #include "render/shading.h"
 #include "mesh/mesh_trace.h"
+#include "scene/animation.h"
 #include "scene/scene.h"
 
 namespace streamrt {
@@ -50,6 +51,10 @@ class RecursiveRenderer {
 
     /// One pixel's colour: the average over its samples.
     ColorT<double> render_pixel(int x, int y, RayCounts& counts) const;
+
+    /// Animation: the scene was put at another frame (set_frame); re-derives what `change`
+    /// names only (moved objects' Mi and their boxes, lights, camera).
+    void update(const FrameChange& change);
 
   private:
     /// What the loop over objects reads: Mi (world -> canonical, top three rows) computed

@@ -32,6 +32,7 @@
 #include "parallel/parallelism.h"
 #include "driver/limits.h"
 #include "driver/render.h"
+#include "scene/animation.h"
 #include "scene/parser.h"
 
 #ifndef STREAMRT_VERSION
@@ -73,9 +74,12 @@ struct Options {
     // Display colour overrides of the image keys (docs/scene-format.md, "Output and display colour").
     std::string colorspace, tonemap;
     std::optional<double> exposure;
+    std::string frames;  ///< --frames A..B (animation)
     /// Rendered tile by tile (render_tiles) rather than as one image.
     bool tiled() const { return mpi || shard_n > 0 || !checkpoint.empty() || !tile_costs.empty(); }
 };
+
+std::optional<std::string> frame_output_name(const std::string& pattern, int frame);  // animation, below
 
 /// This process's rank when an MPI launcher started it (0 otherwise): messages that every
 /// rank would print alike are printed by rank 0 only.
@@ -193,6 +197,7 @@ struct Job {
     EngineOptions eo;
     std::unique_ptr<StreamProfile> profile;  ///< when profiling (eo.profile points to it)
     double read_seconds = 0;
+    int frame = -1;  ///< the frame being rendered (animation; -1: a still picture)
 };
 
 /// Applies the command line to a loaded scene and checks everything before rendering.
@@ -215,6 +220,9 @@ Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
     if (!opt.colorspace.empty()) s.colorspace = opt.colorspace == "linear" ? ColorSpace::Linear : ColorSpace::Srgb;
     if (!opt.tonemap.empty()) s.tonemap = opt.tonemap == "reinhard" ? Tonemap::Reinhard : Tonemap::Clamp;
     if (opt.exposure) s.exposure = *opt.exposure;
+    if (opt.mpi && s.frames_last > s.frames_first)
+        throw UsageError("--mpi renders one picture, the scene's image frames= asks for several (render them as a job "
+                         "array, docs/distributed.md)");
     if (writes) {
         // A shard part is a tile file (docs/distributed.md), whatever its name.
         if (opt.shard_n > 0) check_writable_path(s.output, opt.scene_path);
@@ -252,7 +260,8 @@ Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
 /// from its own tables (128 bytes each; 128 MB at 1e6 objects).
 std::unique_ptr<PreparedRender> prepare(Job& job, EngineKind which, bool keep_objects) {
     auto prepared = prepare_render(job.scene, which, job.eo);
-    if (!prepared->reads_scene_objects() && !keep_objects) {
+    // An animated scene keeps them: the next frames are set on them (scene/animation.h).
+    if (!prepared->reads_scene_objects() && !keep_objects && !job.scene.animation) {
         std::vector<Object>().swap(job.scene.objects);
         std::vector<ObjectLoc>().swap(job.scene.object_locs);
     }
@@ -270,10 +279,11 @@ void print_summary(const Options& opt, const Job& job, int jobs, const std::stri
                    const RayCounts& counts, double setup_seconds, double write_seconds) {
     if (opt.quiet) return;
     const RenderSettings& s = job.scene.settings;
+    const std::string frame = job.frame >= 0 ? ", frame " + std::to_string(job.frame) : "";
     const double mrays = counts.total() / std::max(seconds, 1e-9) / 1e6;
     std::printf("%s: %dx%d, spp %d, degree %d, %s engine%s, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s"
                 " (read %.3f s, set-up %.3f s, render %.3f s, write %.3f s)\n",
-                opt.scene_path.c_str(), s.width, s.height, s.spp, s.degree, engine_name(job.engine), how.c_str(), jobs,
+                opt.scene_path.c_str(), s.width, s.height, s.spp, s.degree, engine_name(job.engine), (how + frame).c_str(), jobs,
                 seconds, static_cast<unsigned long long>(counts.total()), mrays, setup_seconds, s.output.c_str(),
                 job.read_seconds, setup_seconds, seconds, write_seconds);
 }
@@ -283,10 +293,12 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 
 /// Renders tile by tile: shards, checkpoints, tile costs, and MPI (`mpi` set). On MPI ranks
 /// other than 0, renders what rank 0 hands out and returns.
-int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle, const MpiSession* mpi) {
+/// `prepared`: the engine's set-up, kept from frame to frame (animation); made when null.
+int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle, const MpiSession* mpi,
+                 std::unique_ptr<PreparedRender>& prepared) {
     const RenderSettings& s = job.scene.settings;
     const bool rank0 = !mpi || mpi->rank() == 0;
-    const auto prepared = prepare(job, job.engine, false);
+    if (!prepared) prepared = prepare(job, job.engine, false);
     RenderProgress progress;
     progress.cancel = &g_cancel;
     const MpiSchedule schedule = opt.mpi_schedule == "static" ? MpiSchedule::Static : MpiSchedule::Dynamic;
@@ -298,6 +310,7 @@ int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBund
     TileFileHeader header;
     header.scene = bundle.content_hash();
     header.settings = render_settings_token(s, job.engine, job.eo, opt.accel);
+    if (job.frame >= 0) header.settings += ",frame=" + std::to_string(job.frame);  // parts of one frame only
     header.width = s.width;
     header.height = s.height;
     header.tiles = tile_count(s.width, s.height);
@@ -378,6 +391,13 @@ int run_mpi(const Options& opt, int argc, char** argv) {
             job.emplace(make_job(opt, load_scene_from_bundle(bundle, opt.jobs), false, false));
             job->read_seconds = since(start);
         }
+        // An animated scene: every rank renders its one frame, image frames=F or frame 0
+        // (several frames are refused by make_job, --frames by run()).
+        if (RenderSettings& rs = job->scene.settings; job->scene.animation || rs.has_frames()) {
+            job->frame = rs.has_frames() ? rs.frames_first : 0;
+            set_frame(job->scene, job->frame);
+            rs.output = frame_output_name(rs.output, job->frame).value_or(rs.output);
+        }
         // One kernel level for all: the one asked for if every rank has it, else the best
         // every rank has (float results differ in the last bits between levels).
         if (job->engine == EngineKind::Stream) {
@@ -397,7 +417,8 @@ int run_mpi(const Options& opt, int argc, char** argv) {
             return 0;
         }
         Parallelism par(opt.jobs);
-        return render_tiled(opt, *job, par, bundle, &mpi);
+        std::unique_ptr<PreparedRender> prepared;
+        return render_tiled(opt, *job, par, bundle, &mpi, prepared);
     } catch (const Interrupted&) {
         // Every rank was told to stop and has returned: the job ends together, no image.
         if (rank0) std::fprintf(stderr, "streamrt: interrupted, no image written\n");
@@ -447,6 +468,70 @@ int run_merge(int argc, char** argv) {
                     header.tiles, header.scene.c_str(), output.c_str());
     return 0;
 }
+
+// ---- animation: the frames to render (scene/animation.h) ----
+struct FramePlan {
+    int first = 0, last = 0;
+    bool any = false;   ///< frames asked for (--frames or image frames=)
+    bool many = false;  ///< more than one
+};
+
+/// The output name of frame `frame`: the name's one printf-style %d (flags: 0 and a width,
+/// e.g. %04d) replaced by the number, %% by %; nullopt when the name has no %d (or another
+/// conversion, or two).
+std::optional<std::string> frame_output_name(const std::string& pattern, int frame) {
+    std::string out;
+    bool found = false;
+    for (std::size_t i = 0; i < pattern.size(); ++i) {
+        if (pattern[i] != '%') {
+            out += pattern[i];
+            continue;
+        }
+        if (i + 1 < pattern.size() && pattern[i + 1] == '%') {
+            out += '%';
+            ++i;
+            continue;
+        }
+        std::size_t j = i + 1;
+        const bool zero = j < pattern.size() && pattern[j] == '0';
+        if (zero) ++j;
+        std::size_t width = 0;
+        while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9' && width < 64)
+            width = width * 10 + std::size_t(pattern[j++] - '0');
+        if (found || j >= pattern.size() || pattern[j] != 'd') return std::nullopt;
+        std::string number = std::to_string(frame);
+        if (number.size() < width) number.insert(0, width - number.size(), zero ? '0' : ' ');
+        out += number;
+        found = true;
+        i = j;
+    }
+    if (!found) return std::nullopt;
+    return out;
+}
+
+FramePlan plan_frames(const Options& opt, const RenderSettings& s) {
+    FramePlan p;
+    if (!opt.frames.empty()) {
+        std::string why;
+        if (!parse_frame_range(opt.frames, p.first, p.last, why)) throw UsageError("--frames " + opt.frames + ": " + why);
+        p.any = true;
+    } else if (s.has_frames()) {
+        p.first = s.frames_first;
+        p.last = s.frames_last;
+        p.any = true;
+    }
+    p.many = p.last > p.first;
+    if (p.many && !frame_output_name(s.output, p.first))
+        throw UsageError("output '" + s.output +
+                         "': several frames need one printf-style frame number in the name, e.g. out_%04d.png");
+    if (p.many && (!opt.checkpoint.empty() || !opt.tile_costs.empty()))
+        throw UsageError("--checkpoint and --tile-costs follow one picture: not with several frames");
+    return p;
+}
+
+int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle,
+                   std::unique_ptr<PreparedRender>& prepared);
+int render_frames(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle, const FramePlan& plan);
 
 int run(int argc, char** argv) {
     if (argc >= 2 && std::string(argv[1]) == "merge") return run_merge(argc - 1, argv + 1);
@@ -499,6 +584,9 @@ int run(int argc, char** argv) {
     app.add_option("--checkpoint", opt.checkpoint, "Journal finished tiles to FILE (removed once the image is written)");
     app.add_flag("--resume", opt.resume, "Continue the render journaled in --checkpoint FILE");
     app.add_option("--tile-costs", opt.tile_costs, "Write each tile's rays and seconds to FILE (CSV)");
+    app.add_option("--frames", opt.frames,
+                   "Render frames A..B of an animated scene (overrides image frames=), each to the output name's "
+                   "printf-style %d: -o out_%04d.png");
     app.set_version_flag("--version", std::string("streamrt ") + STREAMRT_VERSION);
     // "--profile=json FILE" is the documented spelling; CLI11 sees it as --profile-json FILE.
     std::vector<std::string> args;
@@ -528,6 +616,9 @@ int run(int argc, char** argv) {
     if (opt.compare && opt.tiled())
         throw UsageError("--compare renders whole images: not with --mpi, --shard, --checkpoint or --tile-costs");
     if (opt.mpi && opt.shard_n > 0) throw UsageError("--shard splits a render without MPI: not with --mpi");
+    if (opt.mpi && !opt.frames.empty())
+        throw UsageError("--frames: not with --mpi (render frames as a job array, or --frames with --shard; "
+                         "docs/distributed.md)");
     // From here on Ctrl-C (or SIGTERM) asks the render to stop; nothing is written then.
     std::signal(SIGINT, on_sigint);
     std::signal(SIGTERM, on_sigint);
@@ -543,6 +634,7 @@ int run(int argc, char** argv) {
     Job job = make_job(opt, std::move(loaded), true, true);
     job.read_seconds = read_seconds;
     const RenderSettings& s = job.scene.settings;
+    const FramePlan frames = plan_frames(opt, s);
     if (opt.check_only) {
         if (!opt.quiet)
             std::printf("%s: ok (%zu objects, %zu lights, %dx%d, spp %d, degree %d)\n", opt.scene_path.c_str(),
@@ -551,7 +643,21 @@ int run(int argc, char** argv) {
     }
     if (g_cancel.load()) throw Interrupted{};
     Parallelism par(opt.jobs);
-    if (opt.tiled()) return render_tiled(opt, job, par, bundle, nullptr);
+    // ---- animation: --frames / image frames= (scene/animation.h) ----
+    if (frames.any) return render_frames(opt, job, par, bundle, frames);
+    // A still picture of an animated scene is frame 0, also in the output name's %d.
+    if (job.scene.animation) job.scene.settings.output = frame_output_name(s.output, 0).value_or(s.output);
+    std::unique_ptr<PreparedRender> prepared;
+    return render_picture(opt, job, par, bundle, prepared);
+}
+
+/// One picture: tile by tile (shards, checkpoints, tile costs), both engines (--compare) or
+/// the chosen one. `prepared`: the engine's set-up, kept from frame to frame (animation);
+/// made when null (--compare makes its own two).
+int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle,
+                   std::unique_ptr<PreparedRender>& prepared) {
+    if (opt.tiled()) return render_tiled(opt, job, par, bundle, nullptr, prepared);
+    const RenderSettings& s = job.scene.settings;
     const EngineKind engine = job.engine;
     EngineOptions& eo = job.eo;
     WriteOptions wo;
@@ -562,9 +668,12 @@ int run(int argc, char** argv) {
         RenderProgress progress;
         progress.cancel = &g_cancel;
         progress.tiles_total = tile_count(s.width, s.height);
-        const auto prepared = prepare(job, which, opt.compare);
+        std::unique_ptr<PreparedRender> own;
+        if (opt.compare) own = prepare(job, which, true);
+        else if (!prepared) prepared = prepare(job, which, false);
+        PreparedRender& ready = opt.compare ? *own : *prepared;
         ProgressDisplay display(progress, show_progress && !opt.quiet && ::isatty(2));
-        RenderResult r = render_prepared(*prepared, par, &progress);
+        RenderResult r = render_prepared(ready, par, &progress);
         display.stop();
         if (g_cancel.load()) throw Interrupted{};
         return r;
@@ -596,11 +705,28 @@ int run(int argc, char** argv) {
     }
 
     const RenderResult r = render_once(engine, true);
-    phase_start = Clock::now();
+    const auto phase_start = Clock::now();
     if (!write_image(s.output, r.image, display_of(s), wo)) throw Interrupted{};
     const double write_seconds = since(phase_start);
     report_profile(opt, job.profile.get());
     print_summary(opt, job, par.jobs(), "", r.seconds, r.counts, r.setup_seconds, write_seconds);
+    return 0;
+}
+
+
+/// --frames A..B or image frames=A..B: each frame is one picture written to the output name
+/// with the frame number put in its printf-style %d (out_%04d.png), the engine's set-up
+/// updated from frame to frame (only what moved is rebuilt).
+int render_frames(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle, const FramePlan& plan) {
+    const std::string pattern = job.scene.settings.output;
+    std::unique_ptr<PreparedRender> prepared;
+    for (int f = plan.first; f <= plan.last; ++f) {
+        const FrameChange change = set_frame(job.scene, f);
+        job.frame = f;
+        job.scene.settings.output = frame_output_name(pattern, f).value_or(pattern);
+        if (prepared) prepared->update(job.scene, change);
+        if (const int status = render_picture(opt, job, par, bundle, prepared); status != 0) return status;
+    }
     return 0;
 }
 

@@ -21,6 +21,7 @@ class PreparedRecursive final : public PreparedRender {
     explicit PreparedRecursive(const Scene& scene) : renderer_(scene) {}
     Framebuffer render(Parallelism& par, RenderProgress* progress) override { return renderer_.render(par, progress); }
     bool reads_scene_objects() const override { return true; }
+    void update_engine(const Scene&, const FrameChange& change) override { renderer_.update(change); }
     void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
         for (int y = tile.y0; y < tile.y1; ++y)
             for (int x = tile.x0; x < tile.x1; ++x) {
@@ -45,6 +46,7 @@ class PreparedStream final : public PreparedRender {
         return renderer_.render(par, progress, profile_);
     }
     bool reads_scene_objects() const override { return false; }
+    void update_engine(const Scene& scene, const FrameChange& change) override { renderer_.update(scene, change); }
     void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
         if (!profile_) return renderer_.render_one_tile(tile, rgb, counts, nullptr, cancel);
         StreamProfile local;
@@ -78,6 +80,12 @@ std::unique_ptr<PreparedRender> prepare_render(const Scene& scene, EngineKind en
     p->width = scene.settings.width;
     p->height = scene.settings.height;
     return p;
+}
+
+void PreparedRender::update(const Scene& scene, const FrameChange& change) {
+    const auto start = Clock::now();
+    if (change.any()) update_engine(scene, change);
+    setup_seconds = seconds_since(start);
 }
 
 void render_tiles(PreparedRender& prepared, Parallelism& par, const TileSource& source, const TileSink& sink,

@@ -12,6 +12,7 @@
 #include "stream/shade_mode.h"
 #include "parallel/parallelism.h"
 #include "render/render_stats.h"
+#include "scene/animation.h"
 #include "scene/scene.h"
 
 namespace streamrt {
@@ -44,10 +45,18 @@ class PreparedRender {
     /// Renders one tile into `rgb` (tile.width() x tile.height() x 3 floats, row by row): the
     /// values render() gives those pixels, on any thread, in any process. Thread-safe.
     virtual void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) = 0;
+    /// Animation (scene/animation.h): the scene given to prepare_render was put at another
+    /// frame by set_frame, which said what changed; the engine re-derives only that (moved
+    /// objects' records and hierarchy boxes, refitted or rebuilt; lights; camera).
+    /// setup_seconds becomes the time this took.
+    void update(const Scene& scene, const FrameChange& change);
     /// After render_tile calls: completes the profile's description (stream engine).
     virtual void finish_tiles(double /*wall_seconds*/, int /*threads*/) {}
     double setup_seconds = 0;
     int width = 0, height = 0;  ///< the image's size (the scene's settings)
+
+  protected:
+    virtual void update_engine(const Scene& scene, const FrameChange& change) = 0;
 };
 
 /// One finished tile: its number (tile_rect), rectangle, pixels, rays and render time.

@@ -17,6 +17,7 @@
 
 #include "mesh/mesh.h"
 #include "parallel/parallelism.h"
+#include "scene/animation.h"
 #include "shapes/shapes.h"
 
 #include <algorithm>
@@ -322,7 +323,8 @@ const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rota
 const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
                                                   "depth",  "degree",  "output",
                                                   "sampler", "calibration", "cutoff",
-                                                  "colorspace", "exposure", "tonemap", "exr"};
+                                                  "colorspace", "exposure", "tonemap", "exr",
+                                                  "frames"};
 const std::vector<std::string_view> kLookAtKeys = {"eye", "look", "up", "fov"};
 const std::vector<std::string_view> kExplicitCameraKeys = {"rx",       "ry",       "df",
                                                            "scale",    "rotate_x", "rotate_y",
@@ -335,13 +337,18 @@ std::vector<std::string_view> join(std::initializer_list<std::vector<std::string
 }
 
 // The joined lists, built once (the order is the one messages list them in).
-const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys});
+const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys, {"name"}});
 const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
-const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys});
+const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys, {"name"}});
 const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth"}});
-const std::vector<std::string_view> kPointLightKeys = {"pos", "color"};
-const std::vector<std::string_view> kSpotLightKeys = {"pos", "dir", "angle", "color"};
-const std::vector<std::string_view> kDirectionalLightKeys = {"dir", "color"};
+const std::vector<std::string_view> kPointLightKeys = {"pos", "color", "name"};
+const std::vector<std::string_view> kSpotLightKeys = {"pos", "dir", "angle", "color", "name"};
+const std::vector<std::string_view> kDirectionalLightKeys = {"dir", "color", "name"};
+// The `key` statement's keys, by what the name names (animation, scene/animation.h).
+const std::vector<std::string_view> kObjectKeyKeys = {"frame", "translate", "rotate", "scale"};
+const std::vector<std::string_view> kLightKeyKeys = {"frame", "pos", "color"};
+const std::vector<std::string_view> kCameraKeyKeys = {"frame", "eye", "look", "fov"};
+const std::vector<std::string_view> kKeyKeys = join({kObjectKeyKeys, {"pos", "color", "eye", "look", "fov"}});
 
 /// Each kind's keys: the common ones, plus its parameter key (shapes/shapes.h) or the mesh's.
 const std::array<std::vector<std::string_view>, kShapeKindCount> kKeysOfKind = [] {
@@ -415,7 +422,7 @@ std::optional<ShapeKind> shape_from_word(std::string_view w) { return canonical_
 
 /// The statement words, in the order the unknown-statement message lists them.
 const std::string kStatementList = [] {
-    std::string list = "image, ambient, background, camera, light, material, ";
+    std::string list = "image, ambient, background, camera, light, material, key, ";
     CanonicalShapes::for_each([&](auto s) { list += std::string(s.name) + ", "; });
     return list + "mesh or include";
 }();
@@ -533,6 +540,12 @@ struct Chunk {
     bool sequential_only = false;        // holds include or mesh
     std::exception_ptr error;            // the first one in the chunk
     int error_line = INT_MAX;
+    struct Name {
+        std::string_view text;
+        int line, column;
+        std::size_t slot;
+    };
+    std::vector<Name> names;             // the name= of its shapes (animation), in order
 };
 
 class Parser {
@@ -663,6 +676,10 @@ class Parser {
         for (const Chunk& c : chunks)
             if (c.error && c.error_line < other_error_line) std::rethrow_exception(c.error);
         if (other_error) std::rethrow_exception(other_error);
+        for (const Chunk& c : chunks)
+            for (const Chunk::Name& n : c.names)
+                name_thing(display, n.line, Arg{"name", n.column, n.text, n.column}, Named::Object,
+                           std::uint32_t(n.slot));
         // The chunks' materials into the scene's list in chunk order, then each object's
         // chunk-local index replaced by the scene's (skipped where they coincide).
         std::vector<std::vector<std::uint32_t>> remap(chunks.size());
@@ -690,7 +707,7 @@ class Parser {
             const std::string_view line = line_at(text, pos);
             const std::string_view w = first_word(line);
             if (is_plain_shape(w)) ++c.shapes;
-            else if (w == "include" || w == "mesh") c.sequential_only = true;
+            else if (w == "include" || w == "mesh" || w == "key") c.sequential_only = true;
             else if (!w.empty()) c.others.emplace_back(pos, c.lines);
             pos += line.size() + 1;
             ++c.lines;
@@ -712,7 +729,9 @@ class Parser {
                 const auto kind = shape_from_word(scratch.toks[0].text);
                 if (!kind) continue;  // already read, in file order
                 Statement st(display, line_no, scratch.toks[0], scratch.args);
-                shape(st, scratch.toks, *kind, file, c.materials, scene.objects[slot], scene.object_locs[slot]);
+                if (const auto name = shape(st, scratch.toks, *kind, file, c.materials, scene.objects[slot],
+                                            scene.object_locs[slot]))
+                    c.names.push_back({name->value, line_no, name->value_col, slot});
                 ++slot;
             }
         } catch (...) {
@@ -734,6 +753,7 @@ class Parser {
         else if (w == "light") light(st, toks);
         else if (w == "material") material(st, toks);
         else if (w == "include") include(st, toks, depth);
+        else if (w == "key") key(st, toks);
         else if (w == "mesh") one_pass_shape(st, toks, ShapeKind::Mesh);
         else if (auto kind = shape_from_word(w)) one_pass_shape(st, toks, *kind);
         else
@@ -763,6 +783,7 @@ class Parser {
             else if (k == "degree") s.degree = st.integer(a, 0, 5);
             else if (k == "cutoff") s.cutoff = st.in_closed(a, 0.0, 1.0);
             else if (k == "output") s.output = std::string(a.value);
+            else if (k == "frames") frame_range(st, a, s.frames_first, s.frames_last);
             else if (k == "sampler") {
                 if (a.value == "stratified") s.pattern = SamplePattern::Stratified;
                 else if (a.value == "grid") s.pattern = SamplePattern::Grid;
@@ -821,11 +842,12 @@ class Parser {
     void camera(Statement& st, const std::vector<Token>& toks) {
         st.read_args(toks, 1, kCameraKeys);
         Camera cam;
-        if (!st.args.empty()) {
-            const Arg& first = st.args.front();
+        const auto named = [](const Arg& a) { return same(a.key, "name"); };
+        if (const auto it = std::find_if_not(st.args.begin(), st.args.end(), named); it != st.args.end()) {
+            const Arg& first = *it;
             const bool look_at = contains(kLookAtKeys, first.key);
             for (const Arg& a : st.args)
-                if (contains(kLookAtKeys, a.key) != look_at)
+                if (!named(a) && contains(kLookAtKeys, a.key) != look_at)
                     st.fail(a.key_col, "camera: " + quote(a.key) + " belongs to the " +
                                            (look_at ? "explicit" : "look-at") + " form but " +
                                            quote(first.key) + " chose the " +
@@ -868,6 +890,7 @@ class Parser {
             if (singular(cam.md)) st.fail_here("camera: the composed transform is singular");
         }
         scene.camera = cam;
+        if (const Arg* n = st.find("name")) name_thing(st.file(), st.line(), *n, Named::Camera, 0);
     }
 
     void light(Statement& st, const std::vector<Token>& toks) {
@@ -902,6 +925,8 @@ class Parser {
         if (needs_pos && !st.find("pos")) st.fail_here("light " + kind + " needs 'pos=x,y,z'");
         if (needs_dir && !st.find("dir")) st.fail_here("light " + kind + " needs 'dir=x,y,z'");
         scene.lights.push_back(l);
+        if (const Arg* n = st.find("name"))
+            name_thing(st.file(), st.line(), *n, Named::Light, std::uint32_t(scene.lights.size() - 1));
     }
 
     /// The material named by `a`, as defined at this statement: the chunked reader has read
@@ -956,7 +981,8 @@ class Parser {
         const std::uint32_t file = file_index(st.file());
         Object obj;
         ObjectLoc loc;
-        shape(st, toks, kind, file, scene_materials_, obj, loc);
+        const std::optional<Arg> name = shape(st, toks, kind, file, scene_materials_, obj, loc);
+        if (name) name_thing(st.file(), st.line(), *name, Named::Object, std::uint32_t(scene.objects.size()));
         scene.objects.push_back(obj);
         scene.object_locs.push_back(loc);
     }
@@ -972,9 +998,9 @@ class Parser {
     }
     std::uint32_t last_file_ = 0;
 
-    /// Reads a shape statement into `out` and `loc`.
-    void shape(Statement& st, const std::vector<Token>& toks, ShapeKind kind, std::uint32_t file,
-               MaterialList& materials, Object& out, ObjectLoc& loc) {
+    /// Reads a shape statement into `out` and `loc`; its `name=` argument, if any.
+    std::optional<Arg> shape(Statement& st, const std::vector<Token>& toks, ShapeKind kind, std::uint32_t file,
+                             MaterialList& materials, Object& out, ObjectLoc& loc) {
         st.read_args(toks, 1, shape_keys(kind));
         ShapeFields f;
         f.kind = kind;
@@ -982,7 +1008,7 @@ class Parser {
         f.param = param.default_value;
         if (const Arg* base = st.find("material")) f.look = lookup_material(st, *base);
         for (const Arg& a : st.args) {
-            if (same(a.key, "material")) continue;
+            if (same(a.key, "material") || same(a.key, "name")) continue;
             if (apply_material_key(st, a, f.look)) continue;
             if (apply_transform_key(st, a, f.md)) continue;
             if (param.present() && same(a.key, param.key)) f.param = st.positive(a);
@@ -997,6 +1023,8 @@ class Parser {
             st.fail_here(std::string(st.word()) +
                          ": the composed transform is singular (or not finite)");
         make_object(st, f, file, materials, out, loc);
+        if (const Arg* n = st.find("name")) return *n;
+        return std::nullopt;
     }
 
     /// The mesh of an OBJ file named relative to the statement's file, read once per file:
@@ -1050,6 +1078,169 @@ class Parser {
         if (options_.copies) options_.copies->push_back(FileCopy{shown, std::string(text.text())});
         read_text(text.text(), shown, id, depth + 1);
     }
+
+    // ---- animation: name= and the key statement (docs/scene-format.md, "Animation") ------
+    enum class Named : std::uint8_t { Object, Light, Camera };
+    struct NameDef {
+        Named what;
+        std::uint32_t index;  // in scene.objects or scene.lights
+        int line;
+    };
+    std::map<std::string, NameDef, std::less<>> names_;  // one namespace for objects, lights, camera
+    std::map<std::pair<std::string, int>, int> key_lines_;  // (name, frame) -> line of its key
+    std::unordered_map<std::uint32_t, std::size_t> object_tracks_, light_tracks_;  // index -> track
+
+    static const char* named_word(Named w) {
+        return w == Named::Object ? "object" : w == Named::Light ? "light" : "camera";
+    }
+
+    /// Records `name=` of a statement at file:line; names are unique across objects, lights
+    /// and the camera.
+    void name_thing(const std::string& file, int line, const Arg& a, Named what, std::uint32_t index) {
+        const auto fail = [&](std::string_view msg) { throw SceneError(SourceLoc{file, line, a.value_col}, msg); };
+        const std::string_view n = a.value;
+        const auto word_char = [](char c) {
+            return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+                   c == '-' || c == '.';
+        };
+        if (!(std::isalpha(static_cast<unsigned char>(n[0])) || n[0] == '_') ||
+            !std::all_of(n.begin(), n.end(), word_char) || n.size() > 64)
+            fail("a name starts with a letter or '_' and holds letters, digits, '_', '-' or '.' (at most 64), got " +
+                 quote(n));
+        if (const auto it = names_.find(n); it != names_.end())
+            fail("name " + quote(n) + " is already given to the " + named_word(it->second.what) + " of line " +
+                 std::to_string(it->second.line));
+        names_.emplace(std::string(n), NameDef{what, index, line});
+    }
+
+    Animation& animation() {
+        if (!scene.animation) scene.animation = std::make_shared<Animation>();
+        return *scene.animation;
+    }
+
+    /// key NAME frame=F k=v...: one key at frame F for each quantity given.
+    void key(Statement& st, const std::vector<Token>& toks) {
+        if (toks.size() < 2 || toks[1].text.find('=') != std::string_view::npos)
+            st.fail(toks.size() < 2 ? toks[0].column : toks[1].column,
+                    "expected a name after 'key' (given with name= on an object, a light or the camera)");
+        const Token& nt = toks[1];
+        const auto it = names_.find(nt.text);
+        if (it == names_.end())
+            st.fail(nt.column, "key for an unknown name " + quote(nt.text) +
+                                   " (name= on an object, light or camera before this line)");
+        const NameDef& def = it->second;
+        st.read_args(toks, 2, kKeyKeys);
+        const std::vector<std::string_view>& fits = def.what == Named::Object  ? kObjectKeyKeys
+                                                    : def.what == Named::Light ? kLightKeyKeys
+                                                                               : kCameraKeyKeys;
+        const std::string who = std::string(named_word(def.what)) + " " + quote(nt.text);
+        for (const Arg& a : st.args)
+            if (!contains(fits, a.key)) {
+                std::string msg = "key: " + quote(a.key) + " does not fit the " + who + " (expected one of:";
+                for (auto k : fits) (msg += ' ') += k;
+                st.fail(a.key_col, msg + ")");
+            }
+        const Arg* fa = st.find("frame");
+        if (!fa) st.fail_here("key needs 'frame=F' (an integer >= 0)");
+        const int frame = st.integer(*fa, 0, kMaxFrame);
+        if (st.args.size() < 2) st.fail_here("key: nothing keyed at frame " + std::to_string(frame) + " for " + who);
+        const auto [seen, added] = key_lines_.try_emplace({std::string(nt.text), frame}, st.line());
+        if (!added)
+            st.fail(fa->value_col, who + " already has a key at frame " + std::to_string(frame) + " (line " +
+                                       std::to_string(seen->second) + ")");
+        Animation& anim = animation();
+        if (def.what == Named::Object) {
+            const auto [t, fresh] = object_tracks_.try_emplace(def.index, anim.objects.size());
+            if (fresh) {
+                anim.objects.emplace_back();
+                anim.objects.back().object = def.index;
+                anim.objects.back().base = scene.objects[def.index].md;
+            }
+            ObjectTrack& tr = anim.objects[t->second];
+            for (const Arg& a : st.args) {
+                if (same(a.key, "translate")) tr.translate.add(frame, st.vec3(a));
+                else if (same(a.key, "scale")) {
+                    const glm::dvec3 sc = st.scale(a);
+                    if (!(sc.x > 0 && sc.y > 0 && sc.z > 0))
+                        st.fail(a.value_col, "a keyed scale must be > 0 in every component, got " + quote(a.value));
+                    tr.scale.add(frame, sc);
+                } else if (same(a.key, "rotate")) tr.rotate.add(frame, rotation(st, a));
+            }
+            // Md at every key of the object stays usable (interpolation stays between them).
+            for (const auto* track : {&tr.translate.frames, &tr.scale.frames, &tr.rotate.frames})
+                for (const int f : *track)
+                    if (singular(keyed_transform(tr, f) * glm::dmat4(tr.base)))
+                        st.fail_here("key: the " + who + "'s transform at frame " + std::to_string(f) +
+                                     " is singular or not finite");
+        } else if (def.what == Named::Light) {
+            const auto [t, fresh] = light_tracks_.try_emplace(def.index, anim.lights.size());
+            if (fresh) {
+                anim.lights.emplace_back();
+                anim.lights.back().light = def.index;
+            }
+            LightTrack& tr = anim.lights[t->second];
+            for (const Arg& a : st.args) {
+                if (same(a.key, "pos")) {
+                    if (scene.lights[def.index].kind == LightKind::Directional)
+                        st.fail(a.key_col, "key: the " + who + " is directional: it has no 'pos'");
+                    tr.pos.add(frame, st.vec3(a));
+                } else if (same(a.key, "color")) tr.color.add(frame, st.color(a));
+            }
+        } else {
+            if (!scene.camera.look_at)
+                st.fail(nt.column, "key: the " + who + " has the explicit form; keys need the look-at form (eye=, look=)");
+            CameraTrack& tr = anim.camera;
+            for (const Arg& a : st.args) {
+                if (same(a.key, "eye")) tr.eye.add(frame, st.vec3(a));
+                else if (same(a.key, "look")) tr.look.add(frame, st.vec3(a));
+                else if (same(a.key, "fov")) tr.fov.add(frame, st.in_open(a, 0.0, 180.0));
+            }
+            // The camera at this key's frame passes the camera statement's checks.
+            Camera c = scene.camera;
+            if (!tr.eye.empty()) c.eye = sample(tr.eye, frame);
+            if (!tr.look.empty()) c.look = sample(tr.look, frame);
+            if (!tr.fov.empty()) c.fov = sample(tr.fov, frame);
+            const glm::dvec3 fwd = c.look - c.eye;
+            if (!(glm::length(fwd) > 0.0) || !std::isfinite(glm::length(fwd)) ||
+                !(glm::length(glm::cross(glm::normalize(fwd), c.up)) > 1e-9) ||
+                singular(c.world_from_canonical(1, 1)))
+                st.fail_here("key: at frame " + std::to_string(frame) +
+                             " the camera's eye and look coincide, or the view is parallel to 'up'");
+            camera_key_ = st.where();
+        }
+    }
+    SourceLoc camera_key_;  // the last camera key, for an interpolated camera that degenerates
+
+    /// rotate=ax,ay,az,degrees: a rotation about a non-zero axis, as a unit quaternion.
+    static glm::dquat rotation(const Statement& st, const Arg& a) {
+        const auto comma = a.value.rfind(',');
+        const auto axis = comma == std::string_view::npos ? std::nullopt : to_vec3(a.value.substr(0, comma));
+        const auto deg = comma == std::string_view::npos ? std::nullopt : to_number(a.value.substr(comma + 1));
+        if (!axis || !deg)
+            st.fail(a.value_col, "expected an axis and an angle ax,ay,az,degrees for 'rotate', got " + quote(a.value));
+        const double len = glm::length(*axis);
+        if (!(len > 0.0) || !std::isfinite(len))
+            st.fail(a.value_col, "the axis of 'rotate' must be a non-zero vector, got " + quote(a.value));
+        return glm::angleAxis(*deg * (3.14159265358979323846 / 180.0), *axis / len);
+    }
+
+    /// image frames=A..B.
+    static void frame_range(const Statement& st, const Arg& a, int& first, int& last) {
+        std::string why;
+        if (!parse_frame_range(a.value, first, last, why)) st.fail(a.value_col, "'frames': " + why);
+    }
+
+  public:
+    /// After the whole text: the scene is put at frame 0 (a still picture of an animated
+    /// scene is frame 0).
+    void finish() {
+        if (!scene.animation) return;
+        try {
+            set_frame(scene, 0);
+        } catch (const UsageError& e) {
+            throw SceneError(camera_key_, e.what());
+        }
+    }
 };
 
 }  // namespace
@@ -1063,6 +1254,7 @@ Scene load_scene(const std::string& path, const ReadOptions& options) {
         Parser p(options);
         p.scene.path = path;
         p.read_top(text.text(), path, identity_of(path), text.mapped());
+        p.finish();
         return std::move(p.scene);
     });
 }
@@ -1078,6 +1270,7 @@ Scene parse_scene(std::string_view text, const std::string& name, const ReadOpti
         Parser p(options);
         p.scene.path = name;
         p.read_top(text, name, identity_of(name.empty() ? fs::path("<memory>") : fs::path(name)), false);
+        p.finish();
         return std::move(p.scene);
     });
 }

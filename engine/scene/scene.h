@@ -19,6 +19,7 @@
 namespace streamrt {
 
 struct Mesh;
+struct Animation;  // scene/animation.h
 
 
 /// A material's optical parameters (the handout's ambi, diff, refl, trans and their
@@ -121,6 +122,12 @@ struct RenderSettings {
     Tonemap tonemap = Tonemap::Clamp;
     double exposure = 1.0;  ///< > 0, multiplies the linear values before the tone curve
     ExrPixels exr = ExrPixels::Half;
+
+    // ---- animation (scene/animation.h) ----
+    /// `image frames=A..B`: the frames rendered by default (frames_last < frames_first: none
+    /// given, one picture of frame 0).
+    int frames_first = 0, frames_last = -1;
+    bool has_frames() const { return frames_last >= frames_first; }
 };
 
 struct Scene {
@@ -134,6 +141,9 @@ struct Scene {
     /// Cold data, for messages only: the statement of each object (same indexing as objects).
     std::vector<ObjectLoc> object_locs;
     std::vector<std::string> files;  ///< the files objects came from (ObjectLoc::file)
+    /// The keys of `key` statements (scene/animation.h); null for a scene without keys. The
+    /// scene as read is at frame 0; set_frame() puts it at another.
+    std::shared_ptr<Animation> animation;
 
     const Material& material_of(const Object& o) const { return materials[o.material]; }
     /// The object's mesh (Mesh objects only; nullptr otherwise).

@@ -64,6 +64,7 @@ std::unique_ptr<SceneBvh> SceneBvh::build(const Scene& scene, const BuildOptions
     });
     for (std::size_t i = 0; i < n; ++i)
         if (boxes[i].empty()) s->unbounded.push_back(std::uint32_t(i));
+    s->bounded = n - s->unbounded.size();
     s->bvh = Bvh::build(std::move(boxes), options);
     return s;
 }
@@ -78,6 +79,33 @@ std::unique_ptr<SceneBvh> SceneBvh::build_for(const Scene& scene, const AccelCon
         if (bounded < config.min_objects) return nullptr;
     }
     return build(scene, config.build, shift);
+}
+
+bool SceneBvh::refit_pays(std::size_t moved, const AccelConfig& config) const {
+    // Counted over every refit since the build: a tree refitted frame after frame degrades
+    // however few objects move each time, so it is rebuilt once enough have moved in all.
+    return double(refitted_ + moved) <= config.refit_max_share * double(bounded);
+}
+
+void SceneBvh::refit(const Scene& scene, std::span<const std::uint32_t> moved, std::span<const std::uint32_t> order,
+                     const glm::dvec3& shift) {
+    if (!links_) {
+        links_ = std::make_unique<BvhLinks>(bvh, order.size());
+        position_.assign(scene.objects.size(), ~0u);
+        for (std::size_t p = 0; p < order.size(); ++p) position_[order[p]] = std::uint32_t(p);
+    }
+    refitted_ += moved.size();
+    std::vector<std::uint32_t> positions;
+    positions.reserve(moved.size());
+    for (const std::uint32_t i : moved)
+        if (position_[i] != ~0u && links_->leaf_node[position_[i]] >= 0) positions.push_back(position_[i]);
+    accel::refit(bvh, *links_, positions, [&](std::uint32_t p) {
+        const Object& o = scene.objects[order[p]];
+        double lo[3], hi[3];
+        if (!object_world_bounds(o, scene.mesh_of(o), lo, hi)) return Aabb{};
+        for (int a = 0; a < 3; ++a) lo[a] -= shift[a], hi[a] -= shift[a];
+        return conservative_box(lo, hi);
+    });
 }
 
 }  // namespace streamrt::accel

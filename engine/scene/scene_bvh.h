@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "accel/bvh.h"
@@ -38,6 +39,10 @@ struct AccelConfig {
     Traversal secondary = Traversal::Packet;  ///< reflected and refracted rays (packets measured faster, docs/performance.md)
     Traversal shadow = Traversal::Packet;
     BuildOptions build;
+    /// Animation (scene/animation.h): frames refit the hierarchy while the objects moved since
+    /// it was built (summed over frames) are at most this share of its objects, and rebuild
+    /// it otherwise (docs/performance.md, "## Animation"). 0: always rebuild.
+    double refit_max_share = 0.25;
 };
 AccelConfig& accel_config();
 
@@ -45,6 +50,7 @@ AccelConfig& accel_config();
 struct SceneBvh {
     Bvh bvh;                               ///< prim_index holds object indices
     std::vector<std::uint32_t> unbounded;  ///< objects tested separately (planes)
+    std::size_t bounded = 0;               ///< objects in the hierarchy
 
     /// nullptr when the configuration says this scene is traced flat.
     /// shift: the hierarchy is built for the scene translated by -shift (the stream engine
@@ -54,6 +60,22 @@ struct SceneBvh {
     /// The hierarchy regardless of the mode.
     static std::unique_ptr<SceneBvh> build(const Scene& scene, const BuildOptions& options = {},
                                            const glm::dvec3& shift = glm::dvec3(0.0));
+
+    // ---- animation: per-frame update (scene/animation.h) ----
+    /// Whether moving `moved` more of the hierarchy's objects is refitted (true) or rebuilt:
+    /// refitted while all the objects moved since the build, these included, are at most
+    /// config.refit_max_share of the hierarchy's.
+    bool refit_pays(std::size_t moved, const AccelConfig& config = accel_config()) const;
+    /// Refits the boxes of the scene objects `moved` (scene indices; unbounded ones are
+    /// skipped) at their current Md. `order` maps a leaf position to its scene index
+    /// (bvh.prim_index, or the stream engine's copy of it); shift as in build().
+    void refit(const Scene& scene, std::span<const std::uint32_t> moved, std::span<const std::uint32_t> order,
+               const glm::dvec3& shift = glm::dvec3(0.0));
+
+  private:
+    std::unique_ptr<BvhLinks> links_;       ///< built on the first refit
+    std::vector<std::uint32_t> position_;   ///< scene index -> leaf position (~0u: unbounded)
+    std::size_t refitted_ = 0;              ///< objects moved by refits since the build (with repeats)
 };
 
 }  // namespace streamrt::accel

@@ -22,10 +22,10 @@ KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t i
     return k;
 }
 
-std::shared_ptr<const StreamAccel> StreamAccel::build_for(const Scene& scene, const glm::dvec3& shift) {
+std::shared_ptr<StreamAccel> StreamAccel::build_for(const Scene& scene, const glm::dvec3& shift) {
     auto bvh = accel::SceneBvh::build_for(scene, accel::accel_config(), shift);
     if (!bvh) return nullptr;
-    return std::make_shared<const StreamAccel>(scene, std::move(bvh), shift);
+    return std::make_shared<StreamAccel>(scene, std::move(bvh), shift);
 }
 
 StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh, const glm::dvec3& shift)
@@ -69,6 +69,35 @@ void StreamAccel::any(const KernelTable& kt, RayView rays) const {
     const AccelKernelTable& at = accel_kernel_table(kt.isa);
     const AccelView view{bvh_->bvh.nodes.data(), objects_.data()};
     (shadow_ == accel::Traversal::Packet ? at.any_packet : at.any_single)(view, rays);
+}
+
+// ---- animation: per-frame update ----
+bool StreamAccel::update(const Scene& scene, std::span<const std::uint32_t> moved, const glm::dvec3& shift, bool all) {
+    if (!all && !bvh_->refit_pays(moved.size())) return false;
+    if (id_of_.empty()) {
+        id_of_.assign(scene.objects.size(), -1);
+        for (std::size_t id = 0; id < order_.size(); ++id) id_of_[order_[id]] = std::int32_t(id);
+    }
+    std::vector<std::uint32_t> every;
+    if (all) {
+        every.resize(scene.objects.size());
+        for (std::uint32_t i = 0; i < every.size(); ++i) every[i] = i;
+        moved = every;
+    }
+    parallel_for_index(moved.size(), 4096, [&](std::size_t k) {
+        const std::int32_t id = id_of_[moved[k]];
+        objects_[std::size_t(id)] = kernel_object(scene, moved[k], id, shift);
+    });
+    const std::size_t n_bounded = bvh_->bounded;
+    bool planes = false;
+    for (const std::uint32_t i : moved) planes = planes || std::size_t(id_of_[i]) >= n_bounded;
+    if (planes) {
+        for (auto& u : unbounded_) u.clear();
+        for (std::size_t id = n_bounded; id < order_.size(); ++id)
+            unbounded_[objects_[id].kind].push_back(objects_[id].xf);
+    }
+    bvh_->refit(scene, moved, std::span<const std::uint32_t>(order_.data(), n_bounded), shift);
+    return true;
 }
 
 }  // namespace streamrt

@@ -7,6 +7,7 @@
 // closest()/any() instead of their per-kind loops when a scene has one.
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "scene/scene_bvh.h"
@@ -25,7 +26,7 @@ class StreamAccel {
   public:
     /// nullptr when the scene is traced without the hierarchy (accel_config()).
     /// For the scene translated by -shift (the stream engine renders relative to the eye).
-    static std::shared_ptr<const StreamAccel> build_for(const Scene& scene, const glm::dvec3& shift = glm::dvec3(0.0));
+    static std::shared_ptr<StreamAccel> build_for(const Scene& scene, const glm::dvec3& shift = glm::dvec3(0.0));
     StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh, const glm::dvec3& shift = glm::dvec3(0.0));
 
     /// Closest hit of every ray (see ClosestHitFn); `coherent` picks the configured traversal
@@ -43,12 +44,21 @@ class StreamAccel {
     const accel::SceneBvh& scene_bvh() const { return *bvh_; }
     std::size_t memory_bytes() const;
 
+    /// Animation: the scene objects `moved` (scene indices) have a new Md, and the engine's
+    /// origin is now -shift. Rewrites their records and refits the hierarchy over them, and
+    /// returns true; false (nothing done) when so many moved that the caller should build a
+    /// new StreamAccel instead (SceneBvh::refit_pays). `all`: every object moved (the eye
+    /// moved), refitted whatever their number (a translation of everything keeps the tree's
+    /// quality).
+    bool update(const Scene& scene, std::span<const std::uint32_t> moved, const glm::dvec3& shift, bool all);
+
   private:
     std::unique_ptr<accel::SceneBvh> bvh_;
     FillLaterVec<KernelObject> objects_;                ///< by id: leaf order, then unbounded
     std::vector<std::uint32_t> order_;                  ///< id -> scene index
     std::vector<ObjectXf> unbounded_[kShapeKindCount];  ///< per kind, outside the hierarchy
     accel::Traversal primary_, secondary_, shadow_;
+    std::vector<std::int32_t> id_of_;  ///< scene index -> id; built on the first update
 };
 
 }  // namespace streamrt

@@ -35,6 +35,10 @@ class StreamRenderer {
     /// Fills the profile's description of the run: wall time, threads, kernels and stages.
     void describe(StreamProfile& profile, double wall_seconds, int threads) const;
 
+    /// Animation: `scene` (the one this renderer was made for) was put at another frame;
+    /// only what `change` names is converted again (StreamScene::update).
+    void update(const Scene& scene, const FrameChange& change) { scene_.update(scene, change); }
+
     /// Names of the stages and kernels this scene's pipeline is built from.
     std::vector<std::string> built_stages() const;
 

@@ -31,6 +31,16 @@ Scene camera_relative_to_eye(const Scene& scene, glm::dvec3& eye) {
     return r;
 }
 
+/// The checker's cell_offset of material m for an engine origin at `eye`: e / cell modulo
+/// the pattern's period of 2 cells, in [0, 2).
+glm::vec3 cell_offset(const Material& m, const glm::dvec3& eye) {
+    const auto period = [&](double e) {
+        const double c = e / m.cell;
+        return float(c - 2.0 * std::floor(c * 0.5));
+    };
+    return {period(eye.x), period(eye.y), period(eye.z)};
+}
+
 }  // namespace
 
 StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
@@ -38,6 +48,7 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
     // doubled the memory and the set-up time).
     glm::dvec3 eye;
     camera = CameraRays<float>::from(camera_relative_to_eye(scene, eye));
+    eye_ = eye;
     const RenderSettings& s = scene.settings;
     background = {float(s.background.x), float(s.background.y), float(s.background.z)};
     meshes = scene.meshes;
@@ -49,7 +60,53 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
     if (accel) {
         objects = accel->objects().data();
     } else {
-        // The handout's loop over every object, per kind, with a box per object for culling.
+        convert_flat(scene);
+    }
+    object_count = n;
+    fill_surfaces(scene);
+
+    bool any_refl = false, any_trans = false;
+    for (const Material& m : scene.materials) {
+        MaterialT<float> mat = MaterialT<float>::from(m);
+        const glm::vec3 offset = cell_offset(m, eye);
+        mat.cell_offset = {offset.x, offset.y, offset.z};
+        materials.push_back(mat);
+        any_refl |= m.refl > 0;
+        any_trans |= m.trans > 0;
+    }
+    convert_lights(scene);
+    features.lighting = s.degree >= 1;
+    features.shadows = s.degree >= 5 && !lights.empty();
+    features.reflect = s.degree >= 3 && s.depth >= 1 && any_refl;
+    features.refract = s.degree >= 4 && s.depth >= 1 && any_trans;
+    features.jitter = s.spp > 1;
+}
+
+void StreamScene::fill_surfaces(const Scene& scene) {
+    const std::size_t n = scene.objects.size();
+    surfaces.resize(n);
+    want_huge_pages(surfaces.data(), n);
+    parallel_for_index(n, 4096, [&](std::size_t id) {
+        const Object& o = scene.objects[accel ? accel->scene_index(std::int32_t(id)) : id];
+        surfaces[id] = {{o.color.x, o.color.y, o.color.z}, o.material};
+    });
+}
+
+void StreamScene::convert_lights(const Scene& scene) {
+    lights.clear();
+    for (Light l : scene.lights) {
+        l.pos -= eye_;
+        lights.push_back(LightT<float>::from(l));
+    }
+}
+
+void StreamScene::convert_flat(const Scene& scene) {
+    // The handout's loop over every object, per kind, with a box per object for culling.
+    const glm::dvec3 eye = eye_;
+    const std::size_t n = scene.objects.size();
+    std::fill(std::begin(group_bounded), std::end(group_bounded), true);
+    for (int k = 0; k < kShapeKindCount; ++k) groups[k].clear(), group_bounds[k].clear();
+    {
         flat_objects_.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
             const Object& o = scene.objects[i];
@@ -76,35 +133,28 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
         }
         objects = flat_objects_.data();
     }
-    object_count = n;
-    surfaces.resize(n);
-    want_huge_pages(surfaces.data(), n);
-    parallel_for_index(n, 4096, [&](std::size_t id) {
-        const Object& o = scene.objects[accel ? accel->scene_index(std::int32_t(id)) : id];
-        surfaces[id] = {{o.color.x, o.color.y, o.color.z}, o.material};
-    });
+}
 
-    bool any_refl = false, any_trans = false;
-    for (const Material& m : scene.materials) {
-        MaterialT<float> mat = MaterialT<float>::from(m);
-        const auto period = [&](double e) {  // e / cell modulo 2, in [0, 2)
-            const double c = e / m.cell;
-            return float(c - 2.0 * std::floor(c * 0.5));
-        };
-        mat.cell_offset = {period(eye.x), period(eye.y), period(eye.z)};
-        materials.push_back(mat);
-        any_refl |= m.refl > 0;
-        any_trans |= m.trans > 0;
+// ---- animation: per-frame update ----
+void StreamScene::update(const Scene& scene, const FrameChange& change) {
+    glm::dvec3 eye = eye_;
+    if (change.camera) camera = CameraRays<float>::from(camera_relative_to_eye(scene, eye));
+    const bool shifted = eye != eye_;
+    eye_ = eye;
+    if (change.lights || shifted) convert_lights(scene);
+    if (shifted)
+        for (std::size_t m = 0; m < materials.size(); ++m) {
+            const glm::vec3 offset = cell_offset(scene.materials[m], eye);
+            materials[m].cell_offset = {offset.x, offset.y, offset.z};
+        }
+    if (!shifted && change.objects.empty()) return;
+    if (!accel) {
+        convert_flat(scene);  // O(N): few objects, unless --accel flat forces the flat loops
+    } else if (!accel->update(scene, change.objects, eye, shifted)) {
+        accel = StreamAccel::build_for(scene, eye);
+        objects = accel->objects().data();
+        fill_surfaces(scene);  // ids follow the new leaf order
     }
-    for (Light l : scene.lights) {
-        l.pos -= eye;
-        lights.push_back(LightT<float>::from(l));
-    }
-    features.lighting = s.degree >= 1;
-    features.shadows = s.degree >= 5 && !lights.empty();
-    features.reflect = s.degree >= 3 && s.depth >= 1 && any_refl;
-    features.refract = s.degree >= 4 && s.depth >= 1 && any_trans;
-    features.jitter = s.spp > 1;
 }
 
 }  // namespace streamrt

@@ -9,6 +9,7 @@
 #include "mesh/mesh.h"
 #include "render/camera_rays.h"
 #include "render/shading.h"
+#include "scene/animation.h"
 #include "scene/scene.h"
 #include "stream/stream_accel.h"
 
@@ -45,17 +46,25 @@ struct StreamScene {
     ColorT<float> background;
     /// The object hierarchy, when the scene is traced with one (stream/stream_accel.h); the
     /// intersect and occlusion stages then use it instead of `groups`, and it owns `objects`.
-    std::shared_ptr<const StreamAccel> accel;
+    std::shared_ptr<StreamAccel> accel;
     /// The meshes the objects use (kept alive here: the objects' records point into them).
     std::vector<std::shared_ptr<const Mesh>> meshes;
     bool has_meshes = false;
 
     explicit StreamScene(const Scene& scene);
+
+    /// Animation (scene/animation.h): `scene` was put at another frame; brings the tables up
+    /// to it, converting only what `change` names (all objects when the eye moved).
+    void update(const Scene& scene, const FrameChange& change);
     StreamScene(const StreamScene&) = delete;  // `objects` may point into flat_objects_
     StreamScene& operator=(const StreamScene&) = delete;
 
   private:
     std::vector<KernelObject> flat_objects_;  ///< `objects` without a hierarchy
+    glm::dvec3 eye_{0.0};                     ///< the world position of the engine's origin
+    void convert_flat(const Scene& scene);    ///< fills flat_objects_, groups and their bounds
+    void convert_lights(const Scene& scene);
+    void fill_surfaces(const Scene& scene);   ///< by id: colour and material
 };
 
 }  // namespace streamrt

@@ -638,3 +638,100 @@ TEST_CASE("cli: a killed render leaves no image and no temporary file") {
     CHECK(WIFSIGNALED(status));
     CHECK(d.files() == std::vector<std::string>{"long.cfg"});
 }
+
+// ---- animation: --frames, image frames=, output patterns, shards of a frame ----------------
+namespace {
+
+const char* kAnimScene =
+    "image width=40 height=20 spp=1 depth=1 degree=5 output=out.pfm\n"
+    "camera eye=0,0,6 look=0,0,0 fov=40\n"
+    "light point pos=5,8,5\n"
+    "sphere name=ball color=1,0.2,0.1 scale=0.6\n"
+    "key ball frame=0 translate=-2,0,0\n"
+    "key ball frame=10 translate=2,0,0\n";
+
+/// The column average of the pixels the red ball covers (red well above green).
+double ball_column(const streamrt::Framebuffer& img) {
+    double sum = 0, n = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x)
+            if (img.pixel(x, y)[0] > img.pixel(x, y)[1] + 0.2f) sum += x, n += 1;
+    REQUIRE(n > 0);
+    return sum / n;
+}
+
+}  // namespace
+
+TEST_CASE("cli: --frames A..B writes one picture per frame to the %d pattern") {
+    Dir d;
+    const fs::path scene = d.write("a.cfg", kAnimScene);
+    const Run r = run_streamrt("-q " + q(scene) + " --frames 2..4 -o " + q(d.path / "out_%04d.pfm"));
+    REQUIRE(r.code == 0);
+    CHECK(!fs::exists(d.path / "out_0001.pfm"));
+    CHECK(!fs::exists(d.path / "out_0005.pfm"));
+    double previous = -1;
+    for (int f = 2; f <= 4; ++f) {
+        CAPTURE(f);
+        const fs::path out = d.path / ("out_000" + std::to_string(f) + ".pfm");
+        REQUIRE(fs::exists(out));
+        const streamrt::Framebuffer written = streamrt::read_image(out.string());
+        // The frame the command wrote is the scene put at that frame, rendered here.
+        streamrt::Scene at = streamrt::load_scene(scene.string());
+        streamrt::set_frame(at, f);
+        streamrt::Parallelism par(2);
+        const streamrt::Framebuffer here = streamrt::render_scene(at, streamrt::EngineKind::Stream, par).image;
+        CHECK(written.rgb == here.rgb);
+        // The ball moves right by 0.4 units a frame.
+        const double column = ball_column(written);
+        CHECK(column > previous + 1.0);
+        previous = column;
+    }
+    // image frames= in the scene does the same without --frames.
+    const fs::path scene2 = d.write("b.cfg", std::string(kAnimScene) + "image frames=0..1 output=b_%d.pfm\n");
+    const Run r2 = run_streamrt("-q " + q(scene2) + " -o " + q(d.path / "b_%d.pfm"));
+    CHECK(r2.code == 0);
+    CHECK(fs::exists(d.path / "b_0.pfm"));
+    CHECK(fs::exists(d.path / "b_1.pfm"));
+}
+
+TEST_CASE("cli: bad frame ranges and output names are one-line errors, exit 2") {
+    Dir d;
+    const fs::path scene = d.write("a.cfg", kAnimScene);
+    const Run back = run_streamrt(q(scene) + " --frames 10..2 -o " + q(d.path / "o_%d.png"));
+    CHECK(back.code == 2);
+    check_one_line_error(back, "--frames 10..2: the range 10..2 runs backwards");
+    const Run neg = run_streamrt(q(scene) + " --frames -1..2 -o " + q(d.path / "o_%d.png"));
+    CHECK(neg.code == 2);
+    const Run nopattern = run_streamrt(q(scene) + " --frames 2..4 -o " + q(d.path / "o.png"));
+    CHECK(nopattern.code == 2);
+    check_one_line_error(nopattern, "several frames need one printf-style frame number in the name");
+    const fs::path bad = d.write("bad.cfg", std::string(kAnimScene) + "key nobody frame=2 translate=0,1,0\n");
+    const Run unknown = run_streamrt(q(bad) + " -o " + q(d.path / "o.png"));
+    CHECK(unknown.code == 2);
+    check_one_line_error(unknown, bad.string() + ":7:5: key for an unknown name 'nobody'");
+    const fs::path back2 = d.write("back.cfg", std::string(kAnimScene) + "image frames=10..2\n");
+    const Run r = run_streamrt(q(back2) + " -o " + q(d.path / "o_%d.png"));
+    CHECK(r.code == 2);
+    check_one_line_error(r, back2.string() + ":7:14: 'frames': the range 10..2 runs backwards");
+    CHECK(d.files().size() == 3);  // the scenes only: nothing written
+}
+
+TEST_CASE("cli: --frames composes with --shard: the merged parts of a frame are that frame") {
+    Dir d;
+    const fs::path scene = d.write("a.cfg", kAnimScene);
+    for (int k = 0; k < 2; ++k) {
+        const Run r = run_streamrt("-q " + q(scene) + " --frames 2..3 --shard " + std::to_string(k) + "/2 -o " +
+                                   q(d.path / ("p" + std::to_string(k) + "_%04d.part")));
+        REQUIRE(r.code == 0);
+    }
+    const Run whole = run_streamrt("-q " + q(scene) + " --frames 3 -o " + q(d.path / "whole_%d.pfm"));
+    REQUIRE(whole.code == 0);
+    const Run m = run_streamrt("merge -q " + q(d.path / "p0_0003.part") + " " + q(d.path / "p1_0003.part") + " -o " +
+                               q(d.path / "merged3.pfm"));
+    REQUIRE(m.code == 0);
+    CHECK(slurp(d.path / "merged3.pfm") == slurp(d.path / "whole_3.pfm"));
+    // Parts of different frames do not merge.
+    const Run mixed = run_streamrt("merge -q " + q(d.path / "p0_0002.part") + " " + q(d.path / "p1_0003.part") +
+                                   " -o " + q(d.path / "mixed.pfm"));
+    CHECK(mixed.code == 2);
+}
