@@ -290,6 +290,12 @@ class Statement {
             fail(a.value_col, quote(a.key) + " must be a non-zero vector, got " + quote(a.value));
         return d / len;
     }
+    bool boolean(const Arg& a) const {
+        if (same(a.value, "true")) return true;
+        if (!same(a.value, "false"))
+            fail(a.value_col, "expected true or false for " + quote(a.key) + ", got " + quote(a.value));
+        return false;
+    }
     /// One number (uniform) or x,y,z; no zero component.
     glm::dvec3 scale(const Arg& a) const {
         glm::dvec3 s;
@@ -316,7 +322,7 @@ class Statement {
 // ---- key vocabularies ------------------------------------------------------------------
 const std::vector<std::string_view> kMaterialKeys = {"color", "ambi",    "diff", "spec",
                                                      "shininess", "refl", "trans", "ior",
-                                                     "checker", "cell"};
+                                                     "checker", "cell", "fresnel"};
 const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rotate_y", "rotate_z",
                                                       "translate"};
 const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
@@ -326,6 +332,8 @@ const std::vector<std::string_view> kLookAtKeys = {"eye", "look", "up", "fov"};
 const std::vector<std::string_view> kExplicitCameraKeys = {"rx",       "ry",       "df",
                                                            "scale",    "rotate_x", "rotate_y",
                                                            "rotate_z", "translate"};
+/// Depth of field: keys of both camera forms.
+const std::vector<std::string_view> kLensKeys = {"aperture", "focus"};
 
 std::vector<std::string_view> join(std::initializer_list<std::vector<std::string_view>> lists) {
     std::vector<std::string_view> out;
@@ -334,7 +342,7 @@ std::vector<std::string_view> join(std::initializer_list<std::vector<std::string
 }
 
 // The joined lists, built once (the order is the one messages list them in).
-const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys});
+const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys, kLensKeys});
 const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
 const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys});
 const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth"}});
@@ -382,6 +390,7 @@ bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
         m.checker_color = st.color(a);
         m.checker = true;
     } else if (same(k, "cell")) m.cell = st.positive(a);
+    else if (same(k, "fresnel")) m.fresnel = st.boolean(a);
     else return false;
     return true;
 }
@@ -794,17 +803,24 @@ class Parser {
     void camera(Statement& st, const std::vector<Token>& toks) {
         st.read_args(toks, 1, kCameraKeys);
         Camera cam;
-        if (!st.args.empty()) {
-            const Arg& first = st.args.front();
+        // The lens keys belong to both forms; the first other key chooses the form.
+        const auto placing = std::find_if(st.args.begin(), st.args.end(),
+                                          [](const Arg& a) { return !contains(kLensKeys, a.key); });
+        if (placing != st.args.end()) {
+            const Arg& first = *placing;
             const bool look_at = contains(kLookAtKeys, first.key);
             for (const Arg& a : st.args)
-                if (contains(kLookAtKeys, a.key) != look_at)
+                if (!contains(kLensKeys, a.key) && contains(kLookAtKeys, a.key) != look_at)
                     st.fail(a.key_col, "camera: " + quote(a.key) + " belongs to the " +
                                            (look_at ? "explicit" : "look-at") + " form but " +
                                            quote(first.key) + " chose the " +
                                            (look_at ? "look-at" : "explicit") +
                                            " form; use one form per camera statement");
             cam.look_at = look_at;
+        }
+        for (const Arg& a : st.args) {  // depth of field
+            if (a.key == "aperture") cam.aperture = st.at_least_zero(a);
+            else if (a.key == "focus") cam.focus = st.positive(a);
         }
         if (cam.look_at) {
             const Arg* up = nullptr;
@@ -959,11 +975,8 @@ class Parser {
             if (apply_material_key(st, a, f.look)) continue;
             if (apply_transform_key(st, a, f.md)) continue;
             if (param.present() && same(a.key, param.key)) f.param = st.positive(a);
-            else if (same(a.key, "smooth")) {
-                if (same(a.value, "true")) f.smooth = true;
-                else if (same(a.value, "false")) f.smooth = false;
-                else st.fail(a.value_col, "expected true or false for 'smooth', got " + quote(a.value));
-            } else if (same(a.key, "file")) f.mesh = mesh_file(st, a);
+            else if (same(a.key, "smooth")) f.smooth = st.boolean(a);
+            else if (same(a.key, "file")) f.mesh = mesh_file(st, a);
         }
         if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
         if (singular(f.md))

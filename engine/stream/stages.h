@@ -55,12 +55,17 @@ struct MeshHits {
 struct GenerateScratch {
     AlignedVec<float> px, py, cell_x, cell_y;
     AlignedVec<std::uint32_t> key_pixel, key_sample;
-    void reserve(std::size_t n) {
+    AlignedVec<float> lens_x, lens_y;  ///< thin lens only: the lens lattice cells (else empty)
+    void reserve(std::size_t n, bool lens) {
         const std::size_t cap = simd::round_up_lanes(n);
         if (px.size() < cap) {
             for (auto* a : {&px, &py, &cell_x, &cell_y}) a->assign(cap, 0.f);
             key_pixel.assign(cap, 0);
             key_sample.assign(cap, 0);
+        }
+        if (lens && lens_x.size() < cap) {
+            lens_x.assign(cap, 0.f);
+            lens_y.assign(cap, 0.f);
         }
     }
 };
@@ -201,7 +206,8 @@ struct PipelineStages {
         const int spp = sc.settings.spp;
         const std::size_t n = std::size_t(n_pixels) * std::size_t(spp);
         rays.reserve(n);
-        g.reserve(n);
+        const bool lens = sc.features.lens;  // one scene-wide choice: the thin-lens kernel
+        g.reserve(n, lens);
         // Integer bookkeeping (pixel of each ray, sample index, lattice cell) in scalar code;
         // the hashing, jitter and camera directions in the SIMD kernel.
         const int cols = grid_columns(spp);
@@ -214,11 +220,19 @@ struct PipelineStages {
                 g.px[i] = float(x);
                 g.py[i] = float(y);
                 if constexpr (kJitter) {
-                    g.key_pixel[i] = pixel;
-                    g.key_sample[i] = std::uint32_t(k);
                     g.cell_x[i] = float(cx);
                     g.cell_y[i] = float(cy);
                     if (++cx == cols) cx = 0, ++cy;
+                }
+                if (kJitter || lens) {
+                    g.key_pixel[i] = pixel;
+                    g.key_sample[i] = std::uint32_t(k);
+                }
+                if (lens) {  // render/sampling.h's lens_cell
+                    int lx, ly;
+                    lens_cell(spp, pixel, k, lx, ly);
+                    g.lens_x[i] = float(lx);
+                    g.lens_y[i] = float(ly);
                 }
                 rays.pixel[i] = p;
                 rays.kind[i] = std::uint8_t(RayKind::Primary);
@@ -240,8 +254,10 @@ struct PipelineStages {
                         1.f / float(spp),
                         {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(),
                          rays.dz.data(), rays.t_max.data(), rays.wr.data(), rays.wg.data(), rays.wb.data(),
-                         rays.cone.data(), rays.pixel.data(), rays.kind.data(), &rays.count}};
-        kt.generate(job);
+                         rays.cone.data(), rays.pixel.data(), rays.kind.data(), &rays.count},
+                        g.lens_x.data(),
+                        g.lens_y.data()};
+        (lens ? kt.generate_lens : kt.generate)(job);
     }
 
     /// intersect: closest hit of every ray, one SIMD kernel per shape kind present.
