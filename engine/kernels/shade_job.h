@@ -72,7 +72,7 @@ struct GenerateJob {
     float weight;
     RayAppend out;
     /// Thin lens only (generate_lens): per ray, the sample's lattice cell on the lens
-    /// (render/sampling.h's lens_cell). Keys are then filled even at spp = 1.
+    /// (render/sampling.h's LensCells). Keys are then filled even at spp = 1.
     const float *lens_cell_x = nullptr, *lens_cell_y = nullptr;
 };
 using GenerateFn = void (*)(const GenerateJob& job);

@@ -85,35 +85,43 @@ inline PixelSample pixel_sample(SamplePattern pattern, int spp, std::uint64_t pi
 // cell index is integer bookkeeping, computed by the scalar driver in both engines; the
 // hashes, jitter and disc mapping run in SIMD lanes in the stream engine's generate kernel.
 
-/// A bijection of [0, n) chosen by seed: an invertible mix of the bits of [0, 2^b) (2^b the
-/// next power of two >= n), repeated until the value lands below n (cycle walking, so the
-/// restriction to [0, n) is still a bijection).
-inline std::uint32_t permute_index(std::uint32_t i, std::uint32_t n, std::uint32_t seed) {
-    if (n <= 1) return 0;
-    std::uint32_t mask = n - 1;
-    mask |= mask >> 1;
-    mask |= mask >> 2;
-    mask |= mask >> 4;
-    mask |= mask >> 8;
-    mask |= mask >> 16;
-    const std::uint32_t mul = hash32(seed) | 1u;  // odd: invertible modulo 2^b
-    const std::uint32_t add = hash32(seed ^ 0xa511e9b3u);
-    do {
-        i = (i * mul + add) & mask;
-        i ^= i >> 1;  // xor with a right shift: invertible, stays below 2^b
-        i = (i * 0x2c1b3c6du) & mask;
-        i ^= (i & mask) >> 3;
-    } while (i >= n);
-    return i;
-}
+/// The lens cells of one pixel's samples: a bijection of [0, spp) chosen by a hash of the
+/// pixel, an invertible mix of the bits of [0, 2^b) (2^b the next power of two >= spp)
+/// repeated until the value lands below spp (cycle walking, so the restriction to [0, spp)
+/// is still a bijection). Set up once per pixel; cell(k) per sample.
+class LensCells {
+  public:
+    LensCells(int spp, std::uint32_t pixel)
+        : n_(std::uint32_t(spp)), cols_(grid_columns(spp)) {
+        const std::uint32_t seed = pixel * 0x27d4eb2du + 0x165667b1u;
+        mul_ = hash32(seed) | 1u;  // odd: invertible modulo 2^b
+        add_ = hash32(seed ^ 0xa511e9b3u);
+        mask_ = n_ - 1;
+        for (int sh = 1; sh < 32; sh *= 2) mask_ |= mask_ >> sh;
+    }
+    /// The index in [0, spp) that sample k takes.
+    std::uint32_t index(std::uint32_t i) const {
+        if (n_ <= 1) return 0;
+        do {
+            i = (i * mul_ + add_) & mask_;
+            i ^= i >> 1;  // xor with a right shift: invertible, stays below 2^b
+            i = (i * 0x2c1b3c6du) & mask_;
+            i ^= i >> 3;
+        } while (i >= n_);
+        return i;
+    }
+    /// Lattice cell (column, row) on the lens of sample k.
+    void cell(int k, int& cx, int& cy) const {
+        const int j = int(index(std::uint32_t(k)));
+        cx = j % cols_;
+        cy = j / cols_;
+    }
 
-/// Lattice cell (column, row) on the lens of sample `sample` of `spp` in pixel `pixel`.
-inline void lens_cell(int spp, std::uint32_t pixel, int sample, int& cx, int& cy) {
-    const int cols = grid_columns(spp);
-    const int j = int(permute_index(std::uint32_t(sample), std::uint32_t(spp), pixel * 0x27d4eb2du + 0x165667b1u));
-    cx = j % cols;
-    cy = j / cols;
-}
+  private:
+    std::uint32_t n_;
+    int cols_;
+    std::uint32_t mul_ = 0, add_ = 0, mask_ = 0;
+};
 
 /// The two lens hashes of sample k of a pixel (independent of sample_hashes').
 template <class U>
@@ -152,14 +160,14 @@ inline PixelSampleT<V> concentric_disc(const V& u, const V& v) {
 }
 
 /// The point on the unit lens disc of sample `sample` of `spp` in pixel `pixel` (row-major
-/// index): the lattice of pixel_sample with the permuted cell of lens_cell, so grid puts
+/// index): the lattice of pixel_sample with the permuted cell of LensCells, so grid puts
 /// lens points at cell centres, stratified one per cell, random anywhere.
 inline PixelSample lens_sample(SamplePattern pattern, int spp, std::uint64_t pixel, int sample) {
     std::uint32_t h1, h2;
     lens_hashes(std::uint32_t(pixel), std::uint32_t(sample), h1, h2);
     const int cols = grid_columns(spp);
     int cx, cy;
-    lens_cell(spp, std::uint32_t(pixel), sample, cx, cy);
+    LensCells(spp, std::uint32_t(pixel)).cell(sample, cx, cy);
     const PixelSample q = lattice_sample(pattern, float(cx), float(cy), float(cols), float(spp / cols),
                                          unit_from_hash(h1), unit_from_hash(h2));
     return concentric_disc(q.x, q.y);

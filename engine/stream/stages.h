@@ -220,25 +220,34 @@ struct PipelineStages {
                 g.px[i] = float(x);
                 g.py[i] = float(y);
                 if constexpr (kJitter) {
+                    g.key_pixel[i] = pixel;
+                    g.key_sample[i] = std::uint32_t(k);
                     g.cell_x[i] = float(cx);
                     g.cell_y[i] = float(cy);
                     if (++cx == cols) cx = 0, ++cy;
-                }
-                if (kJitter || lens) {
-                    g.key_pixel[i] = pixel;
-                    g.key_sample[i] = std::uint32_t(k);
-                }
-                if (lens) {  // render/sampling.h's lens_cell
-                    int lx, ly;
-                    lens_cell(spp, pixel, k, lx, ly);
-                    g.lens_x[i] = float(lx);
-                    g.lens_y[i] = float(ly);
                 }
                 rays.pixel[i] = p;
                 rays.kind[i] = std::uint8_t(RayKind::Primary);
             }
         }
         rays.count = i;
+        if (lens) {  // a second pass, so a pinhole camera runs exactly the loop above
+            std::size_t j = 0;
+            for (int p = first; p < first + n_pixels; ++p) {
+                const int x = tile.x0 + p % tile.width(), y = tile.y0 + p / tile.width();
+                const std::uint32_t pixel =
+                    std::uint32_t(std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x));
+                const LensCells cells(spp, pixel);  // render/sampling.h
+                for (int k = 0; k < spp; ++k, ++j) {
+                    g.key_pixel[j] = pixel;  // also at spp = 1: the lens hashes need them
+                    g.key_sample[j] = std::uint32_t(k);
+                    int lx, ly;
+                    cells.cell(k, lx, ly);
+                    g.lens_x[j] = float(lx);
+                    g.lens_y[j] = float(ly);
+                }
+            }
+        }
         GenerateJob job{n,
                         g.px.data(),
                         g.py.data(),
