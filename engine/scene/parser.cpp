@@ -818,9 +818,12 @@ class Parser {
                                            " form; use one form per camera statement");
             cam.look_at = look_at;
         }
-        for (const Arg& a : st.args) {  // depth of field
-            if (a.key == "aperture") cam.aperture = st.at_least_zero(a);
-            else if (a.key == "focus") cam.focus = st.positive(a);
+        for (const Arg& a : st.args) {  // depth of field (the stream engine's lens is float)
+            if (a.key != "aperture" && a.key != "focus") continue;
+            const double v = a.key == "aperture" ? st.at_least_zero(a) : st.positive(a);
+            if (!(v <= double(std::numeric_limits<float>::max())))
+                st.fail(a.value_col, quote(a.key) + " must be at most 3.4e38 (single precision), got " + quote(a.value));
+            (a.key == "aperture" ? cam.aperture : cam.focus) = v;
         }
         if (cam.look_at) {
             const Arg* up = nullptr;

@@ -61,6 +61,7 @@ TEST_CASE("parser: lens and fresnel errors at line:column") {
     expect_error_at("camera focus=0", 1, 14, "'focus' must be > 0");
     expect_error_at("\ncamera rx=2 focus=-3", 2, 19, "'focus' must be > 0");
     expect_error_at("camera aperture=wide", 1, 17, "expected a number for 'aperture'");
+    expect_error_at("camera focus=1e39", 1, 14, "'focus' must be at most 3.4e38");
     expect_error_at("camera aperture=0.1 eye=0,0,5 rx=2", 1, 31, "belongs to the explicit form");
     expect_error_at("sphere fresnel=maybe", 1, 16, "expected true or false for 'fresnel'");
     expect_error_at("material glass fresnel=yes", 1, 24, "expected true or false for 'fresnel'");
