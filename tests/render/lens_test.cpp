@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "driver/render.h"
+#include "kernels/append_view.h"
 #include "kernels/kernel_table.h"
 #include "render/camera_rays.h"
 #include "render/sampling.h"
@@ -164,10 +165,7 @@ TEST_CASE("thin lens: the generate(lens) kernel traces the scalar formulas' rays
         rays.reserve(n);
         GenerateJob job{n, a_px.data(), a_py.data(), a_cx.data(), a_cy.data(), a_kp.data(), a_ks.data(),
                         int(scene.settings.pattern), true, float(cols), float(spp / cols), &cam, 1.f / float(spp),
-                        {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(),
-                         rays.dz.data(), rays.t_max.data(), rays.wr.data(), rays.wg.data(), rays.wb.data(),
-                         rays.cone.data(), rays.pixel.data(), rays.kind.data(), &rays.count},
-                        a_lx.data(), a_ly.data()};
+                        test::append_view(rays), a_lx.data(), a_ly.data()};
         kernel_table(isa).generate_lens(job);
         for (std::size_t i = 0; i < n; ++i) {
             const PixelSample ps = pixel_sample(scene.settings.pattern, spp, kp[i], int(ks[i]));

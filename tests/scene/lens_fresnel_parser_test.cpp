@@ -4,26 +4,12 @@
 
 #include <string>
 
+#include "scene/expect_error.h"
 #include "scene/parser.h"
 
 using namespace streamrt;
 
-namespace {
-void expect_error_at(const std::string& text, int line, int column, const std::string& needle) {
-    INFO("scene text: ", text);
-    bool thrown = false;
-    try {
-        parse_scene(text, "t.cfg");
-    } catch (const SceneError& e) {
-        thrown = true;
-        INFO("message: ", std::string(e.what()));
-        CHECK(e.where().line == line);
-        CHECK(e.where().column == column);
-        CHECK(e.message().find(needle) != std::string::npos);
-    }
-    CHECK(thrown);
-}
-}  // namespace
+using test::expect_error;  // scene/expect_error.h
 
 TEST_CASE("parser: camera aperture and focus in both forms") {
     const Scene a = parse_scene("camera eye=0,0,5 look=0,0,0 aperture=0.2 focus=4\n", "t.cfg");
@@ -57,13 +43,13 @@ TEST_CASE("parser: fresnel= on materials and shapes") {
 }
 
 TEST_CASE("parser: lens and fresnel errors at line:column") {
-    expect_error_at("camera eye=0,0,5 look=0,0,0 aperture=-1", 1, 38, "'aperture' must be >= 0");
-    expect_error_at("camera focus=0", 1, 14, "'focus' must be > 0");
-    expect_error_at("\ncamera rx=2 focus=-3", 2, 19, "'focus' must be > 0");
-    expect_error_at("camera aperture=wide", 1, 17, "expected a number for 'aperture'");
-    expect_error_at("camera focus=1e39", 1, 14, "'focus' must be at most 3.4e38");
-    expect_error_at("camera aperture=0.1 eye=0,0,5 rx=2", 1, 31, "belongs to the explicit form");
-    expect_error_at("sphere fresnel=maybe", 1, 16, "expected true or false for 'fresnel'");
-    expect_error_at("material glass fresnel=yes", 1, 24, "expected true or false for 'fresnel'");
-    expect_error_at("light point pos=0,0,0 fresnel=true", 1, 23, "unknown key 'fresnel'");
+    expect_error("camera eye=0,0,5 look=0,0,0 aperture=-1", 1, 38, "'aperture' must be >= 0");
+    expect_error("camera focus=0", 1, 14, "'focus' must be > 0");
+    expect_error("\ncamera rx=2 focus=-3", 2, 19, "'focus' must be > 0");
+    expect_error("camera aperture=wide", 1, 17, "expected a number for 'aperture'");
+    expect_error("camera focus=1e39", 1, 14, "'focus' must be at most 3.4e38");
+    expect_error("camera aperture=0.1 eye=0,0,5 rx=2", 1, 31, "belongs to the explicit form");
+    expect_error("sphere fresnel=maybe", 1, 16, "expected true or false for 'fresnel'");
+    expect_error("material glass fresnel=yes", 1, 24, "expected true or false for 'fresnel'");
+    expect_error("light point pos=0,0,0 fresnel=true", 1, 23, "unknown key 'fresnel'");
 }
