@@ -32,7 +32,7 @@ ENGINES = ("stream", "recursive")
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="one scene, spp up to 16, 160x90, 128 spp reference: a smoke run")
-    ap.add_argument("--scenes", help="comma-separated scene files (default whitted, shapes, cornell)")
+    ap.add_argument("--scenes", help="comma-separated scene files (default whitted, shapes, cornell, dof)")
     ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"))
     ap.add_argument("--width", type=int, help="default 320 (quick 160)")
     ap.add_argument("--height", type=int, help="default 180 (quick 90)")
@@ -47,7 +47,8 @@ def main(argv=None):
     args.ref_spp = args.ref_spp or (128 if args.quick else 512)
     max_spp = args.max_spp or (16 if args.quick else 64)
     names = args.scenes.split(",") if args.scenes else (
-        ["scenes/whitted.cfg"] if args.quick else ["scenes/whitted.cfg", "scenes/shapes.cfg", "scenes/cornell.cfg"])
+        ["scenes/whitted.cfg"] if args.quick else ["scenes/whitted.cfg", "scenes/shapes.cfg", "scenes/cornell.cfg",
+                                                    "scenes/dof.cfg"])
     exe = pc.binary(args.build)
     out_dir = os.path.join(args.build, "perf-quick" if args.quick else "perf")
     ref_dir = os.path.join(out_dir, "reference")

@@ -160,7 +160,13 @@ ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) 
     ColorT<double> sum{0, 0, 0};
     for (int k = 0; k < s.spp; ++k) {
         const PixelSample ps = pixel_sample(s.pattern, s.spp, pixel, k);
-        const RayD ray{cam.origin, cam.direction(double(x + ps.x), double(y + ps.y)), 0.0};
+        RayD ray{cam.origin, {}, 0.0};
+        if (cam.has_lens()) {  // thin lens: the sample's point on the lens (render/sampling.h)
+            const PixelSample ls = lens_sample(s.pattern, s.spp, pixel, k);
+            cam.lens_ray(double(x + ps.x), double(y + ps.y), double(ls.x), double(ls.y), ray.origin, ray.dir);
+        } else {
+            ray.dir = cam.direction(double(x + ps.x), double(y + ps.y));
+        }
         ++counts.primary;
         sum = sum + trace(ray, 0, counts);
     }

@@ -226,7 +226,8 @@ KernelTable make_table(Isa isa, const char* name, ShapeList<S...>) {
                         SHADE_GATHERED(4), SHADE_GATHERED(5), SHADE_GATHERED(6), SHADE_GATHERED(7),
                         SHADE_GATHERED(8), SHADE_GATHERED(9), SHADE_GATHERED(10), SHADE_GATHERED(11),
                         SHADE_GATHERED(12), SHADE_GATHERED(13), SHADE_GATHERED(14), SHADE_GATHERED(15)},
-                       &generate_rays<Arch>};
+                       &generate_rays<Arch>,
+                       &generate_lens_rays<Arch>};
 }
 
 template <class Arch>

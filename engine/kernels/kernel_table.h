@@ -43,6 +43,7 @@ struct KernelTable {
     ShadeFn shade[kShadeVariants];
     ShadeFn shade_gathered[kShadeVariants];  ///< runs of one material and kind, objects per lane
     GenerateFn generate;
+    GenerateFn generate_lens;  ///< thin-lens cameras (aperture > 0) only
 };
 
 /// The best level this CPU runs.

@@ -71,6 +71,9 @@ struct GenerateJob {
     const CameraRays<float>* camera;
     float weight;
     RayAppend out;
+    /// Thin lens only (generate_lens): per ray, the sample's lattice cell on the lens
+    /// (render/sampling.h's LensCells). Keys are then filled even at spp = 1.
+    const float *lens_cell_x = nullptr, *lens_cell_y = nullptr;
 };
 using GenerateFn = void (*)(const GenerateJob& job);
 

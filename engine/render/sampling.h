@@ -76,5 +76,102 @@ inline PixelSample pixel_sample(SamplePattern pattern, int spp, std::uint64_t pi
                           unit_from_hash(h1), unit_from_hash(h2));
 }
 
+// ---- depth of field: where each sample falls on the lens ----------------------------------
+// A thin lens needs a second 2-D sample per ray, a point on the lens disc. It uses the same
+// cols x rows lattice as the pixel sample, but sample k takes lattice cell permute(k) on the
+// lens, with a permutation of [0, spp) drawn per pixel: each 2-D projection (pixel jitter,
+// lens point) is stratified, and the pairing of pixel strata with lens strata is a random
+// shuffle per pixel (no correlation such as "left of the pixel = left of the lens"). The
+// cell index is integer bookkeeping, computed by the scalar driver in both engines; the
+// hashes, jitter and disc mapping run in SIMD lanes in the stream engine's generate kernel.
+
+/// The lens cells of one pixel's samples: a bijection of [0, spp) chosen by a hash of the
+/// pixel, an invertible mix of the bits of [0, 2^b) (2^b the next power of two >= spp)
+/// repeated until the value lands below spp (cycle walking, so the restriction to [0, spp)
+/// is still a bijection). Set up once per pixel; cell(k) per sample.
+class LensCells {
+  public:
+    LensCells(int spp, std::uint32_t pixel)
+        : n_(std::uint32_t(spp)), cols_(grid_columns(spp)) {
+        const std::uint32_t seed = pixel * 0x27d4eb2du + 0x165667b1u;
+        mul_ = hash32(seed) | 1u;  // odd: invertible modulo 2^b
+        add_ = hash32(seed ^ 0xa511e9b3u);
+        mask_ = n_ - 1;
+        for (int sh = 1; sh < 32; sh *= 2) mask_ |= mask_ >> sh;
+    }
+    /// The index in [0, spp) that sample k takes.
+    std::uint32_t index(std::uint32_t i) const {
+        if (n_ <= 1) return 0;
+        do {
+            i = (i * mul_ + add_) & mask_;
+            i ^= i >> 1;  // xor with a right shift: invertible, stays below 2^b
+            i = (i * 0x2c1b3c6du) & mask_;
+            i ^= i >> 3;
+        } while (i >= n_);
+        return i;
+    }
+    /// Lattice cell (column, row) on the lens of sample k.
+    void cell(int k, int& cx, int& cy) const {
+        const int j = int(index(std::uint32_t(k)));
+        cx = j % cols_;
+        cy = j / cols_;
+    }
+
+  private:
+    std::uint32_t n_;
+    int cols_;
+    std::uint32_t mul_ = 0, add_ = 0, mask_ = 0;
+};
+
+/// The two lens hashes of sample k of a pixel (independent of sample_hashes').
+template <class U>
+inline void lens_hashes(const U& pixel, const U& k, U& h1, U& h2) {
+    h1 = hash32(pixel * U(0x68e31da4u) + k * U(0xb5297a4du) + U(0x1b56c4e9u));
+    h2 = hash32(h1 ^ U(0x1b873593u));
+}
+
+namespace detail {
+/// sin and cos on [-pi/4, pi/4] by their Taylor polynomials (errors below 2e-9 and 1.2e-10),
+/// with plain multiplies and adds: the same bits in scalar float and at every SIMD level,
+/// where xsimd's sin/cos would round differently from one level to the next.
+template <class V>
+inline void sin_cos_quarter(const V& a, V& s, V& c) {
+    const V a2 = a * a;
+    s = a * (V(1.f) + a2 * (V(-1.f / 6) + a2 * (V(1.f / 120) + a2 * (V(-1.f / 5040) + a2 * V(1.f / 362880)))));
+    c = V(1.f) + a2 * (V(-0.5f) + a2 * (V(1.f / 24) + a2 * (V(-1.f / 720) + a2 * (V(1.f / 40320) +
+                                                                                  a2 * V(-1.f / 3628800)))));
+}
+}  // namespace detail
+
+/// Shirley and Chiu's concentric map of the unit square onto the unit disc: area-preserving
+/// (uniform points stay uniform) and it keeps strata compact, unlike the polar map
+/// (r = sqrt(u), angle 2 pi v). V is float or a float batch.
+template <class V>
+inline PixelSampleT<V> concentric_disc(const V& u, const V& v) {
+    using namespace simd;
+    const V a = V(2.f) * u - V(1.f), b = V(2.f) * v - V(1.f);
+    const auto wide = abs(a) > abs(b);  // the wedges around +-x; otherwise those around +-y
+    const V r = select(wide, a, b);
+    const V num = select(wide, b, a);
+    const V den = select(r == V(0.f), V(1.f), r);  // the centre (a = b = 0): r = 0 anyway
+    V s, c;
+    detail::sin_cos_quarter(V(0.785398163397448f) * (num / den), s, c);
+    return {r * select(wide, c, s), r * select(wide, s, c)};
+}
+
+/// The point on the unit lens disc of sample `sample` of `spp` in pixel `pixel` (row-major
+/// index): the lattice of pixel_sample with the permuted cell of LensCells, so grid puts
+/// lens points at cell centres, stratified one per cell, random anywhere.
+inline PixelSample lens_sample(SamplePattern pattern, int spp, std::uint64_t pixel, int sample) {
+    std::uint32_t h1, h2;
+    lens_hashes(std::uint32_t(pixel), std::uint32_t(sample), h1, h2);
+    const int cols = grid_columns(spp);
+    int cx, cy;
+    LensCells(spp, std::uint32_t(pixel)).cell(sample, cx, cy);
+    const PixelSample q = lattice_sample(pattern, float(cx), float(cy), float(cols), float(spp / cols),
+                                         unit_from_hash(h1), unit_from_hash(h2));
+    return concentric_disc(q.x, q.y);
+}
+
 STREAMRT_ISA_END
 }  // namespace streamrt

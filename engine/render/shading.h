@@ -50,13 +50,20 @@ struct MaterialT {
     /// Added to p / cell before the checker parity: the stream engine renders relative to
     /// the eye and puts (eye / cell) mod 2 here; zero for world coordinates.
     Vec3T<T> cell_offset{T(0), T(0), T(0)};
+    /// Fresnel: set for a fresnel=true material that is a dielectric (trans > 0, ior != 1;
+    /// at ior = 1 there is no interface and nothing to reflect); r0 = ((ior-1)/(ior+1))^2.
+    bool fresnel = false;
+    T r0 = T(0);
 
     static MaterialT from(const Material& m) {
         const double cutoff =
             m.spec > 0 && m.shininess > 0 ? std::min(1.0, std::pow(std::min(1.0, 1e-5 / m.spec), 1.0 / m.shininess)) : 0.0;
+        const bool fresnel = m.fresnel && m.trans > 0 && m.ior != 1.0;
+        const double r = (m.ior - 1.0) / (m.ior + 1.0);
         return {{T(m.checker_color.x), T(m.checker_color.y), T(m.checker_color.z)},
                 T(m.ambi), T(m.diff), T(m.spec), T(m.shininess), T(m.refl), T(m.trans),
-                T(m.ior), T(1.0 / m.cell), m.checker, T(cutoff), {T(0), T(0), T(0)}};
+                T(m.ior), T(1.0 / m.cell), m.checker, T(cutoff), {T(0), T(0), T(0)},
+                fresnel, T(fresnel ? r * r : 0.0)};
     }
 };
 
@@ -207,10 +214,20 @@ inline Vec3T<V> reflect(const Vec3T<V>& d, const Vec3T<V>& n) {
     return d - n * (V(2) * dot(d, n));
 }
 
+/// What Snell's law gives at a surface: the transmitted direction (the mirror direction on
+/// total internal reflection), whether it was total, and the cosines on both sides.
+template <class V>
+struct Refraction {
+    Vec3T<V> dir;
+    MaskOf<V> tir;
+    V cos_i, cos_t;  ///< incident and transmitted angles' cosines (cos_t = 0 when tir)
+    V eta;           ///< n1 / n2: index on the incident side over index on the far side
+};
+
 /// Snell's law for a unit d at a surface of outward unit normal n and index ior inside.
-/// Entering when d.n < 0. On total internal reflection returns the mirror direction.
+/// Entering when d.n < 0.
 template <class V, class T>
-inline Vec3T<V> refract(const Vec3T<V>& d, const Vec3T<V>& n, T ior, MaskOf<V>* total_internal = nullptr) {
+inline Refraction<V> refraction(const Vec3T<V>& d, const Vec3T<V>& n, T ior) {
     using namespace simd;
     const V cos_signed = -dot(d, n);
     const auto leaving = cos_signed < V(0);
@@ -219,9 +236,30 @@ inline Vec3T<V> refract(const Vec3T<V>& d, const Vec3T<V>& n, T ior, MaskOf<V>* 
     const V eta = select(leaving, V(ior), V(T(1) / ior));
     const V k = V(1) - eta * eta * (V(1) - cos_i * cos_i);
     const auto tir = k < V(0);
-    if (total_internal) *total_internal = tir;
-    const Vec3T<V> t = normalize(d * eta + nn * (eta * cos_i - sqrt(select(tir, V(0), k))));
-    return select3(tir, reflect(d, nn), t);
+    const V cos_t = sqrt(select(tir, V(0), k));
+    const Vec3T<V> t = normalize(d * eta + nn * (eta * cos_i - cos_t));
+    return {select3(tir, reflect(d, nn), t), tir, cos_i, cos_t, eta};
+}
+
+/// The transmitted direction alone; on total internal reflection the mirror direction.
+template <class V, class T>
+inline Vec3T<V> refract(const Vec3T<V>& d, const Vec3T<V>& n, T ior, MaskOf<V>* total_internal = nullptr) {
+    const Refraction<V> r = refraction(d, n, ior);
+    if (total_internal) *total_internal = r.tir;
+    return r.dir;
+}
+
+/// Schlick's approximation of the unpolarised Fresnel reflectance at a refraction r, with
+/// r0 = ((n1 - n2) / (n1 + n2))^2: R = r0 + (1 - r0) (1 - cos)^5, where cos is the cosine in
+/// the less dense medium (the incident angle when entering the denser one, the transmitted
+/// angle when leaving it: Schlick's formula is written for that side); R = 1 on total
+/// internal reflection.
+template <class V, class T>
+inline V schlick_reflectance(T r0, const Refraction<V>& r) {
+    using namespace simd;
+    const V c = V(1) - select(r.eta > V(1), r.cos_t, r.cos_i);
+    const V c2 = c * c;
+    return select(r.tir, V(1), V(r0) + V(T(1) - r0) * (c2 * c2 * c));
 }
 
 namespace detail {
@@ -351,6 +389,26 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
             if (!(rules.cutoff > T(0))) return active;
             return active && (max(throughput.x, max(throughput.y, throughput.z)) >= V(rules.cutoff));
         };
+        if constexpr (kReflect && kRefract) {
+            // Fresnel (a per-material choice, uniform over a packet): the dielectric's trans
+            // weight is split by the reflectance R, trans R joining the mirror weight refl and
+            // trans (1 - R) going through; refl + trans stays the total, as with fixed
+            // weights. On total internal reflection everything is reflected (no refracted
+            // child). The stream engine builds spawn(reflect) whenever such a material exists.
+            if (m.fresnel && rules.degree >= 4) {
+                const Refraction<V> rf = refraction(d, n_out, m.ior);
+                const V R = schlick_reflectance(m.r0, rf);
+                const V w_refl = V(m.refl) + V(m.trans) * R, w_trans = V(m.trans) * (V(T(1)) - R);
+                const ColorT<V> through_refl = ray.throughput * w_refl;
+                sink.child(kept(through_refl), offset_ray_origin(p, n, ray.origin), reflect(d, n),
+                           ray.weight * w_refl, through_refl, cone, RayKind::Reflected);
+                const Vec3T<V> side = select3(dot(rf.dir, n_out) > V(0), n_out, -n_out);
+                const ColorT<V> through_trans = ray.throughput * w_trans;
+                sink.child(kept(through_trans) && !rf.tir, offset_ray_origin(p, side, ray.origin), rf.dir,
+                           ray.weight * w_trans, through_trans, cone, RayKind::Refracted);
+                return;
+            }
+        }
         if constexpr (kReflect) {
             if (rules.degree >= 3 && m.refl > T(0)) {
                 const ColorT<V> throughput = ray.throughput * V(m.refl);

@@ -291,6 +291,12 @@ class Statement {
             fail(a.value_col, quote(a.key) + " must be a non-zero vector, got " + quote(a.value));
         return d / len;
     }
+    bool boolean(const Arg& a) const {
+        if (same(a.value, "true")) return true;
+        if (!same(a.value, "false"))
+            fail(a.value_col, "expected true or false for " + quote(a.key) + ", got " + quote(a.value));
+        return false;
+    }
     /// One number (uniform) or x,y,z; no zero component.
     glm::dvec3 scale(const Arg& a) const {
         glm::dvec3 s;
@@ -317,7 +323,7 @@ class Statement {
 // ---- key vocabularies ------------------------------------------------------------------
 const std::vector<std::string_view> kMaterialKeys = {"color", "ambi",    "diff", "spec",
                                                      "shininess", "refl", "trans", "ior",
-                                                     "checker", "cell"};
+                                                     "checker", "cell", "fresnel"};
 const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rotate_y", "rotate_z",
                                                       "translate"};
 const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
@@ -329,6 +335,8 @@ const std::vector<std::string_view> kLookAtKeys = {"eye", "look", "up", "fov"};
 const std::vector<std::string_view> kExplicitCameraKeys = {"rx",       "ry",       "df",
                                                            "scale",    "rotate_x", "rotate_y",
                                                            "rotate_z", "translate"};
+/// Depth of field: keys of both camera forms.
+const std::vector<std::string_view> kLensKeys = {"aperture", "focus"};
 
 std::vector<std::string_view> join(std::initializer_list<std::vector<std::string_view>> lists) {
     std::vector<std::string_view> out;
@@ -337,7 +345,7 @@ std::vector<std::string_view> join(std::initializer_list<std::vector<std::string
 }
 
 // The joined lists, built once (the order is the one messages list them in).
-const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys, {"name"}});
+const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys, kLensKeys, {"name"}});
 const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
 const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys, {"name"}});
 const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth"}});
@@ -390,6 +398,7 @@ bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
         m.checker_color = st.color(a);
         m.checker = true;
     } else if (same(k, "cell")) m.cell = st.positive(a);
+    else if (same(k, "fresnel")) m.fresnel = st.boolean(a);
     else return false;
     return true;
 }
@@ -842,18 +851,27 @@ class Parser {
     void camera(Statement& st, const std::vector<Token>& toks) {
         st.read_args(toks, 1, kCameraKeys);
         Camera cam;
-        const auto named = [](const Arg& a) { return same(a.key, "name"); };
-        if (const auto it = std::find_if_not(st.args.begin(), st.args.end(), named); it != st.args.end()) {
-            const Arg& first = *it;
+        // The lens keys and name= belong to both forms; the first other key chooses the form.
+        const auto either_form = [](const Arg& a) { return same(a.key, "name") || contains(kLensKeys, a.key); };
+        if (const auto placing = std::find_if_not(st.args.begin(), st.args.end(), either_form);
+            placing != st.args.end()) {
+            const Arg& first = *placing;
             const bool look_at = contains(kLookAtKeys, first.key);
             for (const Arg& a : st.args)
-                if (!named(a) && contains(kLookAtKeys, a.key) != look_at)
+                if (!either_form(a) && contains(kLookAtKeys, a.key) != look_at)
                     st.fail(a.key_col, "camera: " + quote(a.key) + " belongs to the " +
                                            (look_at ? "explicit" : "look-at") + " form but " +
                                            quote(first.key) + " chose the " +
                                            (look_at ? "look-at" : "explicit") +
                                            " form; use one form per camera statement");
             cam.look_at = look_at;
+        }
+        for (const Arg& a : st.args) {  // depth of field (the stream engine's lens is float)
+            if (a.key != "aperture" && a.key != "focus") continue;
+            const double v = a.key == "aperture" ? st.at_least_zero(a) : st.positive(a);
+            if (!(v <= double(std::numeric_limits<float>::max())))
+                st.fail(a.value_col, quote(a.key) + " must be at most 3.4e38 (single precision), got " + quote(a.value));
+            (a.key == "aperture" ? cam.aperture : cam.focus) = v;
         }
         if (cam.look_at) {
             const Arg* up = nullptr;
@@ -1012,11 +1030,8 @@ class Parser {
             if (apply_material_key(st, a, f.look)) continue;
             if (apply_transform_key(st, a, f.md)) continue;
             if (param.present() && same(a.key, param.key)) f.param = st.positive(a);
-            else if (same(a.key, "smooth")) {
-                if (same(a.value, "true")) f.smooth = true;
-                else if (same(a.value, "false")) f.smooth = false;
-                else st.fail(a.value_col, "expected true or false for 'smooth', got " + quote(a.value));
-            } else if (same(a.key, "file")) f.mesh = mesh_file(st, a);
+            else if (same(a.key, "smooth")) f.smooth = st.boolean(a);
+            else if (same(a.key, "file")) f.mesh = mesh_file(st, a);
         }
         if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
         if (singular(f.md))

@@ -26,6 +26,12 @@ glm::dmat4 Camera::world_from_canonical(int width, int height) const {
     return m;
 }
 
+double Camera::focus_distance(const glm::dmat4& md) const {
+    if (focus > 0.0) return focus;
+    if (look_at) return glm::length(look - eye);
+    return glm::length(glm::dvec3(md[2]));
+}
+
 }  // namespace streamrt
 
 namespace streamrt {
@@ -38,7 +44,7 @@ std::size_t MaterialHash::operator()(const Material& m) const {
     for (double v : {m.ambi, m.diff, m.spec, m.shininess, m.refl, m.trans, m.ior, m.cell, m.checker_color.x,
                      m.checker_color.y, m.checker_color.z})
         mix(v);
-    return h ^ std::size_t(m.checker);
+    return h ^ std::size_t(m.checker) ^ (std::size_t(m.fresnel) << 1);
 }
 
 std::uint32_t Scene::intern_material(const Material& m) {

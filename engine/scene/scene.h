@@ -36,6 +36,9 @@ struct Material {
     bool checker = false;
     glm::dvec3 checker_color{0.0, 0.0, 0.0};
     double cell = 1.0;  ///< checker cell side, world units
+    /// Fresnel (fresnel=true): at a dielectric (trans > 0) the split between refl and trans
+    /// follows Schlick's approximation instead of the fixed weights (render/shading.h).
+    bool fresnel = false;
 
     bool operator==(const Material&) const = default;
 };
@@ -90,9 +93,17 @@ struct Camera {
     glm::dmat4 md{1.0};  ///< explicit form
     glm::dvec3 eye{0.0, 0.0, 5.0}, look{0.0, 0.0, 0.0}, up{0.0, 1.0, 0.0};
     double fov = 45.0;  ///< look-at form: vertical field of view, degrees
+    // Depth of field (both forms): a thin lens of radius `aperture` (world units; 0 = the
+    // handout's pinhole) focused on the plane parallel to the screen at distance `focus` along
+    // the view axis (0 = the default: |look - eye| in the look-at form, the eye's distance to
+    // the screen plane z = 0, |Md (0,0,-1)|, in the explicit form).
+    double aperture = 0.0;
+    double focus = 0.0;
 
     /// Md for an image of width x height pixels (the look-at form keeps square pixels).
     glm::dmat4 world_from_canonical(int width, int height) const;
+    /// The distance of the plane in focus, `focus` or its default, for this camera's Md.
+    double focus_distance(const glm::dmat4& md) const;
 };
 
 enum class Calibration : std::uint8_t { Clamp, Normalize };

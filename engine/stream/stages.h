@@ -55,12 +55,17 @@ struct MeshHits {
 struct GenerateScratch {
     AlignedVec<float> px, py, cell_x, cell_y;
     AlignedVec<std::uint32_t> key_pixel, key_sample;
-    void reserve(std::size_t n) {
+    AlignedVec<float> lens_x, lens_y;  ///< thin lens only: the lens lattice cells (else empty)
+    void reserve(std::size_t n, bool lens) {
         const std::size_t cap = simd::round_up_lanes(n);
         if (px.size() < cap) {
             for (auto* a : {&px, &py, &cell_x, &cell_y}) a->assign(cap, 0.f);
             key_pixel.assign(cap, 0);
             key_sample.assign(cap, 0);
+        }
+        if (lens && lens_x.size() < cap) {
+            lens_x.assign(cap, 0.f);
+            lens_y.assign(cap, 0.f);
         }
     }
 };
@@ -201,7 +206,8 @@ struct PipelineStages {
         const int spp = sc.settings.spp;
         const std::size_t n = std::size_t(n_pixels) * std::size_t(spp);
         rays.reserve(n);
-        g.reserve(n);
+        const bool lens = sc.features.lens;  // one scene-wide choice: the thin-lens kernel
+        g.reserve(n, lens);
         // Integer bookkeeping (pixel of each ray, sample index, lattice cell) in scalar code;
         // the hashing, jitter and camera directions in the SIMD kernel.
         const int cols = grid_columns(spp);
@@ -225,6 +231,23 @@ struct PipelineStages {
             }
         }
         rays.count = i;
+        if (lens) {  // a second pass, so a pinhole camera runs exactly the loop above
+            std::size_t j = 0;
+            for (int p = first; p < first + n_pixels; ++p) {
+                const int x = tile.x0 + p % tile.width(), y = tile.y0 + p / tile.width();
+                const std::uint32_t pixel =
+                    std::uint32_t(std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x));
+                const LensCells cells(spp, pixel);  // render/sampling.h
+                for (int k = 0; k < spp; ++k, ++j) {
+                    g.key_pixel[j] = pixel;  // also at spp = 1: the lens hashes need them
+                    g.key_sample[j] = std::uint32_t(k);
+                    int lx, ly;
+                    cells.cell(k, lx, ly);
+                    g.lens_x[j] = float(lx);
+                    g.lens_y[j] = float(ly);
+                }
+            }
+        }
         GenerateJob job{n,
                         g.px.data(),
                         g.py.data(),
@@ -240,8 +263,10 @@ struct PipelineStages {
                         1.f / float(spp),
                         {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(),
                          rays.dz.data(), rays.t_max.data(), rays.wr.data(), rays.wg.data(), rays.wb.data(),
-                         rays.cone.data(), rays.pixel.data(), rays.kind.data(), &rays.count}};
-        kt.generate(job);
+                         rays.cone.data(), rays.pixel.data(), rays.kind.data(), &rays.count},
+                        g.lens_x.data(),
+                        g.lens_y.data()};
+        (lens ? kt.generate_lens : kt.generate)(job);
     }
 
     /// intersect: closest hit of every ray, one SIMD kernel per shape kind present.

@@ -21,7 +21,8 @@ StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade, std
 
 std::vector<std::string> StreamRenderer::built_stages() const {
     const StreamFeatures& f = scene_.features;
-    std::vector<std::string> b{f.jitter ? "generate(jittered)" : "generate(centre)"};
+    std::vector<std::string> b{std::string(f.jitter ? "generate(jittered" : "generate(centre") +
+                               (f.lens ? ",lens)" : ")")};
     std::string kernels = "intersect[";
     bool first = true;
     for (int k = 0; k < kShapeKindCount; ++k)

@@ -28,6 +28,8 @@ Scene camera_relative_to_eye(const Scene& scene, glm::dvec3& eye) {
     eye = transform_point(cam, {0.0, 0.0, 1.0});
     r.camera.look_at = false;
     r.camera.md = translate_matrix(-eye) * cam;
+    r.camera.aperture = scene.camera.aperture;
+    r.camera.focus = scene.camera.focus_distance(cam);  // resolved: the default depends on the form
     return r;
 }
 
@@ -65,7 +67,7 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
     object_count = n;
     fill_surfaces(scene);
 
-    bool any_refl = false, any_trans = false;
+    bool any_refl = false, any_trans = false, any_fresnel = false;
     for (const Material& m : scene.materials) {
         MaterialT<float> mat = MaterialT<float>::from(m);
         const glm::vec3 offset = cell_offset(m, eye);
@@ -73,13 +75,15 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
         materials.push_back(mat);
         any_refl |= m.refl > 0;
         any_trans |= m.trans > 0;
+        any_fresnel |= mat.fresnel;  // reflects even with refl = 0 (at degree >= 4)
     }
     convert_lights(scene);
     features.lighting = s.degree >= 1;
     features.shadows = s.degree >= 5 && !lights.empty();
-    features.reflect = s.degree >= 3 && s.depth >= 1 && any_refl;
+    features.reflect = s.degree >= 3 && s.depth >= 1 && (any_refl || (s.degree >= 4 && any_fresnel));
     features.refract = s.degree >= 4 && s.depth >= 1 && any_trans;
     features.jitter = s.spp > 1;
+    features.lens = camera.has_lens();
 }
 
 void StreamScene::fill_surfaces(const Scene& scene) {

@@ -23,6 +23,7 @@ struct StreamFeatures {
     bool reflect = false;   ///< degree >= 3, depth >= 1 and some material has refl > 0
     bool refract = false;   ///< degree >= 4, depth >= 1 and some material has trans > 0
     bool jitter = false;    ///< spp > 1
+    bool lens = false;      ///< camera aperture > 0: the thin-lens generate kernel
 };
 
 struct StreamScene {

@@ -128,7 +128,7 @@ TEST_CASE("cli: --check validates a scene without rendering") {
     CHECK(missing.code == 2);
     check_one_line_error(missing, "nope.cfg: cannot open scene file");
 
-    for (const auto& name : {"whitted.cfg", "shapes.cfg", "cornell.cfg", "random_spheres.cfg"}) {
+    for (const auto& name : {"whitted.cfg", "shapes.cfg", "cornell.cfg", "random_spheres.cfg", "dof.cfg", "fresnel.cfg"}) {
         const Run s = run_streamrt("--check -q " + q(fs::path(STREAMRT_SOURCE_DIR) / "scenes" / name) + " -o " +
                                q(d.path / "o.png"));
         INFO(name, ": ", s.err);

@@ -70,6 +70,9 @@ inline std::string check_scene(const Scene& sc) {
     }
     const glm::dmat4 cam = sc.camera.world_from_canonical(s.width, s.height);
     if (!finite(cam) || !finite(glm::inverse(cam))) return "camera transform not finite or not invertible";
+    if (!(sc.camera.aperture >= 0) || !(sc.camera.aperture <= 3.5e38) ||
+        !(sc.camera.focus_distance(cam) > 0) || !std::isfinite(sc.camera.focus_distance(cam)))
+        return "camera lens (aperture, focus) out of range";
     for (int stream = 0; stream < 2; ++stream) {
         const MemoryEstimate est = estimate_render_memory(sc, stream == 1, 2);
         if (!(est.total_bytes >= est.framebuffer_bytes) || !(est.framebuffer_bytes > 0)) return "memory estimate";

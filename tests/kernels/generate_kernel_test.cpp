@@ -4,6 +4,7 @@
 
 #include <vector>
 
+#include "kernels/append_view.h"
 #include "kernels/kernel_table.h"
 #include "render/camera_rays.h"
 #include "render/sampling.h"
@@ -49,10 +50,7 @@ TEST_CASE("generate kernel: same sample positions and directions as the scalar f
                 rays.reserve(n);
                 GenerateJob job{n, a_px.data(), a_py.data(), a_cx.data(), a_cy.data(), a_kp.data(), a_ks.data(),
                                 int(scene.settings.pattern), spp > 1, float(cols), float(spp / cols),
-                                &cam, 1.f / float(spp),
-                                {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(),
-                                 rays.dz.data(), rays.t_max.data(), rays.wr.data(), rays.wg.data(), rays.wb.data(),
-                                 rays.cone.data(), rays.pixel.data(), rays.kind.data(), &rays.count}};
+                                &cam, 1.f / float(spp), test::append_view(rays)};
                 kernel_table(isa).generate(job);
                 for (std::size_t i = 0; i < n; ++i) {
                     const PixelSample ps = pixel_sample(scene.settings.pattern, spp, kp[i], int(ks[i]));

@@ -59,7 +59,7 @@ def _transform_step(key, val):
 
 TRANSFORM_KEYS = ("scale", "rotate_x", "rotate_y", "rotate_z", "translate")
 MATERIAL_DEFAULT = dict(color=np.ones(3), ambi=1.0, diff=1.0, spec=0.0, shininess=32.0,
-                        refl=0.0, trans=0.0, ior=1.0, checker=None, cell=1.0)
+                        refl=0.0, trans=0.0, ior=1.0, checker=None, cell=1.0, fresnel=False)
 SHAPES = ("sphere", "cube", "cylinder", "cone", "torus", "plane", "disk")
 
 
@@ -77,6 +77,10 @@ def _material_keys(mat, pairs):
     for k, v in pairs:
         if k in ("color", "checker"):
             mat[k] = _vec(v)
+        elif k == "fresnel":
+            if v not in ("true", "false"):
+                raise SceneError(f"fresnel must be true or false, got {v!r}")
+            mat[k] = v == "true"
         elif k in MATERIAL_DEFAULT:
             mat[k] = _num(v)
 
@@ -557,8 +561,7 @@ def trace(scene, o, d, level, width0, spread):
                 col = col + mat["spec"] * hl[:, None] * lc
         if deg >= 3 and level < scene.image["depth"]:
             refl_dir = D - 2 * _dot(D, N)[:, None] * N
-            if mat["refl"] > 0:
-                _queue(sec, off, refl_dir, mat["refl"], sel, width)
+            w_refl, w_trans = mat["refl"], mat["trans"]
             if deg >= 4 and mat["trans"] > 0:
                 entering = cos_i < 0
                 eta = np.where(entering, 1 / mat["ior"], mat["ior"])
@@ -569,7 +572,19 @@ def trace(scene, o, d, level, width0, spread):
                 T /= np.linalg.norm(T, axis=1, keepdims=True)
                 tdir = np.where(tir[:, None], refl_dir, T)
                 torg = np.where(tir[:, None], off, P - eps[:, None] * N)
-                _queue(sec, torg, tdir, mat["trans"], sel, width)
+                if mat["fresnel"] and mat["ior"] != 1:
+                    # docs/scene-format.md, "Fresnel": Schlick with the cosine on the less
+                    # dense side, R = 1 under total internal reflection; trans R is
+                    # reflected on top of refl, trans (1 - R) refracted.
+                    r0 = ((mat["ior"] - 1) / (mat["ior"] + 1)) ** 2
+                    c = np.where(eta > 1, np.sqrt(np.maximum(kk, 0)), ci)
+                    R = np.where(tir, 1.0, r0 + (1 - r0) * (1 - c) ** 5)
+                    w_refl = mat["refl"] + mat["trans"] * R
+                    w_trans = mat["trans"] * (1 - R)
+            if np.any(np.asarray(w_refl) > 0):
+                _queue(sec, off, refl_dir, w_refl, sel, width)
+            if deg >= 4 and mat["trans"] > 0:
+                _queue(sec, torg, tdir, w_trans, sel, width)
         colour[sel] = col
         unsure[sel] = uns
     if sec["o"]:

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "scene/expect_error.h"
 #include "scene/parser.h"
 
 using namespace streamrt;
@@ -29,22 +30,7 @@ glm::dvec3 apply(const glm::dmat4& m, const glm::dvec3& p) {
 
 Scene parse(const std::string& text) { return parse_scene(text, "t.cfg"); }
 
-/// Parses `text` expecting a SceneError at line:column whose message contains `needle`.
-void expect_error(const std::string& text, int line, int column, const std::string& needle = "") {
-    INFO("scene text: ", text);
-    bool thrown = false;
-    try {
-        parse(text);
-    } catch (const SceneError& e) {
-        thrown = true;
-        INFO("message: ", std::string(e.what()));
-        CHECK(e.where().file == "t.cfg");
-        CHECK(e.where().line == line);
-        CHECK(e.where().column == column);
-        if (!needle.empty()) CHECK(e.message().find(needle) != std::string::npos);
-    }
-    CHECK_MESSAGE(thrown, "expected a SceneError");
-}
+using test::expect_error;  // scene/expect_error.h
 
 /// A fresh temporary directory removed at scope exit.
 struct TempDir {
