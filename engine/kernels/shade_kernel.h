@@ -14,6 +14,7 @@
 #include "kernels/compress.h"
 #include "kernels/shade_job.h"
 #include "render/shading.h"
+#include "render/texture.h"
 #include "shapes/shapes.h"
 
 namespace streamrt::STREAMRT_ISA_NAMESPACE {
@@ -71,6 +72,23 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
         }
     }
     return {B::load_aligned(nx), B::load_aligned(ny), B::load_aligned(nz)};
+}
+
+/// Texture coordinates of a mesh's hits, gathered lane by lane (render/texture.h mesh_uv, the
+/// same float expressions as the scalar path). Lanes past the run get (0, 0).
+template <class B>
+inline UvT<B> mesh_uvs(const ShadeJob& job, std::size_t i) {
+    constexpr std::size_t W = B::size;
+    const MeshView& m = *job.object->xf.mesh;
+    alignas(64) float us[W], vs[W];
+    for (std::size_t l = 0; l < W; ++l) {
+        us[l] = vs[l] = 0.f;
+        if (i + l >= job.end || !m.uv) continue;
+        const UvT<float> uv = mesh_uv(m, std::uint32_t(job.prim[i + l]), job.bu[i + l], job.bv[i + l]);
+        us[l] = uv.u;
+        vs[l] = uv.v;
+    }
+    return {B::load_aligned(us), B::load_aligned(vs)};
 }
 
 /// Appends the active lanes' rays to the next generation's stream, compacted.
@@ -187,10 +205,17 @@ void shade_run(const ShadeJob& job) {
         const Vec3T<B> pc = apply_point(rows, o) + apply_vector(rows, d) * t;
         const Vec3T<B> p = o + d * t;
         Vec3T<B> n_out{};
-        if (kLit || m.checker)
+        if (kLit || m.checker || m.texture)
             n_out = apply_normal(rows, kind == ShapeKind::Mesh && !kGathered ? mesh_normals<B>(job, i)
                                                                               : canonical_normal(kind, pc, param));
         const ArrivingRay<B> arriving{o, d, t, B::load_unaligned(job.cone + i), w, w};
+        if (m.texture) {  // one branch per run: the texture replaces the object's colour
+            const B footprint = footprint_width(arriving.cone, B(job.rules.spread), t, dot(d, n_out));
+            color = kind == ShapeKind::Mesh && !kGathered
+                        ? texture_color_at(m, mesh_uvs<B>(job, i), B(job.object->xf.mesh->uv_density),
+                                           canonical_per_world<B>(rows), footprint)
+                        : texture_color(m, kind, pc, param, rows, footprint);
+        }
         SimdSink<B> sink{job, i};
         shade_hit<kLit, kShadows, kReflect, kRefract>(job.rules, m, job.lights, job.n_lights, arriving, p, n_out, color,
                                                       active, sink);

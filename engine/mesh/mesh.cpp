@@ -18,12 +18,13 @@ namespace streamrt {
 
 std::size_t Mesh::memory_bytes() const {
     return tri.size() * sizeof(float) + index.size() * sizeof(std::uint32_t) +
-           vertex_normals.size() * sizeof(float) + bvh.memory_bytes();
+           vertex_normals.size() * sizeof(float) + corner_uv.size() * sizeof(float) + bvh.memory_bytes();
 }
 
 std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<float>& positions,
                                         const std::vector<std::uint32_t>& triangles,
-                                        const accel::BuildOptions& options) {
+                                        const accel::BuildOptions& options,
+                                        const std::vector<float>& corner_uv) {
     auto m = std::make_shared<Mesh>();
     m->name = std::move(name);
     const std::size_t n_verts = positions.size() / 3;
@@ -33,6 +34,7 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
     // Keep the triangles with three distinct, valid vertices and a non-zero area (in double:
     // the cross product of float differences is nearly exact).
     std::vector<std::uint32_t> kept;
+    std::vector<std::uint32_t> kept_from;  // the input triangle of each kept one (texture coordinates)
     kept.reserve(triangles.size());
     for (std::size_t k = 0; k + 2 < triangles.size(); k += 3) {
         const std::uint32_t a = triangles[k], b = triangles[k + 1], c = triangles[k + 2];
@@ -41,8 +43,12 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
             const Vec3d n = cross(vertex(b) - vertex(a), vertex(c) - vertex(a));
             ok = dot(n, n) > 0.0 && std::isfinite(dot(n, n));
         }
-        if (ok) kept.insert(kept.end(), {a, b, c});
-        else ++m->dropped;
+        if (ok) {
+            kept.insert(kept.end(), {a, b, c});
+            kept_from.push_back(std::uint32_t(k / 3));
+        } else {
+            ++m->dropped;
+        }
     }
     const std::size_t n_tris = kept.size() / 3;
 
@@ -94,6 +100,21 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
             for (int a = 0; a < 3; ++a) m->tri[9 * k + 3 * j + a] = positions[3 * v + a];
         }
     });
+    if (!corner_uv.empty()) {
+        m->corner_uv.resize(6 * n_tris);
+        double uv_length = 0.0, length_sum = 0.0;
+        for (std::size_t k = 0; k < n_tris; ++k) {
+            const std::uint32_t src = kept_from[m->bvh.prim_index[k]];
+            std::copy_n(&corner_uv[6 * std::size_t(src)], 6, &m->corner_uv[6 * k]);
+            for (int j = 0; j < 3; ++j) {
+                const int i = (j + 1) % 3;
+                const float* a = &m->corner_uv[6 * k];
+                uv_length += std::hypot(double(a[2 * i]) - a[2 * j], double(a[2 * i + 1]) - a[2 * j + 1]);
+                length_sum += length(vertex(m->index[3 * k + std::size_t(i)]) - vertex(m->index[3 * k + std::size_t(j)]));
+            }
+        }
+        m->uv_density = length_sum > 0.0 && uv_length > 0.0 ? float(uv_length / length_sum) : 1.f;
+    }
     m->bvh.prim_index.clear();
     m->bvh.prim_index.shrink_to_fit();
     for (int a = 0; a < 3; ++a) {
@@ -106,11 +127,12 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
             m->hi[a] = std::max(m->hi[a], double(m->tri[3 * k + a]));
         }
     m->kernel_view = {m->bvh.nodes.empty() ? nullptr : m->bvh.nodes.data(), m->tri.data(), m->index.data(),
-                      m->vertex_normals.data(), std::uint32_t(n_tris)};
+                      m->vertex_normals.data(), std::uint32_t(n_tris),
+                      m->corner_uv.empty() ? nullptr : m->corner_uv.data(), m->uv_density};
     return m;
 }
 
-std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path) {
+std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw std::runtime_error("cannot open mesh file");
     std::ostringstream ss;
@@ -129,15 +151,24 @@ std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path) {
     const tinyobj::attrib_t& at = reader.GetAttrib();
     std::vector<float> positions(at.vertices.begin(), at.vertices.end());
     std::vector<std::uint32_t> tris;
+    std::vector<float> corner_uv;  // with_uv: 6 per triangle
     for (const tinyobj::shape_t& s : reader.GetShapes()) {
         std::size_t off = 0;
         for (const auto nv : s.mesh.num_face_vertices) {
             if (nv == 3) {
                 for (int j = 0; j < 3; ++j) {
-                    const int v = s.mesh.indices[off + std::size_t(j)].vertex_index;
+                    const tinyobj::index_t& ix = s.mesh.indices[off + std::size_t(j)];
+                    const int v = ix.vertex_index;
                     if (v < 0 || std::size_t(v) >= positions.size() / 3)
                         throw std::runtime_error("OBJ face refers to a missing vertex");
                     tris.push_back(std::uint32_t(v));
+                    if (!with_uv) continue;
+                    const int t = ix.texcoord_index;
+                    if (t < 0 || 2 * std::size_t(t) + 1 >= at.texcoords.size())
+                        throw std::runtime_error("OBJ file has a face without texture coordinates (vt), which a "
+                                                 "texture needs");
+                    corner_uv.push_back(at.texcoords[2 * std::size_t(t)]);
+                    corner_uv.push_back(at.texcoords[2 * std::size_t(t) + 1]);
                 }
             }
             off += nv;
@@ -146,7 +177,9 @@ std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path) {
     for (float p : positions)
         if (!std::isfinite(p)) throw std::runtime_error("OBJ file has a vertex that is not finite");
     const std::size_t faces = tris.size() / 3;
-    auto mesh = Mesh::build(path, positions, tris);
+    for (float t : corner_uv)
+        if (!std::isfinite(t)) throw std::runtime_error("OBJ file has a texture coordinate that is not finite");
+    auto mesh = Mesh::build(path, positions, tris, {}, corner_uv);
     if (mesh->triangle_count() == 0)
         throw std::runtime_error(faces == 0 ? "OBJ file has no faces"
                                             : "OBJ file has no triangles of non-zero area (" +

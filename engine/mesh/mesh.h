@@ -20,9 +20,11 @@ struct Mesh {
     simd::AlignedVec<float> tri;        ///< 9 per triangle, leaf order
     std::vector<std::uint32_t> index;   ///< 3 per triangle, leaf order
     std::vector<float> vertex_normals;  ///< 3 per vertex
+    std::vector<float> corner_uv;       ///< 6 per triangle (MeshView::uv), leaf order; empty: none
     accel::Bvh bvh;                     ///< prim_index is dropped: triangles are stored in leaf order
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  ///< bounds of the vertices
     std::size_t dropped = 0;            ///< degenerate triangles left out
+    float uv_density = 1.f;            ///< MeshView::uv_density
     MeshView kernel_view{};             ///< pointers into the above, set once built (stable: the mesh is immutable)
 
     std::size_t triangle_count() const { return index.size() / 3; }
@@ -33,16 +35,20 @@ struct Mesh {
     /// Builds a mesh from vertex positions (3 floats each) and triangles (3 vertex numbers
     /// each, counter-clockwise seen from outside). Triangles with a repeated vertex, an
     /// out-of-range vertex or zero area are dropped. May return a mesh with no triangles.
+    /// `corner_uv`, when not empty, holds 6 floats per triangle of `triangles` (its corners'
+    /// texture coordinates), kept with the triangles.
     static std::shared_ptr<const Mesh> build(std::string name, const std::vector<float>& positions,
                                              const std::vector<std::uint32_t>& triangles,
-                                             const accel::BuildOptions& options = {});
+                                             const accel::BuildOptions& options = {},
+                                             const std::vector<float>& corner_uv = {});
 };
 
-/// Reads a Wavefront OBJ file (tinyobjloader; polygons are triangulated, materials, texture
-/// coordinates and normals in the file are ignored). Throws std::runtime_error with a
-/// message (no location) for a missing, unreadable or malformed file or one with no
-/// triangles.
-std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path);
+/// Reads a Wavefront OBJ file (tinyobjloader; polygons are triangulated, materials and
+/// normals in the file are ignored). Texture coordinates (vt) are kept only when `with_uv`
+/// (a textured object uses the mesh); then every face must have them. Throws
+/// std::runtime_error with a message (no location) for a missing, unreadable or malformed
+/// file, one with no triangles, or (with_uv) a face without texture coordinates.
+std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv = false);
 
 // ---- generated surfaces (tests, benchmarks, the sample scene) -----------------------------
 

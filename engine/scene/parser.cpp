@@ -30,6 +30,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -316,7 +317,8 @@ class Statement {
 // ---- key vocabularies ------------------------------------------------------------------
 const std::vector<std::string_view> kMaterialKeys = {"color", "ambi",    "diff", "spec",
                                                      "shininess", "refl", "trans", "ior",
-                                                     "checker", "cell"};
+                                                     "checker", "cell",
+                                                     "texture", "uvscale"};  // textures
 const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rotate_y", "rotate_z",
                                                       "translate"};
 const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
@@ -382,6 +384,7 @@ bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
         m.checker_color = st.color(a);
         m.checker = true;
     } else if (same(k, "cell")) m.cell = st.positive(a);
+    else if (same(k, "uvscale")) m.uv_scale = st.positive(a);  // texture= is the Parser's (texture_file)
     else return false;
     return true;
 }
@@ -572,7 +575,9 @@ class Parser {
     Scratch scratch_;       // the sequential pass's
     std::map<std::string, MaterialDef, std::less<>> materials_;
     std::vector<fs::path> open_;  // the include chain being read
-    std::map<fs::path, std::uint32_t> meshes_;  // by file identity: loaded once, shared (index in scene.meshes)
+    // By file identity and whether its texture coordinates are kept: loaded once, shared
+    // (index in scene.meshes).
+    std::map<std::pair<fs::path, bool>, std::uint32_t> meshes_;
     MaterialList scene_materials_{&scene};  // the one-pass reader's: straight into the scene
     int files_ = 0;
 
@@ -897,7 +902,9 @@ class Parser {
         st.read_args(toks, 2, kMaterialStatementKeys);  // "material": a base to start from
         Appearance m;
         if (const Arg* base = st.find("material")) m = lookup_material(st, *base);
-        for (const Arg& a : st.args) apply_material_key(st, a, m);
+        for (const Arg& a : st.args)
+            if (same(a.key, "texture")) m.m.texture = texture_file(st, a);
+            else apply_material_key(st, a, m);
         materials_.emplace(std::string(name.text), MaterialDef{m, chunked_ ? st.line() : 0});
     }
 
@@ -954,8 +961,13 @@ class Parser {
         const ShapeParam param = shape_param(kind);
         f.param = param.default_value;
         if (const Arg* base = st.find("material")) f.look = lookup_material(st, *base);
+        const Arg* file_arg = nullptr;  // a mesh's file, read once the texture is known
         for (const Arg& a : st.args) {
             if (same(a.key, "material")) continue;
+            if (same(a.key, "texture")) {
+                f.look.m.texture = texture_file(st, a);
+                continue;
+            }
             if (apply_material_key(st, a, f.look)) continue;
             if (apply_transform_key(st, a, f.md)) continue;
             if (param.present() && same(a.key, param.key)) f.param = st.positive(a);
@@ -963,8 +975,9 @@ class Parser {
                 if (same(a.value, "true")) f.smooth = true;
                 else if (same(a.value, "false")) f.smooth = false;
                 else st.fail(a.value_col, "expected true or false for 'smooth', got " + quote(a.value));
-            } else if (same(a.key, "file")) f.mesh = mesh_file(st, a);
+            } else if (same(a.key, "file")) file_arg = &a;
         }
+        if (file_arg) f.mesh = mesh_file(st, *file_arg, f.look.m.texture >= 0);
         if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
         if (singular(f.md))
             st.fail_here(std::string(st.word()) +
@@ -972,19 +985,20 @@ class Parser {
         make_object(st, f, file, materials, out, loc);
     }
 
-    /// The mesh of an OBJ file named relative to the statement's file, read once per file:
-    /// its index in Scene::meshes.
-    std::uint32_t mesh_file(const Statement& st, const Arg& a) {
+    /// The mesh of an OBJ file named relative to the statement's file, read once per file
+    /// (twice when both untextured objects and textured ones, which need its texture
+    /// coordinates, use it): its index in Scene::meshes.
+    std::uint32_t mesh_file(const Statement& st, const Arg& a, bool with_uv) {
         const fs::path base = fs::path(st.file()).parent_path();
         const fs::path target = (base / fs::path(std::string(a.value))).lexically_normal();
-        const fs::path id = identity_of(target);
+        const std::pair<fs::path, bool> id{identity_of(target), with_uv};
         if (const auto it = meshes_.find(id); it != meshes_.end()) return it->second;
         std::error_code ec;
         if (!fs::is_regular_file(target, ec))
             st.fail(a.value_col, "cannot open mesh file " + quote(target.string()));
         if (options_.copies) copy_file(target);
         try {
-            auto mesh = load_obj_mesh(target.string());
+            auto mesh = load_obj_mesh(target.string(), with_uv);
             const auto index = std::uint32_t(scene.meshes.size());
             scene.meshes.push_back(std::move(mesh));
             meshes_.emplace(id, index);
@@ -993,6 +1007,32 @@ class Parser {
             st.fail(a.value_col, quote(target.string()) + ": " + e.what());
         }
     }
+
+    /// The texture of an image file named relative to the statement's file, read once per
+    /// file: its index in Scene::textures. Shapes of the chunked reader call it from several
+    /// threads, hence the lock.
+    std::int32_t texture_file(const Statement& st, const Arg& a) {
+        const fs::path base = fs::path(st.file()).parent_path();
+        const fs::path target = (base / fs::path(std::string(a.value))).lexically_normal();
+        std::lock_guard<std::mutex> lock(textures_mutex_);
+        const fs::path id = identity_of(target);
+        if (const auto it = textures_.find(id); it != textures_.end()) return it->second;
+        std::error_code ec;
+        if (!fs::is_regular_file(target, ec))
+            st.fail(a.value_col, "cannot open texture file " + quote(target.string()));
+        if (options_.copies) copy_file(target);
+        try {
+            auto texture = load_texture(target.string());
+            const auto index = std::int32_t(scene.textures.size());
+            scene.textures.push_back(std::move(texture));
+            textures_.emplace(id, index);
+            return index;
+        } catch (const std::exception& e) {
+            st.fail(a.value_col, quote(target.string()) + ": " + e.what());
+        }
+    }
+    std::mutex textures_mutex_;
+    std::map<fs::path, std::int32_t> textures_;  // by file identity (index in scene.textures)
 
     void copy_file(const fs::path& p) {
         FileText text;

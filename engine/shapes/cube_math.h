@@ -50,6 +50,19 @@ struct CubeMath {
         return {select(x_wins, sign_of(p.x), V(0)), select(y_wins, sign_of(p.y), V(0)),
                 select(z_wins, sign_of(p.z), V(0))};
     }
+    /// Each face shows the whole image, chosen as the normal is: faces x = +-1 map (z, y),
+    /// faces y = +-1 map (x, z), faces z = +-1 map (x, y), each coordinate a in [-1, 1] to
+    /// (a + 1) / 2.
+    template <class V>
+    static UvT<V> uv(const Vec3T<V>& p, V /*param*/) {
+        using namespace simd;
+        const V ax = abs(p.x), ay = abs(p.y), az = abs(p.z);
+        const auto x_wins = (ax >= ay) && (ax >= az);
+        const auto y_wins = !x_wins && (ay >= az);
+        return uv_square(select(x_wins, p.z, p.x), select(y_wins, p.z, p.y));
+    }
+    template <class V>
+    static V uv_density(V /*param*/) { return V(0.5); }
 };
 
 STREAMRT_ISA_END

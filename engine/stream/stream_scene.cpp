@@ -41,6 +41,7 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
     const RenderSettings& s = scene.settings;
     background = {float(s.background.x), float(s.background.y), float(s.background.z)};
     meshes = scene.meshes;
+    textures = scene.textures;
     has_meshes = !meshes.empty();
 
     accel = StreamAccel::build_for(scene, eye);
@@ -92,6 +93,11 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
             return float(c - 2.0 * std::floor(c * 0.5));
         };
         mat.cell_offset = {period(eye.x), period(eye.y), period(eye.z)};
+        if (m.texture >= 0) {
+            mat.texture = scene.textures[std::size_t(m.texture)]->view();
+            mat.uv_scale = float(m.uv_scale);
+            features.textures = true;
+        }
         materials.push_back(mat);
         any_refl |= m.refl > 0;
         any_trans |= m.trans > 0;
