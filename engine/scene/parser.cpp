@@ -985,51 +985,45 @@ class Parser {
         make_object(st, f, file, materials, out, loc);
     }
 
-    /// The mesh of an OBJ file named relative to the statement's file, read once per file
-    /// (twice when both untextured objects and textured ones, which need its texture
-    /// coordinates, use it): its index in Scene::meshes.
-    std::uint32_t mesh_file(const Statement& st, const Arg& a, bool with_uv) {
+    /// A file named by `a` relative to the statement's file, read once: its index in `list`,
+    /// remembered in `known` under key(its identity); load(path) reads it the first time.
+    template <class Map, class List, class Key, class Load>
+    typename Map::mapped_type read_once(const Statement& st, const Arg& a, const std::string& what, Map& known,
+                                        List& list, Key key, Load load) {
         const fs::path base = fs::path(st.file()).parent_path();
         const fs::path target = (base / fs::path(std::string(a.value))).lexically_normal();
-        const std::pair<fs::path, bool> id{identity_of(target), with_uv};
-        if (const auto it = meshes_.find(id); it != meshes_.end()) return it->second;
+        const auto id = key(identity_of(target));
+        if (const auto it = known.find(id); it != known.end()) return it->second;
         std::error_code ec;
         if (!fs::is_regular_file(target, ec))
-            st.fail(a.value_col, "cannot open mesh file " + quote(target.string()));
+            st.fail(a.value_col, "cannot open " + what + " file " + quote(target.string()));
         if (options_.copies) copy_file(target);
         try {
-            auto mesh = load_obj_mesh(target.string(), with_uv);
-            const auto index = std::uint32_t(scene.meshes.size());
-            scene.meshes.push_back(std::move(mesh));
-            meshes_.emplace(id, index);
+            auto item = load(target.string());
+            const auto index = typename Map::mapped_type(list.size());
+            list.push_back(std::move(item));
+            known.emplace(id, index);
             return index;
         } catch (const std::exception& e) {
             st.fail(a.value_col, quote(target.string()) + ": " + e.what());
         }
     }
 
-    /// The texture of an image file named relative to the statement's file, read once per
-    /// file: its index in Scene::textures. Shapes of the chunked reader call it from several
-    /// threads, hence the lock.
+    /// The mesh of an OBJ file, read once per file (twice when both untextured objects and
+    /// textured ones, which need its texture coordinates, use it): its index in Scene::meshes.
+    std::uint32_t mesh_file(const Statement& st, const Arg& a, bool with_uv) {
+        return read_once(
+            st, a, "mesh", meshes_, scene.meshes, [&](fs::path id) { return std::pair{std::move(id), with_uv}; },
+            [&](const std::string& path) { return load_obj_mesh(path, with_uv); });
+    }
+
+    /// The texture of an image file, read once per file: its index in Scene::textures.
+    /// Shapes of the chunked reader call it from several threads, hence the lock.
     std::int32_t texture_file(const Statement& st, const Arg& a) {
-        const fs::path base = fs::path(st.file()).parent_path();
-        const fs::path target = (base / fs::path(std::string(a.value))).lexically_normal();
         std::lock_guard<std::mutex> lock(textures_mutex_);
-        const fs::path id = identity_of(target);
-        if (const auto it = textures_.find(id); it != textures_.end()) return it->second;
-        std::error_code ec;
-        if (!fs::is_regular_file(target, ec))
-            st.fail(a.value_col, "cannot open texture file " + quote(target.string()));
-        if (options_.copies) copy_file(target);
-        try {
-            auto texture = load_texture(target.string());
-            const auto index = std::int32_t(scene.textures.size());
-            scene.textures.push_back(std::move(texture));
-            textures_.emplace(id, index);
-            return index;
-        } catch (const std::exception& e) {
-            st.fail(a.value_col, quote(target.string()) + ": " + e.what());
-        }
+        return read_once(
+            st, a, "texture", textures_, scene.textures, [](fs::path id) { return id; },
+            [](const std::string& path) { return load_texture(path); });
     }
     std::mutex textures_mutex_;
     std::map<fs::path, std::int32_t> textures_;  // by file identity (index in scene.textures)

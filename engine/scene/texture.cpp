@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
 // stb_image's decoder, private to this file (image/image_io.cpp has its own PNG-only copy).
@@ -68,20 +69,39 @@ std::shared_ptr<const Texture> Texture::build(std::string name, int width, int h
     return t;
 }
 
+namespace {
+/// Refuses (closing f) an image larger than kMaxTextureSide / kMaxTextureTexels.
+void check_size(std::FILE* f, std::uint32_t w, std::uint32_t h) {
+    if (w <= std::uint32_t(kMaxTextureSide) && h <= std::uint32_t(kMaxTextureSide) &&
+        std::size_t(w) * std::size_t(h) <= kMaxTextureTexels)
+        return;
+    std::fclose(f);
+    throw std::runtime_error("image of " + std::to_string(w) + " x " + std::to_string(h) +
+                             " texels is too large for a texture (at most " + std::to_string(kMaxTextureSide) +
+                             " per side and " + std::to_string(kMaxTextureTexels) + " texels in all)");
+}
+}  // namespace
+
 std::shared_ptr<const Texture> load_texture(const std::string& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) throw std::runtime_error("cannot open texture file");
     int w = 0, h = 0, n = 0;
+    // A PNG's size is read from its IHDR here: stb_image refuses huge PNGs in its header
+    // scan but then reports the last format it tried ("unknown image type").
+    unsigned char head[24];
+    const bool png = std::fread(head, 1, 24, f) == 24 && std::memcmp(head, "\x89PNG\r\n\x1a\n", 8) == 0 &&
+                     std::memcmp(head + 12, "IHDR", 4) == 0;
+    std::rewind(f);
+    const auto be32 = [&](int at) {
+        return (std::uint32_t(head[at]) << 24) | (std::uint32_t(head[at + 1]) << 16) |
+               (std::uint32_t(head[at + 2]) << 8) | std::uint32_t(head[at + 3]);
+    };
+    if (png) check_size(f, be32(16), be32(20));
     if (!stbi_info_from_file(f, &w, &h, &n)) {
         std::fclose(f);
         throw std::runtime_error(std::string("not a readable PNG or JPEG image (") + stbi_failure_reason() + ")");
     }
-    if (w > kMaxTextureSide || h > kMaxTextureSide || std::size_t(w) * std::size_t(h) > kMaxTextureTexels) {
-        std::fclose(f);
-        throw std::runtime_error("image of " + std::to_string(w) + " x " + std::to_string(h) +
-                                 " texels is too large for a texture (at most " + std::to_string(kMaxTextureSide) +
-                                 " per side and " + std::to_string(kMaxTextureTexels) + " texels)");
-    }
+    check_size(f, std::uint32_t(w), std::uint32_t(h));
     unsigned char* px = stbi_load_from_file(f, &w, &h, &n, 3);
     std::fclose(f);
     if (!px) throw std::runtime_error(std::string("cannot decode image (") + stbi_failure_reason() + ")");

@@ -1,0 +1,125 @@
+// The reader's texture keys (texture=, uvscale=) and the texture files behind them: sRGB
+// decoding, sharing, and every refusal at its exact line:col; OBJ texture coordinates.
+#include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "mesh/mesh.h"
+#include "render/texture.h"
+#include "scene/parser.h"
+#include "scene/test_png.h"
+
+using namespace streamrt;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Dir {
+    fs::path dir;
+    Dir() {
+        static int counter = 0;
+        dir = fs::temp_directory_path() /
+              ("streamrt_texture_reader_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+        test::write_png((dir / "quad.png").string(), 2, 2, test::kQuad);
+        test::write_png_header_only((dir / "huge.png").string(), 80000, 80000);
+        test::write_png_header_only((dir / "wide.png").string(), 20000, 2);
+        std::ofstream(dir / "text.png") << "not an image\n";
+        std::ofstream(dir / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        std::ofstream(dir / "trivt.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
+    }
+    ~Dir() {
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+    }
+    std::string cfg() const { return (dir / "t.cfg").string(); }
+    Scene parse(const std::string& text) const { return parse_scene(text, cfg()); }
+    void expect_error(const std::string& text, int line, int column, const std::string& needle) const {
+        INFO("scene text: ", text);
+        bool thrown = false;
+        try {
+            parse(text);
+        } catch (const SceneError& e) {
+            thrown = true;
+            INFO("message: ", std::string(e.what()));
+            CHECK(e.where().line == line);
+            CHECK(e.where().column == column);
+            CHECK(e.message().find(needle) != std::string::npos);
+        }
+        CHECK_MESSAGE(thrown, "expected a SceneError");
+    }
+};
+
+}  // namespace
+
+// Proven against: the sRGB table built with the 2.2 power law (128 gave 0.2195).
+TEST_CASE("texture reader: texels are decoded from sRGB to linear") {
+    // 128/255 = 0.50196: ((0.50196 + 0.055) / 1.055)^2.4 = 0.2158605 (IEC 61966-2-1).
+    CHECK(srgb_to_linear(128) == doctest::Approx(0.2158605).epsilon(1e-6));
+    // 10/255 = 0.039216 <= 0.04045: the linear segment, / 12.92 = 0.0030353.
+    CHECK(srgb_to_linear(10) == doctest::Approx(0.0030352698).epsilon(1e-6));
+    CHECK(srgb_to_linear(0) == 0.0f);
+    CHECK(srgb_to_linear(255) == 1.0f);
+}
+
+// Proven against: textures not shared (each statement loaded its own: 2 textures) and the
+// material hash ignoring the texture index (the two materials merged into one).
+TEST_CASE("texture reader: texture= and uvscale= on materials and shapes; one image per file") {
+    Dir d;
+    const Scene s = d.parse(
+        "material tiled texture=quad.png uvscale=4\n"
+        "sphere material=tiled\n"
+        "plane texture=./quad.png\n"
+        "cube color=0.5,0.5,0.5\n");
+    REQUIRE(s.textures.size() == 1);
+    const Texture& t = *s.textures[0];
+    REQUIRE(t.levels.size() == 2);
+    CHECK(t.levels[0].width == 2);
+    // Top-left red, bottom-right white (codes 255 -> 1 exactly).
+    CHECK(t.levels[0].rgb[0] == 1.0f);
+    CHECK(t.levels[0].rgb[1] == 0.0f);
+    CHECK(t.levels[0].rgb[9] == 1.0f);
+    CHECK(s.material_of(s.objects[0]).texture == 0);
+    CHECK(s.material_of(s.objects[0]).uv_scale == 4.0);
+    CHECK(s.material_of(s.objects[1]).texture == 0);
+    CHECK(s.material_of(s.objects[1]).uv_scale == 1.0);
+    CHECK(s.material_of(s.objects[2]).texture == -1);
+    CHECK(s.materials.size() == 3);
+}
+
+// Proven against: the file's path column replaced by the statement's (col 1), and the size
+// check after decoding (the 80000 x 80000 header gave "unknown image type").
+TEST_CASE("texture reader: missing, unreadable and too large images at the path's column") {
+    Dir d;
+    d.expect_error("sphere texture=nope.png\n", 1, 16, "cannot open texture file");
+    d.expect_error("image width=4 height=4\nsphere color=1,1,1 texture=text.png\n", 2, 28,
+                   "not a readable PNG or JPEG image");
+    d.expect_error("material m texture=huge.png\n", 1, 20, "image of 80000 x 80000 texels is too large");
+    d.expect_error("plane texture=wide.png\n", 1, 15, "at most 16384 per side");
+    d.expect_error("sphere texture=quad.png uvscale=0\n", 1, 33, "'uvscale' must be > 0");
+    d.expect_error("sphere texture=\n", 1, 16, "empty value");
+}
+
+// Proven against: load_obj_mesh ignoring with_uv (the textured mesh read no vt: no error,
+// and mesh_uv read a null pointer).
+TEST_CASE("texture reader: a textured mesh needs vt; coordinates kept only when a texture uses them") {
+    Dir d;
+    d.expect_error("mesh file=tri.obj texture=quad.png\n", 1, 11, "face without texture coordinates (vt)");
+    const Scene s = d.parse(
+        "mesh file=trivt.obj\n"
+        "mesh file=trivt.obj texture=quad.png\n");
+    REQUIRE(s.meshes.size() == 2);  // the untextured use is read without coordinates
+    CHECK(s.meshes[s.objects[0].mesh]->view().uv == nullptr);
+    const MeshView& m = s.meshes[s.objects[1].mesh]->view();
+    REQUIRE(m.uv != nullptr);
+    // Corners (0,0), (1,0), (0,1): at barycentrics (1/4, 1/2), (u, v) = (1/4, 1/2).
+    const UvT<double> uv = mesh_uv(m, 0, 0.25, 0.5);
+    CHECK(uv.u == doctest::Approx(0.25));
+    CHECK(uv.v == doctest::Approx(0.5));
+    // uv edge lengths 1 + sqrt2 + 1 over edge lengths 1 + sqrt2 + 1: density 1.
+    CHECK(m.uv_density == doctest::Approx(1.0));
+}
