@@ -56,8 +56,8 @@ TEST_CASE("texture: bilinear lookups of a 2 x 2 texture at hand-worked coordinat
     CHECK(f.y == doctest::Approx(0.25));
 }
 
-// Proven against: the box filter averaging 2 of the 4 texels (only the top row): level 1
-// was (0.5, 0.5, 0); a 3-wide level dropping its last column: (4/3 ... ) below differed.
+// Proven against: the odd last column not folded in (x1 = min(2x + 1, w - 1)): the 3 x 1
+// level 1 was (0 + 3) / 2 = 1.5.
 TEST_CASE("texture: the mip chain is the box-filtered mean, down to 1 x 1") {
     const auto t = quad();
     REQUIRE(t->levels.size() == 2);
@@ -73,9 +73,8 @@ TEST_CASE("texture: the mip chain is the box-filtered mean, down to 1 x 1") {
     CHECK(odd->levels[1].rgb[0] == doctest::Approx(3.0));
 }
 
-// Proven against: lod = log2(texels) without the clamp at the coarsest level (read past the
-// chain: a crash under ASan), and lod from the footprint without the uv density (the
-// plane/sphere cases below differ by 1/pi).
+// Proven against: the nearest lower level instead of the blend of two (f = 0 in
+// texture_sample: the halfway lookup gave red); v not flipped (the red texel's centre read blue).
 TEST_CASE("texture: the mip level of a footprint") {
     const auto t = Texture::build("grey", 4, 4, std::vector<float>(4 * 4 * 3, 0.5f));  // levels 4, 2, 1
     const TextureView v = t->view();
@@ -108,8 +107,7 @@ TEST_CASE("texture: the mip level of a footprint") {
 }
 
 // Proven against: the stream engine's texture branch removed from the SIMD shade kernel (the
-// pixel stayed the object's colour, white) and the baseline's uv read from the world point
-// instead of the canonical one (the translate moved it to the blue texel).
+// pixel stayed the object's colour, white); v not flipped in the lookup (blue, not red).
 TEST_CASE("texture: a rendered pixel of a textured plane, both engines") {
     const fs::path dir = fs::temp_directory_path() / ("streamrt_texture_test_" + std::to_string(::getpid()));
     fs::create_directories(dir);

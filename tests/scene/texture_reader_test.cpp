@@ -66,8 +66,8 @@ TEST_CASE("texture reader: texels are decoded from sRGB to linear") {
     CHECK(srgb_to_linear(255) == 1.0f);
 }
 
-// Proven against: textures not shared (each statement loaded its own: 2 textures) and the
-// material hash ignoring the texture index (the two materials merged into one).
+// Proven against: textures not shared (read_once's lookup of a known file removed: each
+// statement loaded its own, 2 textures).
 TEST_CASE("texture reader: texture= and uvscale= on materials and shapes; one image per file") {
     Dir d;
     const Scene s = d.parse(
@@ -91,8 +91,8 @@ TEST_CASE("texture reader: texture= and uvscale= on materials and shapes; one im
     CHECK(s.materials.size() == 3);
 }
 
-// Proven against: the file's path column replaced by the statement's (col 1), and the size
-// check after decoding (the 80000 x 80000 header gave "unknown image type").
+// Without load_texture's own PNG header read, the 80000 x 80000 file gave "unknown image
+// type" (stb_image's header scan refuses it, then reports the last format it tried).
 TEST_CASE("texture reader: missing, unreadable and too large images at the path's column") {
     Dir d;
     d.expect_error("sphere texture=nope.png\n", 1, 16, "cannot open texture file");
@@ -104,8 +104,8 @@ TEST_CASE("texture reader: missing, unreadable and too large images at the path'
     d.expect_error("sphere texture=\n", 1, 16, "empty value");
 }
 
-// Proven against: load_obj_mesh ignoring with_uv (the textured mesh read no vt: no error,
-// and mesh_uv read a null pointer).
+// Proven against: the mesh read without its coordinates whatever the texture (mesh_file
+// passing with_uv = false: no error, and the textured mesh had no uv).
 TEST_CASE("texture reader: a textured mesh needs vt; coordinates kept only when a texture uses them") {
     Dir d;
     d.expect_error("mesh file=tri.obj texture=quad.png\n", 1, 11, "face without texture coordinates (vt)");

@@ -25,9 +25,7 @@ void check_uv(double x, double y, double z, double u, double v, double param = 0
 
 }  // namespace
 
-// Proven against: the sphere's u from atan2(z, x) (the +z point went to u = 0.75) and v
-// from acos (the equator stayed at 0.5 but the north pole went to 0); the cube's y faces
-// mapping (z, x) (u and v swapped).
+// Proven against: the sphere's u from atan2(z, x) (the +z point went to u = 0.75).
 TEST_CASE("uv: sphere, longitude and latitude") {
     check_uv<SphereMath>(0, 0, 1, 0.5, 0.5);   // atan2(0, 1) = 0, asin(0) = 0
     check_uv<SphereMath>(1, 0, 0, 0.75, 0.5);  // atan2(1, 0) = pi/2: 0.5 + 1/4
