@@ -74,21 +74,35 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
     return {B::load_aligned(nx), B::load_aligned(ny), B::load_aligned(nz)};
 }
 
-/// Texture coordinates of a mesh's hits, gathered lane by lane (render/texture.h mesh_uv, the
-/// same float expressions as the scalar path). Lanes past the run get (0, 0).
-template <class B>
-inline UvT<B> mesh_uvs(const ShadeJob& job, std::size_t i) {
+/// The texture colour of each lane's hit (render/texture.h), lane by lane in scalar float:
+/// the same calls and values as the scalar shade path, so the picture is the same bits at
+/// every ISA level (xsimd's atan2, asin and cbrt round differently at different levels).
+/// The texel reads are per lane anyway.
+template <class B, class Rows>
+inline ColorT<B> texture_colors(const ShadeJob& job, std::size_t i, const MaterialT<float>& m, ShapeKind kind,
+                                bool mesh, const Vec3T<B>& pc, const B& param, const Rows& rows, const B& footprint) {
     constexpr std::size_t W = B::size;
-    const MeshView& m = *job.object->xf.mesh;
-    alignas(64) float us[W], vs[W];
+    alignas(64) float px[W], py[W], pz[W], fp[W], pa[W], r[W], g[W], b[W], rw[12][W];
+    pc.x.store_aligned(px);
+    pc.y.store_aligned(py);
+    pc.z.store_aligned(pz);
+    footprint.store_aligned(fp);
+    param.store_aligned(pa);
+    for (int k = 0; k < 12; ++k) B(rows[k]).store_aligned(rw[k]);
     for (std::size_t l = 0; l < W; ++l) {
-        us[l] = vs[l] = 0.f;
-        if (i + l >= job.end || !m.uv) continue;
-        const UvT<float> uv = mesh_uv(m, std::uint32_t(job.prim[i + l]), job.bu[i + l], job.bv[i + l]);
-        us[l] = uv.u;
-        vs[l] = uv.v;
+        float mi[12];
+        for (int k = 0; k < 12; ++k) mi[k] = rw[k][l];
+        ColorT<float> c{0.f, 0.f, 0.f};
+        if (!mesh)
+            c = texture_color(m, kind, Vec3T<float>{px[l], py[l], pz[l]}, pa[l], mi, fp[l]);
+        else if (i + l < job.end)  // lanes past the run have no triangle
+            c = mesh_texture_color(m, *job.object->xf.mesh, std::uint32_t(job.prim[i + l]), job.bu[i + l],
+                                   job.bv[i + l], canonical_per_world<float>(mi), fp[l]);
+        r[l] = c.x;
+        g[l] = c.y;
+        b[l] = c.z;
     }
-    return {B::load_aligned(us), B::load_aligned(vs)};
+    return {B::load_aligned(r), B::load_aligned(g), B::load_aligned(b)};
 }
 
 /// Appends the active lanes' rays to the next generation's stream, compacted.
@@ -211,10 +225,7 @@ void shade_run(const ShadeJob& job) {
         const ArrivingRay<B> arriving{o, d, t, B::load_unaligned(job.cone + i), w, w};
         if (m.texture) {  // one branch per run: the texture replaces the object's colour
             const B footprint = footprint_width(arriving.cone, B(job.rules.spread), t, dot(d, n_out));
-            color = kind == ShapeKind::Mesh && !kGathered
-                        ? texture_color_at(m, mesh_uvs<B>(job, i), B(job.object->xf.mesh->uv_density),
-                                           canonical_per_world<B>(rows), footprint)
-                        : texture_color(m, kind, pc, param, rows, footprint);
+            color = texture_colors(job, i, m, kind, kind == ShapeKind::Mesh && !kGathered, pc, param, rows, footprint);
         }
         SimdSink<B> sink{job, i};
         shade_hit<kLit, kShadows, kReflect, kRefract>(job.rules, m, job.lights, job.n_lights, arriving, p, n_out, color,

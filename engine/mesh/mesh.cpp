@@ -132,59 +132,150 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
     return m;
 }
 
-std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv) {
+namespace {
+
+std::string read_file_bytes(const std::string& path, const char* what) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error("cannot open mesh file");
+    if (!in) throw std::runtime_error(std::string("cannot open ") + what);
     std::ostringstream ss;
     ss << in.rdbuf();
-    if (in.bad()) throw std::runtime_error("cannot read mesh file");
+    if (in.bad()) throw std::runtime_error(std::string("cannot read ") + what);
+    return ss.str();
+}
+
+/// The triangles of an OBJ text, grouped by material id (all in group -1 unless by_material),
+/// with their corners' texture coordinates where uv_for(group) says so.
+struct ObjFaces {
+    std::vector<float> positions;
+    struct Group {
+        std::vector<std::uint32_t> tris;
+        std::vector<float> corner_uv;
+    };
+    std::map<int, Group> groups;
+    std::vector<tinyobj::material_t> materials;
+};
+
+template <class UvFor>
+ObjFaces read_obj_faces(const std::string& obj_text, const std::string& mtl_text, bool by_material, UvFor uv_for) {
     tinyobj::ObjReaderConfig config;
     config.triangulate = true;
     config.vertex_color = false;
     tinyobj::ObjReader reader;
-    // From a string with no material text: `mtllib` lines are ignored, nothing else is read.
-    if (!reader.ParseFromString(ss.str(), "", config)) {
+    // From strings: the material text is the one given (none: `mtllib` lines are ignored).
+    if (!reader.ParseFromString(obj_text, mtl_text, config)) {
         std::string err = reader.Error();
         while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
         throw std::runtime_error("cannot parse OBJ file: " + err);
     }
+    ObjFaces out;
     const tinyobj::attrib_t& at = reader.GetAttrib();
-    std::vector<float> positions(at.vertices.begin(), at.vertices.end());
-    std::vector<std::uint32_t> tris;
-    std::vector<float> corner_uv;  // with_uv: 6 per triangle
+    out.positions.assign(at.vertices.begin(), at.vertices.end());
+    out.materials = reader.GetMaterials();
     for (const tinyobj::shape_t& s : reader.GetShapes()) {
         std::size_t off = 0;
-        for (const auto nv : s.mesh.num_face_vertices) {
+        for (std::size_t f = 0; f < s.mesh.num_face_vertices.size(); ++f) {
+            const auto nv = s.mesh.num_face_vertices[f];
+            const int key = by_material && f < s.mesh.material_ids.size() ? s.mesh.material_ids[f] : -1;
             if (nv == 3) {
+                ObjFaces::Group& g = out.groups[key];
+                const bool with_uv = uv_for(key);
                 for (int j = 0; j < 3; ++j) {
                     const tinyobj::index_t& ix = s.mesh.indices[off + std::size_t(j)];
                     const int v = ix.vertex_index;
-                    if (v < 0 || std::size_t(v) >= positions.size() / 3)
+                    if (v < 0 || std::size_t(v) >= out.positions.size() / 3)
                         throw std::runtime_error("OBJ face refers to a missing vertex");
-                    tris.push_back(std::uint32_t(v));
+                    g.tris.push_back(std::uint32_t(v));
                     if (!with_uv) continue;
                     const int t = ix.texcoord_index;
                     if (t < 0 || 2 * std::size_t(t) + 1 >= at.texcoords.size())
                         throw std::runtime_error("OBJ file has a face without texture coordinates (vt), which a "
                                                  "texture needs");
-                    corner_uv.push_back(at.texcoords[2 * std::size_t(t)]);
-                    corner_uv.push_back(at.texcoords[2 * std::size_t(t) + 1]);
+                    g.corner_uv.push_back(at.texcoords[2 * std::size_t(t)]);
+                    g.corner_uv.push_back(at.texcoords[2 * std::size_t(t) + 1]);
                 }
             }
             off += nv;
         }
     }
-    for (float p : positions)
+    for (float p : out.positions)
         if (!std::isfinite(p)) throw std::runtime_error("OBJ file has a vertex that is not finite");
-    const std::size_t faces = tris.size() / 3;
-    for (float t : corner_uv)
-        if (!std::isfinite(t)) throw std::runtime_error("OBJ file has a texture coordinate that is not finite");
-    auto mesh = Mesh::build(path, positions, tris, {}, corner_uv);
+    for (const auto& [key, g] : out.groups)
+        for (float t : g.corner_uv)
+            if (!std::isfinite(t)) throw std::runtime_error("OBJ file has a texture coordinate that is not finite");
+    return out;
+}
+
+std::shared_ptr<const Mesh> build_checked(const std::string& path, const std::vector<float>& positions,
+                                          const ObjFaces::Group& g) {
+    const std::size_t faces = g.tris.size() / 3;
+    auto mesh = Mesh::build(path, positions, g.tris, {}, g.corner_uv);
     if (mesh->triangle_count() == 0)
         throw std::runtime_error(faces == 0 ? "OBJ file has no faces"
                                             : "OBJ file has no triangles of non-zero area (" +
                                                   std::to_string(faces) + " degenerate)");
     return mesh;
+}
+
+}  // namespace
+
+std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv) {
+    const ObjFaces faces = read_obj_faces(read_file_bytes(path, "mesh file"), "", false, [&](int) { return with_uv; });
+    static const ObjFaces::Group kNone;
+    const auto it = faces.groups.find(-1);
+    return build_checked(path, faces.positions, it == faces.groups.end() ? kNone : it->second);
+}
+
+ObjModel load_obj_model(const std::string& path, bool with_uv) {
+    const std::string obj_text = read_file_bytes(path, "mesh file");
+    ObjModel model;
+    std::string mtl_text;
+    {
+        std::istringstream lines(obj_text);
+        std::string line;
+        while (std::getline(lines, line)) {
+            std::istringstream words(line);
+            std::string word, name;
+            if (words >> word && word == "mtllib" && words >> name) {
+                const std::size_t slash = path.find_last_of('/');
+                model.mtl_path = slash == std::string::npos ? name : path.substr(0, slash + 1) + name;
+                mtl_text = read_file_bytes(model.mtl_path, ("material library '" + model.mtl_path + "'").c_str());
+                break;
+            }
+        }
+    }
+    std::vector<bool> mapped;  // per material: has map_Kd
+    const auto uv_for = [&](int m) { return with_uv || (m >= 0 && std::size_t(m) < mapped.size() && mapped[m]); };
+    // The materials are known only once parsed: a first pass without coordinates finds them.
+    {
+        tinyobj::ObjReaderConfig config;
+        tinyobj::ObjReader reader;
+        if (reader.ParseFromString("mtllib library\n", mtl_text, config))
+            for (const tinyobj::material_t& m : reader.GetMaterials()) mapped.push_back(!m.diffuse_texname.empty());
+    }
+    const ObjFaces faces = read_obj_faces(obj_text, mtl_text, true, uv_for);
+    for (const tinyobj::material_t& m : faces.materials) {
+        ObjMaterial o;
+        o.name = m.name;
+        for (int c = 0; c < 3; ++c) {
+            o.kd[c] = m.diffuse[c];
+            o.ks[c] = m.specular[c];
+        }
+        o.ns = m.shininess;
+        o.ni = m.ior;
+        o.d = m.dissolve;
+        o.map_kd = m.diffuse_texname;
+        model.materials.push_back(o);
+    }
+    for (const auto& [key, g] : faces.groups) {
+        auto mesh = Mesh::build(path, faces.positions, g.tris, {}, g.corner_uv);
+        if (mesh->triangle_count() == 0) continue;  // a group of degenerate faces only
+        const int material = key >= 0 && std::size_t(key) < model.materials.size() ? key : -1;
+        model.parts.push_back({std::move(mesh), material});
+    }
+    if (model.parts.empty())
+        throw std::runtime_error(faces.groups.empty() ? "OBJ file has no faces"
+                                                      : "OBJ file has no triangles of non-zero area");
+    return model;
 }
 
 // ---- generated surfaces -------------------------------------------------------------------

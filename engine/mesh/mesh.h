@@ -50,6 +50,37 @@ struct Mesh {
 /// file, one with no triangles, or (with_uv) a face without texture coordinates.
 std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv = false);
 
+/// One material of an OBJ file's material library (MTL), as read (docs/scene-format.md,
+/// "OBJ materials" maps it onto the material keys).
+struct ObjMaterial {
+    std::string name;
+    double kd[3] = {0, 0, 0};  ///< Kd
+    double ks[3] = {0, 0, 0};  ///< Ks
+    double ns = 0;             ///< Ns
+    double ni = 1;             ///< Ni
+    double d = 1;              ///< d (1: opaque)
+    std::string map_kd;        ///< map_Kd, relative to the MTL file's folder; empty: none
+};
+
+/// An OBJ file read with its materials (mesh materials=obj): one mesh per material used by
+/// its faces (usemtl groups; faces before any usemtl form the part of material -1), all cut
+/// from the file's one vertex list.
+struct ObjModel {
+    struct Part {
+        std::shared_ptr<const Mesh> mesh;
+        int material = -1;  ///< index into materials; -1: none
+    };
+    std::vector<Part> parts;
+    std::vector<ObjMaterial> materials;
+    std::string mtl_path;  ///< the library read (empty: the file names none)
+};
+
+/// Reads an OBJ file and the material library its first `mtllib` line names (relative to
+/// the OBJ file's folder). A part keeps its texture coordinates when `with_uv` or its
+/// material has map_Kd. Throws std::runtime_error like load_obj_mesh, and for a library that
+/// cannot be read.
+ObjModel load_obj_model(const std::string& path, bool with_uv);
+
 // ---- generated surfaces (tests, benchmarks, the sample scene) -----------------------------
 
 /// Vertices and triangles of a generated surface.

@@ -72,7 +72,9 @@ inline ColorT<T> texture_sample(const TextureView& t, T u, T v, T texels) {
 }
 
 /// The lookup for every lane of V: one point for a scalar, lane by lane for a batch (the
-/// texels of different lanes are anywhere in the image).
+/// texels of different lanes are anywhere in the image). The SIMD shade kernel calls the
+/// scalar functions lane by lane instead (kernels/shade_kernel.h texture_colors), for the same
+/// bits at every ISA level; batches serve tests and callers that need no such guarantee.
 template <class V>
 inline ColorT<V> texture_sample_lanes(const TextureView& t, const V& u, const V& v, const V& texels) {
     if constexpr (!simd::is_batch<V>) {

@@ -31,6 +31,13 @@ struct Dir {
         std::ofstream(dir / "text.png") << "not an image\n";
         std::ofstream(dir / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
         std::ofstream(dir / "trivt.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
+        // Two usemtl groups of one vertex list: a red glassy square, a textured one.
+        std::ofstream(dir / "two.obj") << "mtllib two.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv 3 -1 0\n"
+                                          "v 3 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl red\nf 1 2 3\nf 1 3 4\n"
+                                          "usemtl pic\nf 2/1 5/2 6/3\nf 2/1 6/3 3/4\n";
+        std::ofstream(dir / "two.mtl") << "newmtl red\nKd 0.8 0.1 0.2\nKs 0.3 0.6 0.9\nNs 50\nNi 1.5\nd 0.75\n"
+                                          "newmtl pic\nKd 1 1 1\nmap_Kd quad.png\n";
+        std::ofstream(dir / "nolib.obj") << "mtllib none.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     }
     ~Dir() {
         std::error_code ec;
@@ -122,4 +129,29 @@ TEST_CASE("texture reader: a textured mesh needs vt; coordinates kept only when 
     CHECK(uv.v == doctest::Approx(0.5));
     // uv edge lengths 1 + sqrt2 + 1 over edge lengths 1 + sqrt2 + 1: density 1.
     CHECK(m.uv_density == doctest::Approx(1.0));
+}
+
+// Proven against: Ks mapped from its first component (spec 0.3, not the mean 0.6).
+TEST_CASE("texture reader: mesh materials=obj maps each usemtl group's MTL material onto the keys") {
+    Dir d;
+    const Scene s = d.parse("mesh file=two.obj materials=obj ambi=0.5 scale=2\n");
+    REQUIRE(s.objects.size() == 2);  // one object per usemtl group
+    REQUIRE(s.meshes.size() == 2);
+    const Material& red = s.material_of(s.objects[0]);
+    CHECK(s.objects[0].color.x == doctest::Approx(0.8));  // Kd -> color
+    CHECK(s.objects[0].color.z == doctest::Approx(0.2));
+    CHECK(red.spec == doctest::Approx(0.6));        // Ks -> spec, the mean (0.3 + 0.6 + 0.9) / 3
+    CHECK(red.shininess == doctest::Approx(50.0));  // Ns -> shininess
+    CHECK(red.ior == doctest::Approx(1.5));         // Ni -> ior
+    CHECK(red.trans == doctest::Approx(0.25));      // d -> trans = 1 - d
+    CHECK(red.ambi == 0.5);                         // the statement's keys where MTL says nothing
+    CHECK(red.texture == -1);
+    CHECK(s.meshes[s.objects[0].mesh]->view().uv == nullptr);  // no map_Kd: no coordinates kept
+    const Material& pic = s.material_of(s.objects[1]);
+    REQUIRE(pic.texture == 0);  // map_Kd -> texture, relative to the library's folder
+    CHECK(s.textures[0]->levels[0].width == 2);
+    CHECK(s.meshes[s.objects[1].mesh]->view().uv != nullptr);
+    CHECK(s.objects[0].md == s.objects[1].md);  // both placed by the statement
+    d.expect_error("mesh file=two.obj materials=mtl\n", 1, 29, "expected obj for 'materials'");
+    d.expect_error("mesh file=nolib.obj materials=obj\n", 1, 11, "cannot open material library");
 }
