@@ -157,10 +157,10 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     if (material.texture) {  // the texture replaces the object's colour (render/texture.h)
         const PreparedObject& ob = objects_[std::size_t(hit.object)];
         const double footprint = footprint_width(ray.cone, camera_.spread, hit.t, dot(ray.dir, hit.normal));
+        const double scale = canonical_per_world<double>(RowsOf{ob.mi});
         object_color = ob.kind == ShapeKind::Mesh
-                           ? mesh_texture_color(material, ob.mesh->view(), hit.tri, hit.bu, hit.bv,
-                                                canonical_per_world<double>(RowsOf{ob.mi}), footprint)
-                           : texture_color(material, ob.kind, hit.canonical, ob.param, RowsOf{ob.mi}, footprint);
+                           ? mesh_texture_color(material, ob.mesh->view(), hit.tri, hit.bu, hit.bv, scale, footprint)
+                           : texture_color(material, ob.kind, hit.canonical, ob.param, scale, footprint);
     }
     RecursiveSink sink{*this, depth, counts};
     const auto shade = [&]<bool kLit, bool kShadows>() {

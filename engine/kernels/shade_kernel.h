@@ -77,27 +77,37 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
 /// The texture colour of each lane's hit (render/texture.h), lane by lane in scalar float:
 /// the same calls and values as the scalar shade path, so the picture is the same bits at
 /// every ISA level (xsimd's atan2, asin and cbrt round differently at different levels).
-/// The texel reads are per lane anyway.
+/// The texel reads are per lane anyway. `scale`: the run's canonical_per_world, or (gathered,
+/// scale < 0) each lane's, from its rows.
 template <class B, class Rows>
 inline ColorT<B> texture_colors(const ShadeJob& job, std::size_t i, const MaterialT<float>& m, ShapeKind kind,
-                                bool mesh, const Vec3T<B>& pc, const B& param, const Rows& rows, const B& footprint) {
+                                bool mesh, const Vec3T<B>& pc, const B& param, const Rows& rows, float scale,
+                                const B& footprint) {
     constexpr std::size_t W = B::size;
-    alignas(64) float px[W], py[W], pz[W], fp[W], pa[W], r[W], g[W], b[W], rw[12][W];
+    alignas(64) float px[W], py[W], pz[W], fp[W], pa[W], r[W], g[W], b[W], sc[W];
     pc.x.store_aligned(px);
     pc.y.store_aligned(py);
     pc.z.store_aligned(pz);
     footprint.store_aligned(fp);
     param.store_aligned(pa);
-    for (int k = 0; k < 12; ++k) B(rows[k]).store_aligned(rw[k]);
+    if (scale < 0.f) {
+        alignas(64) float rw[12][W];
+        for (int k = 0; k < 12; ++k) B(rows[k]).store_aligned(rw[k]);
+        for (std::size_t l = 0; l < W; ++l) {
+            float mi[12];
+            for (int k = 0; k < 12; ++k) mi[k] = rw[k][l];
+            sc[l] = canonical_per_world<float>(mi);
+        }
+    } else {
+        for (std::size_t l = 0; l < W; ++l) sc[l] = scale;
+    }
     for (std::size_t l = 0; l < W; ++l) {
-        float mi[12];
-        for (int k = 0; k < 12; ++k) mi[k] = rw[k][l];
         ColorT<float> c{0.f, 0.f, 0.f};
         if (!mesh)
-            c = texture_color(m, kind, Vec3T<float>{px[l], py[l], pz[l]}, pa[l], mi, fp[l]);
+            c = texture_color(m, kind, Vec3T<float>{px[l], py[l], pz[l]}, pa[l], sc[l], fp[l]);
         else if (i + l < job.end)  // lanes past the run have no triangle
             c = mesh_texture_color(m, *job.object->xf.mesh, std::uint32_t(job.prim[i + l]), job.bu[i + l],
-                                   job.bv[i + l], canonical_per_world<float>(mi), fp[l]);
+                                   job.bv[i + l], sc[l], fp[l]);
         r[l] = c.x;
         g[l] = c.y;
         b[l] = c.z;
@@ -187,6 +197,8 @@ void shade_run(const ShadeJob& job) {
     const MaterialT<float>& m = *job.material;
     alignas(64) float lane_index[W];
     for (std::size_t l = 0; l < W; ++l) lane_index[l] = float(l);
+    // Textures: the object's canonical units per world unit, once per run (gathered: per lane).
+    const float run_scale = m.texture && !kGathered ? canonical_per_world<float>(ob.m) : -1.f;
     const B lanes = B::load_aligned(lane_index);
 
     for (std::size_t i = job.begin; i < job.end; i += W) {
@@ -225,7 +237,8 @@ void shade_run(const ShadeJob& job) {
         const ArrivingRay<B> arriving{o, d, t, B::load_unaligned(job.cone + i), w, w};
         if (m.texture) {  // one branch per run: the texture replaces the object's colour
             const B footprint = footprint_width(arriving.cone, B(job.rules.spread), t, dot(d, n_out));
-            color = texture_colors(job, i, m, kind, kind == ShapeKind::Mesh && !kGathered, pc, param, rows, footprint);
+            color = texture_colors(job, i, m, kind, kind == ShapeKind::Mesh && !kGathered, pc, param, rows,
+                                   run_scale, footprint);
         }
         SimdSink<B> sink{job, i};
         shade_hit<kLit, kShadows, kReflect, kRefract>(job.rules, m, job.lights, job.n_lights, arriving, p, n_out, color,

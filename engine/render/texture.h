@@ -122,18 +122,18 @@ inline ColorT<V> texture_color_at(const MaterialT<T>& m, const UvT<V>& uv, const
 }
 
 /// The surface colour of a textured material on a canonical shape: uv from the canonical
-/// hit point pc by the shape's mapping (shapes/*_math.h), then texture_color_at. `mi` is the
-/// object's Mi (rows).
-template <class V, class T, class Rows>
+/// hit point pc by the shape's mapping (shapes/*_math.h), then texture_color_at. `scale` is
+/// the object's canonical_per_world (computed once per object where the caller can).
+template <class V, class T>
 inline ColorT<V> texture_color(const MaterialT<T>& m, ShapeKind kind, const Vec3T<V>& pc, const V& param,
-                               const Rows& mi, const V& footprint) {
+                               const V& scale, const V& footprint) {
     UvT<V> uv;
     V density;
     visit_shape(kind, [&](auto shape) {
         uv = shape.template uv<V>(pc, param);
         density = shape.template uv_density<V>(param);
     });
-    return texture_color_at(m, uv, density, canonical_per_world<V>(mi), footprint);
+    return texture_color_at(m, uv, density, scale, footprint);
 }
 
 /// A mesh's texture coordinates at barycentrics (bu, bv) of triangle tri: its corners' (OBJ

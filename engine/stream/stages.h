@@ -367,10 +367,11 @@ struct PipelineStages {
             ColorT<float> color{sf.color[0], sf.color[1], sf.color[2]};
             if (m.texture) {  // the texture replaces the object's colour (render/texture.h)
                 const float footprint = footprint_width(rays.cone[i], rules.spread, t, dot(d, n_out));
+                const float scale = canonical_per_world<float>(ob.xf.m);
                 color = kind == ShapeKind::Mesh
                             ? mesh_texture_color(m, *ob.xf.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i],
-                                                 mesh_hits.v[i], canonical_per_world<float>(ob.xf.m), footprint)
-                            : texture_color(m, kind, pc, ob.xf.param, ob.xf.m, footprint);
+                                                 mesh_hits.v[i], scale, footprint)
+                            : texture_color(m, kind, pc, ob.xf.param, scale, footprint);
             }
             shade_hit<kLighting, kShadows, kReflect, kRefract>(rules, m, sc.lights.data(), sc.lights.size(), arriving,
                                                                p, n_out, color, true, sink);

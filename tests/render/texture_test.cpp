@@ -96,14 +96,15 @@ TEST_CASE("texture: the mip level of a footprint") {
     // A sphere's density 1/pi makes it 2/pi texels: level 0.
     MaterialT<double> m = MaterialT<double>::from(Material{});
     m.texture = v;
-    const auto plane = texture_color(m, ShapeKind::Plane, Vec3d{0.1, 0, 0.1}, 0.0, mi, 1.0);
+    const double s = canonical_per_world<double>(mi);
+    const auto plane = texture_color(m, ShapeKind::Plane, Vec3d{0.1, 0, 0.1}, 0.0, s, 1.0);
     check_color(plane, 0.5, 0.5, 0.5);
     MaterialT<double> mq = MaterialT<double>::from(Material{});
     mq.texture = q->view();
     // Plane at canonical (0.25, 0, 0.75): (u, v) = (0.25, 0.75), the red texel's centre; a
     // footprint of 2 world units is 2 x 0.5 x 1 x 2 = 2 texels: level 1 (grey), 1/2: level 0.
-    check_color(texture_color(mq, ShapeKind::Plane, Vec3d{0.25, 0, 0.75}, 0.0, mi, 2.0), 0.5, 0.5, 0.5);
-    check_color(texture_color(mq, ShapeKind::Plane, Vec3d{0.25, 0, 0.75}, 0.0, mi, 0.5), 1, 0, 0);
+    check_color(texture_color(mq, ShapeKind::Plane, Vec3d{0.25, 0, 0.75}, 0.0, s, 2.0), 0.5, 0.5, 0.5);
+    check_color(texture_color(mq, ShapeKind::Plane, Vec3d{0.25, 0, 0.75}, 0.0, s, 0.5), 1, 0, 0);
 }
 
 // Proven against: the stream engine's texture branch removed from the SIMD shade kernel (the
