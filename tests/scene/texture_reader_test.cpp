@@ -155,3 +155,27 @@ TEST_CASE("texture reader: mesh materials=obj maps each usemtl group's MTL mater
     d.expect_error("mesh file=two.obj materials=mtl\n", 1, 29, "expected obj for 'materials'");
     d.expect_error("mesh file=nolib.obj materials=obj\n", 1, 11, "cannot open material library");
 }
+
+// Proven against: read_once without the texture lock (run under TSan: a race on the cache)
+// is not provable here; this checks the result: the chunked reader (shapes parsed in
+// parallel) shares one texture per file like the one-pass reader, and the bundle's copies
+// hold the image's bytes (the distributed renderer ships them).
+TEST_CASE("texture reader: chunked reading and file copies") {
+    Dir d;
+    std::string text;
+    for (int i = 0; i < 200; ++i) text += "sphere texture=quad.png translate=" + std::to_string(i) + ",0,0\n";
+    std::vector<FileCopy> copies;
+    ReadOptions options;
+    options.jobs = 2;
+    options.chunk_bytes = 512;
+    options.chunked_from = 0;
+    options.copies = &copies;
+    const Scene s = parse_scene(text, d.cfg(), options);
+    CHECK(s.objects.size() == 200);
+    CHECK(s.textures.size() == 1);
+    CHECK(s.materials.size() == 1);
+    std::size_t png_bytes = 0;
+    for (const FileCopy& c : copies)
+        if (c.path.find("quad.png") != std::string::npos) png_bytes = c.bytes.size();
+    CHECK(png_bytes == fs::file_size(d.dir / "quad.png"));
+}
