@@ -156,10 +156,9 @@ TEST_CASE("texture reader: mesh materials=obj maps each usemtl group's MTL mater
     d.expect_error("mesh file=nolib.obj materials=obj\n", 1, 11, "cannot open material library");
 }
 
-// Proven against: read_once without the texture lock (run under TSan: a race on the cache)
-// is not provable here; this checks the result: the chunked reader (shapes parsed in
-// parallel) shares one texture per file like the one-pass reader, and the bundle's copies
-// hold the image's bytes (the distributed renderer ships them).
+// The chunked reader (shapes parsed in parallel, texture_file under its lock) shares one
+// texture per file like the one-pass reader, and the copies hold the image's bytes (what the
+// distributed renderer ships). Proven against: read_once without copy_file (0 bytes).
 TEST_CASE("texture reader: chunked reading and file copies") {
     Dir d;
     std::string text;
