@@ -171,14 +171,22 @@ ObjFaces read_obj_faces(const std::string& obj_text, const std::string& mtl_text
     const tinyobj::attrib_t& at = reader.GetAttrib();
     out.positions.assign(at.vertices.begin(), at.vertices.end());
     out.materials = reader.GetMaterials();
+    // The group of the previous face, looked up again only when the material changes.
+    int last_key = -2;
+    ObjFaces::Group* group = nullptr;
+    bool with_uv = false;
     for (const tinyobj::shape_t& s : reader.GetShapes()) {
         std::size_t off = 0;
         for (std::size_t f = 0; f < s.mesh.num_face_vertices.size(); ++f) {
             const auto nv = s.mesh.num_face_vertices[f];
             const int key = by_material && f < s.mesh.material_ids.size() ? s.mesh.material_ids[f] : -1;
             if (nv == 3) {
-                ObjFaces::Group& g = out.groups[key];
-                const bool with_uv = uv_for(key);
+                if (key != last_key) {
+                    group = &out.groups[key];
+                    with_uv = uv_for(key);
+                    last_key = key;
+                }
+                ObjFaces::Group& g = *group;
                 for (int j = 0; j < 3; ++j) {
                     const tinyobj::index_t& ix = s.mesh.indices[off + std::size_t(j)];
                     const int v = ix.vertex_index;
