@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "render/sampling.h"
+#include "render/texture.h"
 #include "shapes/shapes.h"
 #include "shapes/triangle_math.h"
 
@@ -41,7 +42,13 @@ RecursiveRenderer::RecursiveRenderer(const Scene& scene)
         const Object& o = scene.objects[i];
         objects_[i] = {affine_inverse(o.md), o.param, o.kind, scene.mesh_of(o)};
     });
-    for (const Material& m : scene.materials) materials_.push_back(MaterialT<double>::from(m));
+    for (const Material& m : scene.materials) {
+        materials_.push_back(MaterialT<double>::from(m));
+        if (m.texture >= 0) {
+            materials_.back().texture = scene.textures[std::size_t(m.texture)]->view();
+            materials_.back().uv_scale = m.uv_scale;
+        }
+    }
     for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(l));
 }
 
@@ -102,6 +109,10 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
     hit.t = best_t;
     hit.point = apply_point(RowsOf{scene_.objects[std::size_t(best)].md}, pc);
     hit.normal = apply_normal(RowsOf{ob.mi}, nc);
+    hit.canonical = pc;
+    hit.tri = cand.tri;
+    hit.bu = cand.u;
+    hit.bv = cand.v;
     return true;
 }
 
@@ -141,10 +152,19 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     const ShadeRules<double> rules{s.degree, s.ambient, depth < s.depth, s.cutoff, camera_.spread};
     // Weight 1: the caller multiplies what this ray brings back by its weight.
     const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
-    const ColorT<double> object_color{object.color.x, object.color.y, object.color.z};
+    ColorT<double> object_color{object.color.x, object.color.y, object.color.z};
+    const MaterialT<double>& material = materials_[object.material];
+    if (material.texture) {  // the texture replaces the object's colour (render/texture.h)
+        const PreparedObject& ob = objects_[std::size_t(hit.object)];
+        const double footprint = footprint_width(ray.cone, camera_.spread, hit.t, dot(ray.dir, hit.normal));
+        const double scale = canonical_per_world<double>(RowsOf{ob.mi});
+        object_color = ob.kind == ShapeKind::Mesh
+                           ? mesh_texture_color(material, ob.mesh->view(), hit.tri, hit.bu, hit.bv, scale, footprint)
+                           : texture_color(material, ob.kind, hit.canonical, ob.param, scale, footprint);
+    }
     RecursiveSink sink{*this, depth, counts};
     const auto shade = [&]<bool kLit, bool kShadows>() {
-        shade_hit<kLit, kShadows, true, true>(rules, materials_[object.material], lights_.data(), lights_.size(),
+        shade_hit<kLit, kShadows, true, true>(rules, material, lights_.data(), lights_.size(),
                                               arriving, hit.point, hit.normal, object_color, true, sink);
     };
     if (s.degree == 0) shade.template operator()<false, false>();

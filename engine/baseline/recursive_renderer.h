@@ -31,6 +31,11 @@ struct HitD {
     double t = 0;
     Vec3d point;   ///< world space, Md applied to the canonical hit point
     Vec3d normal;  ///< world space, unit, outward (Mn applied to the canonical normal)
+    // Where a texture is read (render/texture.h): the canonical point, and for a mesh the
+    // triangle and its barycentrics.
+    Vec3d canonical;
+    std::uint32_t tri = 0;
+    double bu = 0, bv = 0;
 };
 
 class RecursiveRenderer {

@@ -14,6 +14,7 @@
 #include "kernels/compress.h"
 #include "kernels/shade_job.h"
 #include "render/shading.h"
+#include "render/texture.h"
 #include "shapes/shapes.h"
 
 namespace streamrt::STREAMRT_ISA_NAMESPACE {
@@ -71,6 +72,47 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
         }
     }
     return {B::load_aligned(nx), B::load_aligned(ny), B::load_aligned(nz)};
+}
+
+/// The texture colour of each lane's hit (render/texture.h), lane by lane in scalar float:
+/// the same calls and values as the scalar shade path, so the picture is the same bits at
+/// every ISA level (xsimd's atan2, asin and cbrt round differently at different levels).
+/// The texel reads are per lane anyway. `scale`: the run's canonical_per_world, or (gathered,
+/// scale < 0) each lane's, from its rows.
+template <class B, class Rows>
+inline ColorT<B> texture_colors(const ShadeJob& job, std::size_t i, const MaterialT<float>& m, ShapeKind kind,
+                                bool mesh, const Vec3T<B>& pc, const B& param, const Rows& rows, float scale,
+                                const B& footprint) {
+    constexpr std::size_t W = B::size;
+    alignas(64) float px[W], py[W], pz[W], fp[W], pa[W], r[W], g[W], b[W], sc[W];
+    pc.x.store_aligned(px);
+    pc.y.store_aligned(py);
+    pc.z.store_aligned(pz);
+    footprint.store_aligned(fp);
+    param.store_aligned(pa);
+    if (scale < 0.f) {
+        alignas(64) float rw[12][W];
+        for (int k = 0; k < 12; ++k) B(rows[k]).store_aligned(rw[k]);
+        for (std::size_t l = 0; l < W; ++l) {
+            float mi[12];
+            for (int k = 0; k < 12; ++k) mi[k] = rw[k][l];
+            sc[l] = canonical_per_world<float>(mi);
+        }
+    } else {
+        for (std::size_t l = 0; l < W; ++l) sc[l] = scale;
+    }
+    for (std::size_t l = 0; l < W; ++l) {
+        ColorT<float> c{0.f, 0.f, 0.f};
+        if (!mesh)
+            c = texture_color(m, kind, Vec3T<float>{px[l], py[l], pz[l]}, pa[l], sc[l], fp[l]);
+        else if (i + l < job.end)  // lanes past the run have no triangle
+            c = mesh_texture_color(m, *job.object->xf.mesh, std::uint32_t(job.prim[i + l]), job.bu[i + l],
+                                   job.bv[i + l], sc[l], fp[l]);
+        r[l] = c.x;
+        g[l] = c.y;
+        b[l] = c.z;
+    }
+    return {B::load_aligned(r), B::load_aligned(g), B::load_aligned(b)};
 }
 
 /// Appends the active lanes' rays to the next generation's stream, compacted.
@@ -155,6 +197,8 @@ void shade_run(const ShadeJob& job) {
     const MaterialT<float>& m = *job.material;
     alignas(64) float lane_index[W];
     for (std::size_t l = 0; l < W; ++l) lane_index[l] = float(l);
+    // Textures: the object's canonical units per world unit, once per run (gathered: per lane).
+    const float run_scale = m.texture && !kGathered ? canonical_per_world<float>(ob.m) : -1.f;
     const B lanes = B::load_aligned(lane_index);
 
     for (std::size_t i = job.begin; i < job.end; i += W) {
@@ -187,10 +231,15 @@ void shade_run(const ShadeJob& job) {
         const Vec3T<B> pc = apply_point(rows, o) + apply_vector(rows, d) * t;
         const Vec3T<B> p = o + d * t;
         Vec3T<B> n_out{};
-        if (kLit || m.checker)
+        if (kLit || m.checker || m.texture)
             n_out = apply_normal(rows, kind == ShapeKind::Mesh && !kGathered ? mesh_normals<B>(job, i)
                                                                               : canonical_normal(kind, pc, param));
         const ArrivingRay<B> arriving{o, d, t, B::load_unaligned(job.cone + i), w, w};
+        if (m.texture) {  // one branch per run: the texture replaces the object's colour
+            const B footprint = footprint_width(arriving.cone, B(job.rules.spread), t, dot(d, n_out));
+            color = texture_colors(job, i, m, kind, kind == ShapeKind::Mesh && !kGathered, pc, param, rows,
+                                   run_scale, footprint);
+        }
         SimdSink<B> sink{job, i};
         shade_hit<kLit, kShadows, kReflect, kRefract>(job.rules, m, job.lights, job.n_lights, arriving, p, n_out, color,
                                                       active, sink);

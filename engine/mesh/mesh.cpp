@@ -18,12 +18,13 @@ namespace streamrt {
 
 std::size_t Mesh::memory_bytes() const {
     return tri.size() * sizeof(float) + index.size() * sizeof(std::uint32_t) +
-           vertex_normals.size() * sizeof(float) + bvh.memory_bytes();
+           vertex_normals.size() * sizeof(float) + corner_uv.size() * sizeof(float) + bvh.memory_bytes();
 }
 
 std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<float>& positions,
                                         const std::vector<std::uint32_t>& triangles,
-                                        const accel::BuildOptions& options) {
+                                        const accel::BuildOptions& options,
+                                        const std::vector<float>& corner_uv) {
     auto m = std::make_shared<Mesh>();
     m->name = std::move(name);
     const std::size_t n_verts = positions.size() / 3;
@@ -33,6 +34,7 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
     // Keep the triangles with three distinct, valid vertices and a non-zero area (in double:
     // the cross product of float differences is nearly exact).
     std::vector<std::uint32_t> kept;
+    std::vector<std::uint32_t> kept_from;  // the input triangle of each kept one (texture coordinates)
     kept.reserve(triangles.size());
     for (std::size_t k = 0; k + 2 < triangles.size(); k += 3) {
         const std::uint32_t a = triangles[k], b = triangles[k + 1], c = triangles[k + 2];
@@ -41,8 +43,12 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
             const Vec3d n = cross(vertex(b) - vertex(a), vertex(c) - vertex(a));
             ok = dot(n, n) > 0.0 && std::isfinite(dot(n, n));
         }
-        if (ok) kept.insert(kept.end(), {a, b, c});
-        else ++m->dropped;
+        if (ok) {
+            kept.insert(kept.end(), {a, b, c});
+            kept_from.push_back(std::uint32_t(k / 3));
+        } else {
+            ++m->dropped;
+        }
     }
     const std::size_t n_tris = kept.size() / 3;
 
@@ -94,6 +100,21 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
             for (int a = 0; a < 3; ++a) m->tri[9 * k + 3 * j + a] = positions[3 * v + a];
         }
     });
+    if (!corner_uv.empty()) {
+        m->corner_uv.resize(6 * n_tris);
+        double uv_length = 0.0, length_sum = 0.0;
+        for (std::size_t k = 0; k < n_tris; ++k) {
+            const std::uint32_t src = kept_from[m->bvh.prim_index[k]];
+            std::copy_n(&corner_uv[6 * std::size_t(src)], 6, &m->corner_uv[6 * k]);
+            for (int j = 0; j < 3; ++j) {
+                const int i = (j + 1) % 3;
+                const float* a = &m->corner_uv[6 * k];
+                uv_length += std::hypot(double(a[2 * i]) - a[2 * j], double(a[2 * i + 1]) - a[2 * j + 1]);
+                length_sum += length(vertex(m->index[3 * k + std::size_t(i)]) - vertex(m->index[3 * k + std::size_t(j)]));
+            }
+        }
+        m->uv_density = length_sum > 0.0 && uv_length > 0.0 ? float(uv_length / length_sum) : 1.f;
+    }
     m->bvh.prim_index.clear();
     m->bvh.prim_index.shrink_to_fit();
     for (int a = 0; a < 3; ++a) {
@@ -106,52 +127,163 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
             m->hi[a] = std::max(m->hi[a], double(m->tri[3 * k + a]));
         }
     m->kernel_view = {m->bvh.nodes.empty() ? nullptr : m->bvh.nodes.data(), m->tri.data(), m->index.data(),
-                      m->vertex_normals.data(), std::uint32_t(n_tris)};
+                      m->vertex_normals.data(), std::uint32_t(n_tris),
+                      m->corner_uv.empty() ? nullptr : m->corner_uv.data(), m->uv_density};
     return m;
 }
 
-std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path) {
+namespace {
+
+std::string read_file_bytes(const std::string& path, const char* what) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error("cannot open mesh file");
+    if (!in) throw std::runtime_error(std::string("cannot open ") + what);
     std::ostringstream ss;
     ss << in.rdbuf();
-    if (in.bad()) throw std::runtime_error("cannot read mesh file");
+    if (in.bad()) throw std::runtime_error(std::string("cannot read ") + what);
+    return ss.str();
+}
+
+/// The triangles of an OBJ text, grouped by material id (all in group -1 unless by_material),
+/// with their corners' texture coordinates where uv_for(group) says so.
+struct ObjFaces {
+    std::vector<float> positions;
+    struct Group {
+        std::vector<std::uint32_t> tris;
+        std::vector<float> corner_uv;
+    };
+    std::map<int, Group> groups;
+    std::vector<tinyobj::material_t> materials;
+};
+
+template <class UvFor>
+ObjFaces read_obj_faces(const std::string& obj_text, const std::string& mtl_text, bool by_material, UvFor uv_for) {
     tinyobj::ObjReaderConfig config;
     config.triangulate = true;
     config.vertex_color = false;
     tinyobj::ObjReader reader;
-    // From a string with no material text: `mtllib` lines are ignored, nothing else is read.
-    if (!reader.ParseFromString(ss.str(), "", config)) {
+    // From strings: the material text is the one given (none: `mtllib` lines are ignored).
+    if (!reader.ParseFromString(obj_text, mtl_text, config)) {
         std::string err = reader.Error();
         while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
         throw std::runtime_error("cannot parse OBJ file: " + err);
     }
+    ObjFaces out;
     const tinyobj::attrib_t& at = reader.GetAttrib();
-    std::vector<float> positions(at.vertices.begin(), at.vertices.end());
-    std::vector<std::uint32_t> tris;
+    out.positions.assign(at.vertices.begin(), at.vertices.end());
+    out.materials = reader.GetMaterials();
+    // The group of the previous face, looked up again only when the material changes.
+    int last_key = -2;
+    ObjFaces::Group* group = nullptr;
+    bool with_uv = false;
     for (const tinyobj::shape_t& s : reader.GetShapes()) {
         std::size_t off = 0;
-        for (const auto nv : s.mesh.num_face_vertices) {
+        for (std::size_t f = 0; f < s.mesh.num_face_vertices.size(); ++f) {
+            const auto nv = s.mesh.num_face_vertices[f];
+            const int key = by_material && f < s.mesh.material_ids.size() ? s.mesh.material_ids[f] : -1;
             if (nv == 3) {
+                if (key != last_key) {
+                    group = &out.groups[key];
+                    with_uv = uv_for(key);
+                    last_key = key;
+                }
+                ObjFaces::Group& g = *group;
                 for (int j = 0; j < 3; ++j) {
-                    const int v = s.mesh.indices[off + std::size_t(j)].vertex_index;
-                    if (v < 0 || std::size_t(v) >= positions.size() / 3)
+                    const tinyobj::index_t& ix = s.mesh.indices[off + std::size_t(j)];
+                    const int v = ix.vertex_index;
+                    if (v < 0 || std::size_t(v) >= out.positions.size() / 3)
                         throw std::runtime_error("OBJ face refers to a missing vertex");
-                    tris.push_back(std::uint32_t(v));
+                    g.tris.push_back(std::uint32_t(v));
+                    if (!with_uv) continue;
+                    const int t = ix.texcoord_index;
+                    if (t < 0 || 2 * std::size_t(t) + 1 >= at.texcoords.size())
+                        throw std::runtime_error("OBJ file has a face without texture coordinates (vt), which a "
+                                                 "texture needs");
+                    g.corner_uv.push_back(at.texcoords[2 * std::size_t(t)]);
+                    g.corner_uv.push_back(at.texcoords[2 * std::size_t(t) + 1]);
                 }
             }
             off += nv;
         }
     }
-    for (float p : positions)
+    for (float p : out.positions)
         if (!std::isfinite(p)) throw std::runtime_error("OBJ file has a vertex that is not finite");
-    const std::size_t faces = tris.size() / 3;
-    auto mesh = Mesh::build(path, positions, tris);
+    for (const auto& [key, g] : out.groups)
+        for (float t : g.corner_uv)
+            if (!std::isfinite(t)) throw std::runtime_error("OBJ file has a texture coordinate that is not finite");
+    return out;
+}
+
+std::shared_ptr<const Mesh> build_checked(const std::string& path, const std::vector<float>& positions,
+                                          const ObjFaces::Group& g) {
+    const std::size_t faces = g.tris.size() / 3;
+    auto mesh = Mesh::build(path, positions, g.tris, {}, g.corner_uv);
     if (mesh->triangle_count() == 0)
         throw std::runtime_error(faces == 0 ? "OBJ file has no faces"
                                             : "OBJ file has no triangles of non-zero area (" +
                                                   std::to_string(faces) + " degenerate)");
     return mesh;
+}
+
+}  // namespace
+
+std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv) {
+    const ObjFaces faces = read_obj_faces(read_file_bytes(path, "mesh file"), "", false, [&](int) { return with_uv; });
+    static const ObjFaces::Group kNone;
+    const auto it = faces.groups.find(-1);
+    return build_checked(path, faces.positions, it == faces.groups.end() ? kNone : it->second);
+}
+
+ObjModel load_obj_model(const std::string& path, bool with_uv) {
+    const std::string obj_text = read_file_bytes(path, "mesh file");
+    ObjModel model;
+    std::string mtl_text;
+    {
+        std::istringstream lines(obj_text);
+        std::string line;
+        while (std::getline(lines, line)) {
+            std::istringstream words(line);
+            std::string word, name;
+            if (words >> word && word == "mtllib" && words >> name) {
+                const std::size_t slash = path.find_last_of('/');
+                model.mtl_path = slash == std::string::npos ? name : path.substr(0, slash + 1) + name;
+                mtl_text = read_file_bytes(model.mtl_path, ("material library '" + model.mtl_path + "'").c_str());
+                break;
+            }
+        }
+    }
+    std::vector<bool> mapped;  // per material: has map_Kd
+    const auto uv_for = [&](int m) { return with_uv || (m >= 0 && std::size_t(m) < mapped.size() && mapped[m]); };
+    // The materials are known only once parsed: a first pass without coordinates finds them.
+    {
+        tinyobj::ObjReaderConfig config;
+        tinyobj::ObjReader reader;
+        if (reader.ParseFromString("mtllib library\n", mtl_text, config))
+            for (const tinyobj::material_t& m : reader.GetMaterials()) mapped.push_back(!m.diffuse_texname.empty());
+    }
+    const ObjFaces faces = read_obj_faces(obj_text, mtl_text, true, uv_for);
+    for (const tinyobj::material_t& m : faces.materials) {
+        ObjMaterial o;
+        o.name = m.name;
+        for (int c = 0; c < 3; ++c) {
+            o.kd[c] = m.diffuse[c];
+            o.ks[c] = m.specular[c];
+        }
+        o.ns = m.shininess;
+        o.ni = m.ior;
+        o.d = m.dissolve;
+        o.map_kd = m.diffuse_texname;
+        model.materials.push_back(o);
+    }
+    for (const auto& [key, g] : faces.groups) {
+        auto mesh = Mesh::build(path, faces.positions, g.tris, {}, g.corner_uv);
+        if (mesh->triangle_count() == 0) continue;  // a group of degenerate faces only
+        const int material = key >= 0 && std::size_t(key) < model.materials.size() ? key : -1;
+        model.parts.push_back({std::move(mesh), material});
+    }
+    if (model.parts.empty())
+        throw std::runtime_error(faces.groups.empty() ? "OBJ file has no faces"
+                                                      : "OBJ file has no triangles of non-zero area");
+    return model;
 }
 
 // ---- generated surfaces -------------------------------------------------------------------

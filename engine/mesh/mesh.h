@@ -20,9 +20,11 @@ struct Mesh {
     simd::AlignedVec<float> tri;        ///< 9 per triangle, leaf order
     std::vector<std::uint32_t> index;   ///< 3 per triangle, leaf order
     std::vector<float> vertex_normals;  ///< 3 per vertex
+    std::vector<float> corner_uv;       ///< 6 per triangle (MeshView::uv), leaf order; empty: none
     accel::Bvh bvh;                     ///< prim_index is dropped: triangles are stored in leaf order
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  ///< bounds of the vertices
     std::size_t dropped = 0;            ///< degenerate triangles left out
+    float uv_density = 1.f;            ///< MeshView::uv_density
     MeshView kernel_view{};             ///< pointers into the above, set once built (stable: the mesh is immutable)
 
     std::size_t triangle_count() const { return index.size() / 3; }
@@ -33,16 +35,51 @@ struct Mesh {
     /// Builds a mesh from vertex positions (3 floats each) and triangles (3 vertex numbers
     /// each, counter-clockwise seen from outside). Triangles with a repeated vertex, an
     /// out-of-range vertex or zero area are dropped. May return a mesh with no triangles.
+    /// `corner_uv`, when not empty, holds 6 floats per triangle of `triangles` (its corners'
+    /// texture coordinates), kept with the triangles.
     static std::shared_ptr<const Mesh> build(std::string name, const std::vector<float>& positions,
                                              const std::vector<std::uint32_t>& triangles,
-                                             const accel::BuildOptions& options = {});
+                                             const accel::BuildOptions& options = {},
+                                             const std::vector<float>& corner_uv = {});
 };
 
-/// Reads a Wavefront OBJ file (tinyobjloader; polygons are triangulated, materials, texture
-/// coordinates and normals in the file are ignored). Throws std::runtime_error with a
-/// message (no location) for a missing, unreadable or malformed file or one with no
-/// triangles.
-std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path);
+/// Reads a Wavefront OBJ file (tinyobjloader; polygons are triangulated, materials and
+/// normals in the file are ignored). Texture coordinates (vt) are kept only when `with_uv`
+/// (a textured object uses the mesh); then every face must have them. Throws
+/// std::runtime_error with a message (no location) for a missing, unreadable or malformed
+/// file, one with no triangles, or (with_uv) a face without texture coordinates.
+std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv = false);
+
+/// One material of an OBJ file's material library (MTL), as read (docs/scene-format.md,
+/// "OBJ materials" maps it onto the material keys).
+struct ObjMaterial {
+    std::string name;
+    double kd[3] = {0, 0, 0};  ///< Kd
+    double ks[3] = {0, 0, 0};  ///< Ks
+    double ns = 0;             ///< Ns
+    double ni = 1;             ///< Ni
+    double d = 1;              ///< d (1: opaque)
+    std::string map_kd;        ///< map_Kd, relative to the MTL file's folder; empty: none
+};
+
+/// An OBJ file read with its materials (mesh materials=obj): one mesh per material used by
+/// its faces (usemtl groups; faces before any usemtl form the part of material -1), all cut
+/// from the file's one vertex list.
+struct ObjModel {
+    struct Part {
+        std::shared_ptr<const Mesh> mesh;
+        int material = -1;  ///< index into materials; -1: none
+    };
+    std::vector<Part> parts;
+    std::vector<ObjMaterial> materials;
+    std::string mtl_path;  ///< the library read (empty: the file names none)
+};
+
+/// Reads an OBJ file and the material library its first `mtllib` line names (relative to
+/// the OBJ file's folder). A part keeps its texture coordinates when `with_uv` or its
+/// material has map_Kd. Throws std::runtime_error like load_obj_mesh, and for a library that
+/// cannot be read.
+ObjModel load_obj_model(const std::string& path, bool with_uv);
 
 // ---- generated surfaces (tests, benchmarks, the sample scene) -----------------------------
 

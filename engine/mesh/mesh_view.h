@@ -15,6 +15,12 @@ struct MeshView {
     const std::uint32_t* index;      ///< 3 vertex numbers per triangle (into normals)
     const float* vertex_normals;     ///< 3 floats per vertex, unit (area-weighted face normals)
     std::uint32_t n_tris;
+    /// Texture coordinates (OBJ vt), 6 floats per triangle (u, v at its corners 0, 1, 2),
+    /// leaf order; nullptr when the mesh was read without them (no textured object uses it).
+    const float* uv = nullptr;
+    /// How fast (u, v) changes per canonical unit along the surface (the mesh's total uv
+    /// edge length over its total edge length), for the mip level selection.
+    float uv_density = 1.f;
 };
 
 }  // namespace streamrt

@@ -54,6 +54,10 @@ struct MaterialT {
     /// at ior = 1 there is no interface and nothing to reflect); r0 = ((ior-1)/(ior+1))^2.
     bool fresnel = false;
     T r0 = T(0);
+    // Textures (render/texture.h): the image's levels replace the object's colour; set by
+    // each engine from Scene::textures (empty: no texture, today's code).
+    TextureView texture{};
+    T uv_scale = T(1);
 
     static MaterialT from(const Material& m) {
         const double cutoff =
@@ -116,6 +120,10 @@ inline V odd_share(const V& c, const V& half) {
 /// odd), the closed form of a box filter applied to the 3-D checker. Far away, where a pixel
 /// covers many cells, this converges to the average colour instead of aliasing, and the
 /// float and double engines agree there.
+/// A textured material (MaterialT::texture) has `color` already replaced by its texture's
+/// filtered colour at the hit: each engine computes it before shade_hit, from the canonical
+/// hit point it holds (render/texture.h texture_color), only when the material has a texture
+/// (one branch per material, or per run of rays in the SIMD kernel).
 template <class V, class T, class C>
 inline ColorT<V> surface_color(const MaterialT<T>& m, const ColorT<C>& color, const Vec3T<V>& p, const Vec3T<V>& n,
                                const V& footprint) {

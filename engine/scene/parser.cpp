@@ -31,6 +31,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -323,7 +324,8 @@ class Statement {
 // ---- key vocabularies ------------------------------------------------------------------
 const std::vector<std::string_view> kMaterialKeys = {"color", "ambi",    "diff", "spec",
                                                      "shininess", "refl", "trans", "ior",
-                                                     "checker", "cell", "fresnel"};
+                                                     "checker", "cell", "fresnel",
+                                                     "texture", "uvscale"};  // textures
 const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rotate_y", "rotate_z",
                                                       "translate"};
 const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
@@ -348,7 +350,7 @@ std::vector<std::string_view> join(std::initializer_list<std::vector<std::string
 const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys, kLensKeys, {"name"}});
 const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
 const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys, {"name"}});
-const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth"}});
+const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth", "materials"}});
 const std::vector<std::string_view> kPointLightKeys = {"pos", "color", "name"};
 const std::vector<std::string_view> kSpotLightKeys = {"pos", "dir", "angle", "color", "name"};
 const std::vector<std::string_view> kDirectionalLightKeys = {"dir", "color", "name"};
@@ -399,6 +401,7 @@ bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
         m.checker = true;
     } else if (same(k, "cell")) m.cell = st.positive(a);
     else if (same(k, "fresnel")) m.fresnel = st.boolean(a);
+    else if (same(k, "uvscale")) m.uv_scale = st.positive(a);  // texture= is the Parser's (texture_file)
     else return false;
     return true;
 }
@@ -595,7 +598,9 @@ class Parser {
     Scratch scratch_;       // the sequential pass's
     std::map<std::string, MaterialDef, std::less<>> materials_;
     std::vector<fs::path> open_;  // the include chain being read
-    std::map<fs::path, std::uint32_t> meshes_;  // by file identity: loaded once, shared (index in scene.meshes)
+    // By file identity and whether its texture coordinates are kept: loaded once, shared
+    // (index in scene.meshes).
+    std::map<std::pair<fs::path, bool>, std::uint32_t> meshes_;
     MaterialList scene_materials_{&scene};  // the one-pass reader's: straight into the scene
     int files_ = 0;
 
@@ -967,7 +972,9 @@ class Parser {
         st.read_args(toks, 2, kMaterialStatementKeys);  // "material": a base to start from
         Appearance m;
         if (const Arg* base = st.find("material")) m = lookup_material(st, *base);
-        for (const Arg& a : st.args) apply_material_key(st, a, m);
+        for (const Arg& a : st.args)
+            if (same(a.key, "texture")) m.m.texture = texture_file(st, a);
+            else apply_material_key(st, a, m);
         materials_.emplace(std::string(name.text), MaterialDef{m, chunked_ ? st.line() : 0});
     }
 
@@ -1003,6 +1010,11 @@ class Parser {
         if (name) name_thing(st.file(), st.line(), *name, Named::Object, std::uint32_t(scene.objects.size()));
         scene.objects.push_back(obj);
         scene.object_locs.push_back(loc);
+        for (const auto& [o, l] : extra_objects_) {  // materials=obj: the file's other parts
+            scene.objects.push_back(o);
+            scene.object_locs.push_back(l);
+        }
+        extra_objects_.clear();
     }
 
     /// The index of a file name in Scene::files (one-pass reader and set-up only: not
@@ -1025,14 +1037,49 @@ class Parser {
         const ShapeParam param = shape_param(kind);
         f.param = param.default_value;
         if (const Arg* base = st.find("material")) f.look = lookup_material(st, *base);
+        const Arg* file_arg = nullptr;  // a mesh's file, read once the texture is known
+        bool obj_materials = false;     // materials=obj: the file's own materials, a part each
         for (const Arg& a : st.args) {
             if (same(a.key, "material") || same(a.key, "name")) continue;
+            if (same(a.key, "texture")) {
+                f.look.m.texture = texture_file(st, a);
+                continue;
+            }
             if (apply_material_key(st, a, f.look)) continue;
             if (apply_transform_key(st, a, f.md)) continue;
             if (param.present() && same(a.key, param.key)) f.param = st.positive(a);
             else if (same(a.key, "smooth")) f.smooth = st.boolean(a);
-            else if (same(a.key, "file")) f.mesh = mesh_file(st, a);
+            else if (same(a.key, "file")) {
+                file_arg = &a;
+            } else if (same(a.key, "materials")) {
+                if (!same(a.value, "obj"))
+                    st.fail(a.value_col, "expected obj for 'materials' (the OBJ file's own materials), got " +
+                                             quote(a.value));
+                obj_materials = true;
+            }
         }
+        if (file_arg && obj_materials) {
+            if (singular(f.md))
+                st.fail_here(std::string(st.word()) + ": the composed transform is singular (or not finite)");
+            // One object per part (usemtl group), each with its part's material over the
+            // statement's; the first goes into `out`, the others after it (one-pass reader only:
+            // mesh statements are never read in chunks).
+            const ObjParts& parts = obj_parts(st, *file_arg, f.look.m.texture >= 0);
+            for (std::size_t k = 0; k < parts.meshes.size(); ++k) {
+                ShapeFields g = f;
+                g.mesh = parts.meshes[k];
+                apply_obj_material(st, *file_arg, parts, parts.materials[k], g.look);
+                if (k == 0) {
+                    make_object(st, g, file, materials, out, loc);
+                } else {
+                    extra_objects_.emplace_back();
+                    make_object(st, g, file, materials, extra_objects_.back().first, extra_objects_.back().second);
+                }
+            }
+            if (const Arg* n = st.find("name")) return *n;
+            return std::nullopt;
+        }
+        if (file_arg) f.mesh = mesh_file(st, *file_arg, f.look.m.texture >= 0);
         if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
         if (singular(f.md))
             st.fail_here(std::string(st.word()) +
@@ -1042,27 +1089,99 @@ class Parser {
         return std::nullopt;
     }
 
-    /// The mesh of an OBJ file named relative to the statement's file, read once per file:
-    /// its index in Scene::meshes.
-    std::uint32_t mesh_file(const Statement& st, const Arg& a) {
-        const fs::path base = fs::path(st.file()).parent_path();
-        const fs::path target = (base / fs::path(std::string(a.value))).lexically_normal();
-        const fs::path id = identity_of(target);
-        if (const auto it = meshes_.find(id); it != meshes_.end()) return it->second;
+    /// The file `a` names, relative to the statement's file.
+    static fs::path target_of(const Statement& st, const Arg& a) {
+        return (fs::path(st.file()).parent_path() / fs::path(std::string(a.value))).lexically_normal();
+    }
+
+    /// A file read once: its index in `list`, remembered in `known` under key(its identity);
+    /// load(path) reads it the first time. Errors at column `col` of the statement.
+    template <class Map, class List, class Key, class Load>
+    typename Map::mapped_type read_once(const Statement& st, int col, const fs::path& target, const std::string& what,
+                                        Map& known, List& list, Key key, Load load) {
+        const auto id = key(identity_of(target));
+        if (const auto it = known.find(id); it != known.end()) return it->second;
         std::error_code ec;
-        if (!fs::is_regular_file(target, ec))
-            st.fail(a.value_col, "cannot open mesh file " + quote(target.string()));
+        if (!fs::is_regular_file(target, ec)) st.fail(col, "cannot open " + what + " file " + quote(target.string()));
         if (options_.copies) copy_file(target);
         try {
-            auto mesh = load_obj_mesh(target.string());
-            const auto index = std::uint32_t(scene.meshes.size());
-            scene.meshes.push_back(std::move(mesh));
-            meshes_.emplace(id, index);
+            auto item = load(target.string());
+            const auto index = typename Map::mapped_type(list.size());
+            list.push_back(std::move(item));
+            known.emplace(id, index);
             return index;
         } catch (const std::exception& e) {
-            st.fail(a.value_col, quote(target.string()) + ": " + e.what());
+            st.fail(col, quote(target.string()) + ": " + e.what());
         }
     }
+
+    /// The mesh of an OBJ file, read once per file (twice when both untextured objects and
+    /// textured ones, which need its texture coordinates, use it): its index in Scene::meshes.
+    std::uint32_t mesh_file(const Statement& st, const Arg& a, bool with_uv) {
+        return read_once(
+            st, a.value_col, target_of(st, a), "mesh", meshes_, scene.meshes,
+            [&](fs::path id) { return std::pair{std::move(id), with_uv}; },
+            [&](const std::string& path) { return load_obj_mesh(path, with_uv); });
+    }
+
+    /// The texture of an image file, read once per file: its index in Scene::textures.
+    /// Shapes of the chunked reader call it from several threads, hence the lock.
+    std::int32_t texture_file(const Statement& st, int col, const fs::path& target) {
+        std::lock_guard<std::mutex> lock(textures_mutex_);
+        return read_once(
+            st, col, target, "texture", textures_, scene.textures, [](fs::path id) { return id; },
+            [](const std::string& path) { return load_texture(path); });
+    }
+    std::int32_t texture_file(const Statement& st, const Arg& a) { return texture_file(st, a.value_col, target_of(st, a)); }
+
+    /// An OBJ file read with its materials (mesh materials=obj): once per file and need of
+    /// texture coordinates; its parts' meshes are in Scene::meshes.
+    struct ObjParts {
+        std::vector<std::uint32_t> meshes;  ///< per part, index in Scene::meshes
+        std::vector<int> materials;         ///< per part, index in `library` (-1: none)
+        std::vector<ObjMaterial> library;
+        std::string mtl_path;
+    };
+    const ObjParts& obj_parts(const Statement& st, const Arg& a, bool with_uv) {
+        const std::size_t i = read_once(
+            st, a.value_col, target_of(st, a), "mesh", obj_models_, obj_parts_,
+            [&](fs::path id) { return std::pair{std::move(id), with_uv}; },
+            [&](const std::string& path) {
+                ObjModel model = load_obj_model(path, with_uv);
+                ObjParts parts;
+                for (ObjModel::Part& p : model.parts) {
+                    parts.meshes.push_back(std::uint32_t(scene.meshes.size()));
+                    scene.meshes.push_back(std::move(p.mesh));
+                    parts.materials.push_back(p.material);
+                }
+                parts.library = std::move(model.materials);
+                parts.mtl_path = model.mtl_path;
+                if (options_.copies && !parts.mtl_path.empty()) copy_file(parts.mtl_path);
+                return parts;
+            });
+        return obj_parts_[i];
+    }
+    std::map<std::pair<fs::path, bool>, std::size_t> obj_models_;
+    std::vector<std::pair<Object, ObjectLoc>> extra_objects_;  // a materials=obj statement's parts after the first
+    std::vector<ObjParts> obj_parts_;
+
+    /// The material keys an OBJ material sets (docs/scene-format.md, "OBJ materials"), over
+    /// the statement's appearance; map_Kd is read relative to the library's folder.
+    void apply_obj_material(const Statement& st, const Arg& file, const ObjParts& parts, int material,
+                            Appearance& look) {
+        if (material < 0) return;
+        const ObjMaterial& o = parts.library[std::size_t(material)];
+        look.color = {o.kd[0], o.kd[1], o.kd[2]};
+        look.m.spec = std::max(0.0, (o.ks[0] + o.ks[1] + o.ks[2]) / 3.0);
+        look.m.shininess = std::max(0.0, o.ns);
+        look.m.ior = o.ni > 0.0 ? o.ni : 1.0;
+        look.m.trans = std::clamp(1.0 - o.d, 0.0, 1.0);
+        if (!o.map_kd.empty())
+            look.m.texture = texture_file(
+                st, file.value_col, (fs::path(parts.mtl_path).parent_path() / fs::path(o.map_kd)).lexically_normal());
+    }
+    std::mutex textures_mutex_;
+    std::map<fs::path, std::int32_t> textures_;  // by file identity (index in scene.textures)
 
     void copy_file(const fs::path& p) {
         FileText text;

@@ -42,7 +42,7 @@ std::size_t MaterialHash::operator()(const Material& m) const {
     std::size_t h = 0;
     const auto mix = [&h](double v) { h = h * 0x9E3779B97F4A7C15ull ^ std::hash<double>{}(v + 0.0); };
     for (double v : {m.ambi, m.diff, m.spec, m.shininess, m.refl, m.trans, m.ior, m.cell, m.checker_color.x,
-                     m.checker_color.y, m.checker_color.z})
+                     m.checker_color.y, m.checker_color.z, double(m.texture), m.uv_scale})
         mix(v);
     return h ^ std::size_t(m.checker) ^ (std::size_t(m.fresnel) << 1);
 }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "scene/texture.h"
 #include "core/transform.h"
 #include "shapes/shape_kind.h"
 
@@ -39,6 +40,9 @@ struct Material {
     /// Fresnel (fresnel=true): at a dielectric (trans > 0) the split between refl and trans
     /// follows Schlick's approximation instead of the fixed weights (render/shading.h).
     bool fresnel = false;
+    // Textures (docs/scene-format.md, "Textures and UV mapping").
+    std::int32_t texture = -1;  ///< index into Scene::textures; -1: the object's colour
+    double uv_scale = 1.0;      ///< uvscale=: multiplies (u, v) before the lookup (tiling)
 
     bool operator==(const Material&) const = default;
 };
@@ -149,6 +153,7 @@ struct Scene {
     std::vector<Object> objects;
     std::vector<Material> materials;  ///< deduplicated; Object::material indexes it
     std::vector<std::shared_ptr<const Mesh>> meshes;  ///< one per OBJ file; Object::mesh indexes it
+    std::vector<std::shared_ptr<const Texture>> textures;  ///< one per image file; Material::texture indexes it
     /// Cold data, for messages only: the statement of each object (same indexing as objects).
     std::vector<ObjectLoc> object_locs;
     std::vector<std::string> files;  ///< the files objects came from (ObjectLoc::file)

@@ -39,17 +39,36 @@ struct CubeMath {
         best = keep_closest(best, t_far, spans, t_min);  // from inside, t_near < t_min
         return miss_if_unchanged(best, t_max);
     }
-    /// The face whose axis has the largest |coordinate|.
+    /// The face a point is on: the axis with the largest |coordinate| (x, then y, on ties).
     template <class V>
-    static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) {
+    struct Face {
+        decltype(V() < V()) x, y, z;
+    };
+    template <class V>
+    static Face<V> face(const Vec3T<V>& p) {
         using namespace simd;
         const V ax = abs(p.x), ay = abs(p.y), az = abs(p.z);
         const auto x_wins = (ax >= ay) && (ax >= az);
         const auto y_wins = !x_wins && (ay >= az);
-        const auto z_wins = !x_wins && !y_wins;
-        return {select(x_wins, sign_of(p.x), V(0)), select(y_wins, sign_of(p.y), V(0)),
-                select(z_wins, sign_of(p.z), V(0))};
+        return {x_wins, y_wins, !x_wins && !y_wins};
     }
+    template <class V>
+    static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) {
+        using namespace simd;
+        const Face<V> f = face(p);
+        return {select(f.x, sign_of(p.x), V(0)), select(f.y, sign_of(p.y), V(0)), select(f.z, sign_of(p.z), V(0))};
+    }
+    /// Each face shows the whole image, on the face the normal is: faces x = +-1 map (z, y),
+    /// faces y = +-1 map (x, z), faces z = +-1 map (x, y), each coordinate a in [-1, 1] to
+    /// (a + 1) / 2.
+    template <class V>
+    static UvT<V> uv(const Vec3T<V>& p, V /*param*/) {
+        using namespace simd;
+        const Face<V> f = face(p);
+        return uv_square(select(f.x, p.z, p.x), select(f.y, p.z, p.y));
+    }
+    template <class V>
+    static V uv_density(V /*param*/) { return V(0.5); }
 };
 
 STREAMRT_ISA_END

@@ -44,6 +44,18 @@ struct CylinderMath {
         return {select(on_cap, V(0), p.x), select(on_cap, sign_of(p.y), V(0)),
                 select(on_cap, V(0), p.z)};
     }
+    /// Side: angle and height, (0.5 + atan2(x, z) / (2 pi), (y + 1) / 2); caps (chosen as the
+    /// normal is): planar, ((x + 1) / 2, (z + 1) / 2).
+    template <class V>
+    static UvT<V> uv(const Vec3T<V>& p, V /*param*/) {
+        using namespace simd;
+        const V rho = sqrt(p.x * p.x + p.z * p.z);
+        const auto on_cap = (abs(p.y) - V(1)) > (rho - V(1));
+        const UvT<V> cap = uv_square(p.x, p.z);
+        return {select(on_cap, cap.u, uv_angle(p.x, p.z)), select(on_cap, cap.v, (p.y + V(1)) * V(0.5))};
+    }
+    template <class V>
+    static V uv_density(V /*param*/) { return V(0.5); }
 };
 
 STREAMRT_ISA_END

@@ -29,6 +29,11 @@ struct DiskMath {
     }
     template <class V>
     static Vec3T<V> normal(const Vec3T<V>& /*p*/, V /*param*/) { return {V(0), V(1), V(0)}; }
+    /// Planar: the square around the disk, ((x + 1) / 2, (z + 1) / 2).
+    template <class V>
+    static UvT<V> uv(const Vec3T<V>& p, V /*param*/) { return uv_square(p.x, p.z); }
+    template <class V>
+    static V uv_density(V /*param*/) { return V(0.5); }
 };
 
 STREAMRT_ISA_END

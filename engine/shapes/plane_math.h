@@ -29,6 +29,11 @@ struct PlaneMath {
     }
     template <class V>
     static Vec3T<V> normal(const Vec3T<V>& /*p*/, V /*param*/) { return {V(0), V(1), V(0)}; }
+    /// Planar: (u, v) = (x, z), one image per canonical unit (repeated; uvscale= tiles it).
+    template <class V>
+    static UvT<V> uv(const Vec3T<V>& p, V /*param*/) { return {p.x, p.z}; }
+    template <class V>
+    static V uv_density(V /*param*/) { return V(1.0); }
 };
 
 STREAMRT_ISA_END

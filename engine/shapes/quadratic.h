@@ -1,8 +1,10 @@
 #pragma once
 // Shared root finding for the quadric shapes.
+#include <cmath>
 #include <limits>
 
 #include "core/vec3.h"
+#include "shapes/shape_traits.h"
 #include "simd/lanes.h"
 #include "simd/isa_namespace.h"
 
@@ -48,6 +50,20 @@ inline V keep_cap(V best, const Vec3T<V>& o, const Vec3T<V>& d, V level, V t_min
     const V t = (level - o.y) / d.y;
     const V x = o.x + d.x * t, z = o.z + d.z * t;
     return keep_closest(best, t, x * x + z * z <= V(1), t_min);
+}
+
+/// The texture coordinate of an angle around the y axis: 0.5 + atan2(x, z) / (2 pi), so
+/// u = 0.5 on +z, 0.75 on +x, 0 and 1 on -z (the seam, where the lookup wraps).
+template <class V>
+inline V uv_angle(const V& x, const V& z) {
+    using std::atan2;
+    return V(0.5) + atan2(x, z) * V(0.15915494309189535);
+}
+
+/// Planar coordinates of the square [-1, 1]^2 in [0, 1]^2: ((a + 1) / 2, (b + 1) / 2).
+template <class V>
+inline UvT<V> uv_square(const V& a, const V& b) {
+    return {(a + V(1)) * V(0.5), (b + V(1)) * V(0.5)};
 }
 
 /// best started at t_max; lanes that kept it report a miss (+inf).

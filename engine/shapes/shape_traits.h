@@ -39,6 +39,16 @@ struct CanonicalBounds {
     constexpr bool bounded() const { return form != Form::Unbounded; }
 };
 
+/// Texture coordinates of a surface point (docs/scene-format.md, "Textures and UV mapping"):
+/// each shape's uv<V>(p, param) maps its canonical hit point p to (u, v), and its
+/// uv_density<V>(param) is how fast (u, v) changes per canonical unit of length along the
+/// surface (the larger of the two rates; an approximation where it varies), which the mip
+/// level selection uses (render/texture.h).
+template <class V>
+struct UvT {
+    V u, v;
+};
+
 inline constexpr double kUnboundedExtent = std::numeric_limits<double>::infinity();
 
 /// Everything the engines need of a canonical shape S, all static:
@@ -49,6 +59,7 @@ inline constexpr double kUnboundedExtent = std::numeric_limits<double>::infinity
 ///   Compute         the kernels' lane type: float, or double where float is not enough
 ///   hit_t<V>(o, d, param, t_min, t_max)   nearest t in (t_min, t_max), +inf for a miss
 ///   normal<V>(p, param)                   outward normal (not unit) at a surface point
+///   uv<V>(p, param), uv_density(param)    texture mapping (UvT below)
 /// for V = double (baseline), float (scalar shade) and xsimd batches (kernels).
 template <class S>
 concept CanonicalShape = requires(const Vec3T<double>& pd, double d, const Vec3T<float>& pf, float f,
@@ -65,6 +76,9 @@ concept CanonicalShape = requires(const Vec3T<double>& pd, double d, const Vec3T
     { S::template normal<double>(pd, d) } -> std::same_as<Vec3T<double>>;
     { S::template normal<float>(pf, f) } -> std::same_as<Vec3T<float>>;
     { S::template normal<decltype(b)>(pb, b) } -> std::same_as<Vec3T<decltype(b)>>;
+    { S::template uv<double>(pd, d) } -> std::same_as<UvT<double>>;
+    { S::template uv<float>(pf, f) } -> std::same_as<UvT<float>>;
+    { S::template uv_density<double>(d) } -> std::same_as<double>;
 };
 
 }  // namespace streamrt

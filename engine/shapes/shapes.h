@@ -41,6 +41,10 @@ constexpr bool declares_every_member() {
                   "a canonical shape declares template <class V> V hit_t(o, d, param, t_min, t_max)");
     static_assert(requires(const Vec3T<double>& v, double x) { S::template normal<double>(v, x); },
                   "a canonical shape declares template <class V> Vec3T<V> normal(p, param)");
+    static_assert(requires(const Vec3T<double>& v, double x) { S::template uv<double>(v, x); },
+                  "a canonical shape declares template <class V> UvT<V> uv(p, param) (its texture mapping)");
+    static_assert(requires(double x) { S::template uv_density<double>(x); },
+                  "a canonical shape declares template <class V> V uv_density(param)");
     static_assert(CanonicalShape<S>, "a canonical shape's members have the types of shapes/shape_traits.h");
     return true;
 }

@@ -26,6 +26,7 @@
 
 #include "core/vec3.h"
 #include "shapes/shape_traits.h"
+#include "shapes/quadratic.h"
 #include "simd/lanes.h"
 #include "simd/isa_namespace.h"
 
@@ -348,6 +349,21 @@ struct TorusMath {
     }
     template <class V>
     static Vec3T<V> normal(const Vec3T<V>& p, V minor) { return torus_normal(p, minor); }
+    /// The two angles: u = 0.5 + atan2(x, z) / (2 pi) around the ring, v = 0.5 +
+    /// atan2(y, rho - 1) / (2 pi) around the tube (rho = sqrt(x^2 + z^2); v = 0.5 on the outer
+    /// equator, 0.75 on top of the tube, 0 and 1 on the inner equator).
+    template <class V>
+    static UvT<V> uv(const Vec3T<V>& p, V /*minor*/) {
+        using namespace simd;
+        const V rho = sqrt(p.x * p.x + p.z * p.z);
+        return {uv_angle(p.x, p.z), uv_angle(p.y, rho - V(1))};
+    }
+    /// The tube's rate 1 / (2 pi r), or the ring's 1 / (2 pi) when the tube is thicker.
+    template <class V>
+    static V uv_density(V minor) {
+        using namespace simd;
+        return V(0.15915494309189535) / min(minor, V(1));
+    }
 };
 
 STREAMRT_ISA_END

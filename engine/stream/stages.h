@@ -12,6 +12,7 @@
 #include "parallel/parallelism.h"
 #include "render/render_stats.h"
 #include "render/sampling.h"
+#include "render/texture.h"
 #include "shapes/shapes.h"
 #include "stream/profile.h"
 #include "kernels/ray_stream.h"
@@ -387,10 +388,18 @@ struct PipelineStages {
                     : visit_shape(kind, [&](auto shape) { return shape.template normal<float>(pc, ob.xf.param); });
             const ArrivingRay<float> arriving{o, d, t, rays.cone[i], w, w};
             ScalarSink sink{accum, px, next, shadows, counts};
+            const Vec3f n_out = apply_normal(ob.xf.m, nc);
+            ColorT<float> color{sf.color[0], sf.color[1], sf.color[2]};
+            if (m.texture) {  // the texture replaces the object's colour (render/texture.h)
+                const float footprint = footprint_width(rays.cone[i], rules.spread, t, dot(d, n_out));
+                const float scale = canonical_per_world<float>(ob.xf.m);
+                color = kind == ShapeKind::Mesh
+                            ? mesh_texture_color(m, *ob.xf.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i],
+                                                 mesh_hits.v[i], scale, footprint)
+                            : texture_color(m, kind, pc, ob.xf.param, scale, footprint);
+            }
             shade_hit<kLighting, kShadows, kReflect, kRefract>(rules, m, sc.lights.data(), sc.lights.size(), arriving,
-                                                               p, apply_normal(ob.xf.m, nc),
-                                                               ColorT<float>{sf.color[0], sf.color[1], sf.color[2]},
-                                                               true, sink);
+                                                               p, n_out, color, true, sink);
         }
     }
 

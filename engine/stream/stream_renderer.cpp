@@ -34,7 +34,7 @@ std::vector<std::string> StreamRenderer::built_stages() const {
     const char* how = shade_mode_ == ShadeMode::Sorted     ? ",simd,sorted)"
                       : shade_mode_ == ShadeMode::Gathered ? ",simd,gathered)"
                                                            : ",scalar)";
-    b.push_back(std::string(f.lighting ? "shade(lit" : "shade(flat") + how);
+    b.push_back(std::string(f.lighting ? "shade(lit" : "shade(flat") + (f.textures ? ",textured" : "") + how);
     if (f.reflect) b.push_back("spawn(reflect)");
     if (f.refract) b.push_back("spawn(refract)");
     if (f.shadows) b.push_back("occlusion(any-hit)");

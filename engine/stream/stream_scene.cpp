@@ -54,6 +54,7 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
     const RenderSettings& s = scene.settings;
     background = {float(s.background.x), float(s.background.y), float(s.background.z)};
     meshes = scene.meshes;
+    textures = scene.textures;
     has_meshes = !meshes.empty();
 
     accel = StreamAccel::build_for(scene, eye);
@@ -72,6 +73,11 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
         MaterialT<float> mat = MaterialT<float>::from(m);
         const glm::vec3 offset = cell_offset(m, eye);
         mat.cell_offset = {offset.x, offset.y, offset.z};
+        if (m.texture >= 0) {
+            mat.texture = scene.textures[std::size_t(m.texture)]->view();
+            mat.uv_scale = float(m.uv_scale);
+            features.textures = true;
+        }
         materials.push_back(mat);
         any_refl |= m.refl > 0;
         any_trans |= m.trans > 0;

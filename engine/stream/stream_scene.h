@@ -24,6 +24,7 @@ struct StreamFeatures {
     bool refract = false;   ///< degree >= 4, depth >= 1 and some material has trans > 0
     bool jitter = false;    ///< spp > 1
     bool lens = false;      ///< camera aperture > 0: the thin-lens generate kernel
+    bool textures = false;  ///< some material has a texture (only those materials read it)
 };
 
 struct StreamScene {
@@ -51,6 +52,8 @@ struct StreamScene {
     /// The meshes the objects use (kept alive here: the objects' records point into them).
     std::vector<std::shared_ptr<const Mesh>> meshes;
     bool has_meshes = false;
+    /// The images the materials' textures point into (kept alive here).
+    std::vector<std::shared_ptr<const Texture>> textures;
 
     explicit StreamScene(const Scene& scene);
 
