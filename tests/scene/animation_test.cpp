@@ -7,6 +7,7 @@
 #include <string>
 
 #include "scene/animation.h"
+#include "scene/expect_error.h"
 #include "scene/parser.h"
 
 using namespace streamrt;
@@ -15,21 +16,7 @@ namespace {
 
 Scene parse(const std::string& text) { return parse_scene(text, "t.cfg"); }
 
-/// Parses `text` expecting a SceneError at line:column whose message contains `needle`.
-void expect_error(const std::string& text, int line, int column, const std::string& needle) {
-    INFO("scene text: ", text);
-    bool thrown = false;
-    try {
-        parse(text);
-    } catch (const SceneError& e) {
-        thrown = true;
-        INFO("message: ", std::string(e.what()));
-        CHECK(e.where().line == line);
-        CHECK(e.where().column == column);
-        CHECK(e.message().find(needle) != std::string::npos);
-    }
-    CHECK_MESSAGE(thrown, "expected a SceneError");
-}
+using test::expect_error;
 
 /// Column c of the object's Md (linear part: the image of an axis; column 3: translation).
 glm::dvec3 column(const Scene& s, std::size_t object, int c) { return s.objects[object].md[c]; }

@@ -10,6 +10,7 @@
 #include "mesh/mesh.h"
 #include "render/texture.h"
 #include "scene/parser.h"
+#include "scene/expect_error.h"
 #include "scene/test_png.h"
 
 using namespace streamrt;
@@ -46,18 +47,7 @@ struct Dir {
     std::string cfg() const { return (dir / "t.cfg").string(); }
     Scene parse(const std::string& text) const { return parse_scene(text, cfg()); }
     void expect_error(const std::string& text, int line, int column, const std::string& needle) const {
-        INFO("scene text: ", text);
-        bool thrown = false;
-        try {
-            parse(text);
-        } catch (const SceneError& e) {
-            thrown = true;
-            INFO("message: ", std::string(e.what()));
-            CHECK(e.where().line == line);
-            CHECK(e.where().column == column);
-            CHECK(e.message().find(needle) != std::string::npos);
-        }
-        CHECK_MESSAGE(thrown, "expected a SceneError");
+        test::expect_error_in(cfg(), text, line, column, needle);
     }
 };
 
