@@ -18,7 +18,10 @@ struct RecursiveSink {
     const RecursiveRenderer& renderer;
     int depth;
     RayCounts& counts;
+    std::uint32_t key;  ///< the camera sample's light-sampling key
     ColorT<double> color{0, 0, 0};
+
+    std::uint32_t light_key() const { return key; }
 
     void local(const ColorT<double>& c) { color = c; }
     bool occluded(const Vec3d& from, const Vec3d& to, double t_max) {
@@ -29,7 +32,7 @@ struct RecursiveSink {
                const ColorT<double>& throughput, double cone, RayKind kind) {
         if (!send) return;
         ++(kind == RayKind::Reflected ? counts.reflected : counts.refracted);
-        color = color + mul(renderer.trace({from, dir, cone, throughput}, depth + 1, counts), weight);
+        color = color + mul(renderer.trace({from, dir, cone, throughput}, depth + 1, counts, key), weight);
     }
 };
 }  // namespace
@@ -132,7 +135,7 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
     return false;
 }
 
-ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& counts) const {
+ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& counts, std::uint32_t key) const {
     const RenderSettings& s = scene_.settings;
     HitD hit;
     if (!closest_hit(ray, 0.0, kInf, hit)) return {s.background.x, s.background.y, s.background.z};
@@ -142,7 +145,7 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     // Weight 1: the caller multiplies what this ray brings back by its weight.
     const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
     const ColorT<double> object_color{object.color.x, object.color.y, object.color.z};
-    RecursiveSink sink{*this, depth, counts};
+    RecursiveSink sink{*this, depth, counts, key};
     const auto shade = [&]<bool kLit, bool kShadows>() {
         shade_hit<kLit, kShadows, true, true>(rules, materials_[object.material], lights_.data(), lights_.size(),
                                               arriving, hit.point, hit.normal, object_color, true, sink);
@@ -162,7 +165,7 @@ ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) 
         const PixelSample ps = pixel_sample(s.pattern, s.spp, pixel, k);
         const RayD ray{cam.origin, cam.direction(double(x + ps.x), double(y + ps.y)), 0.0};
         ++counts.primary;
-        sum = sum + trace(ray, 0, counts);
+        sum = sum + trace(ray, 0, counts, light_key(pixel, k));
     }
     return sum * (1.0 / s.spp);
 }
