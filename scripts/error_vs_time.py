@@ -16,7 +16,8 @@ stratified, made once and cached in BUILD/perf/reference/. Writes
 Seconds are streamrt's render clock (-j as given, default 2), median of --runs.
 Scenes with area lights (scenes/soft_shadows.cfg) also get a sweep of --light-samples
 1, 2, ... max-spp at 1 spp, stratified (sampler "light" in the CSV), and their reference
-takes min(--ref-spp, 32) spp with --ref-light-samples light samples (default 64, quick 16).
+takes min(--ref-spp, 2 x max-spp) spp (above the sweep's, so no pixel sample is shared) with
+--ref-light-samples light samples (default 64, quick 16).
 """
 import argparse
 import csv
@@ -71,7 +72,7 @@ def main(argv=None):
         path = name if os.path.isabs(name) else os.path.join(pc.ROOT, name)
         base = os.path.splitext(os.path.basename(path))[0]
         area = has_area_lights(path)
-        ref_spp = min(args.ref_spp, 32) if area else args.ref_spp
+        ref_spp = min(args.ref_spp, 2 * max_spp) if area else args.ref_spp
         ref_extra = ["--light-samples", str(args.ref_light_samples)] if area else []
         ref = os.path.join(ref_dir, "%s_%dx%d_%dspp%s.pfm" % (base, w, h, ref_spp,
                                                              "_%dls" % args.ref_light_samples if area else ""))
