@@ -400,7 +400,8 @@ inline ShapedSample<V> sample_shaped_light(const LightT<T>& l, const Vec3T<V>& p
         const V d2 = dot(c, c);
         const V r2(l.radius * l.radius);
         const V dist = sqrt(d2);
-        const Vec3T<V> a = c * (V(1) / dist);
+        // At the very centre (dist 0) any axis will do: a = 0 still gives a unit w below.
+        const Vec3T<V> a = c * (V(1) / max(dist, V(std::numeric_limits<T>::min())));
         const V cos_max = sqrt(V(1) - min(r2 / d2, V(1)));
         const V cos_t = V(1) - u1 * (V(1) - cos_max);
         const V sin_t = sqrt(max(V(1) - cos_t * cos_t, V(0)));
