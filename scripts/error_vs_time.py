@@ -14,6 +14,10 @@ stratified, made once and cached in BUILD/perf/reference/. Writes
 (BUILD/perf-quick/ with --quick) and, when matplotlib is there (/usr/bin/python3), one log-log plot per scene into docs/img/
 (scripts/plot_perf.py --errors draws them again from the CSV).
 Seconds are streamrt's render clock (-j as given, default 2), median of --runs.
+Scenes with area lights (scenes/soft_shadows.cfg) also get a sweep of --light-samples
+1, 2, ... max-spp at 1 spp, stratified (sampler "light" in the CSV), and their reference
+takes min(--ref-spp, 2 x max-spp) spp (above the sweep's, so no pixel sample is shared) with
+--ref-light-samples light samples (default 64, quick 16).
 """
 import argparse
 import csv
@@ -32,12 +36,13 @@ ENGINES = ("stream", "recursive")
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="one scene, spp up to 16, 160x90, 128 spp reference: a smoke run")
-    ap.add_argument("--scenes", help="comma-separated scene files (default whitted, shapes, cornell, dof)")
+    ap.add_argument("--scenes", help="comma-separated scene files (default whitted, shapes, cornell, dof, soft_shadows)")
     ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"))
     ap.add_argument("--width", type=int, help="default 320 (quick 160)")
     ap.add_argument("--height", type=int, help="default 180 (quick 90)")
     ap.add_argument("--max-spp", type=int, help="default 64 (quick 16)")
     ap.add_argument("--ref-spp", type=int, help="reference spp (default 512, quick 128)")
+    ap.add_argument("--ref-light-samples", type=int, help="area-light scenes: reference light samples (default 64, quick 16)")
     ap.add_argument("-j", "--jobs", type=int, default=2)
     ap.add_argument("--runs", type=int, default=1, help="timed renders per point (median)")
     ap.add_argument("--img", default=os.path.join(pc.ROOT, "docs", "img"), help="where the plots go")
@@ -45,10 +50,11 @@ def main(argv=None):
     w = args.width or (160 if args.quick else 320)
     h = args.height or (90 if args.quick else 180)
     args.ref_spp = args.ref_spp or (128 if args.quick else 512)
+    args.ref_light_samples = args.ref_light_samples or (16 if args.quick else 64)
     max_spp = args.max_spp or (16 if args.quick else 64)
     names = args.scenes.split(",") if args.scenes else (
         ["scenes/whitted.cfg"] if args.quick else ["scenes/whitted.cfg", "scenes/shapes.cfg", "scenes/cornell.cfg",
-                                                    "scenes/dof.cfg"])
+                                                    "scenes/dof.cfg", "scenes/soft_shadows.cfg"])
     exe = pc.binary(args.build)
     out_dir = os.path.join(args.build, "perf-quick" if args.quick else "perf")
     ref_dir = os.path.join(out_dir, "reference")
@@ -65,12 +71,17 @@ def main(argv=None):
     for name in names:
         path = name if os.path.isabs(name) else os.path.join(pc.ROOT, name)
         base = os.path.splitext(os.path.basename(path))[0]
-        ref = os.path.join(ref_dir, "%s_%dx%d_%dspp.pfm" % (base, w, h, args.ref_spp))
+        area = has_area_lights(path)
+        ref_spp = min(args.ref_spp, 2 * max_spp) if area else args.ref_spp
+        ref_extra = ["--light-samples", str(args.ref_light_samples)] if area else []
+        ref = os.path.join(ref_dir, "%s_%dx%d_%dspp%s.pfm" % (base, w, h, ref_spp,
+                                                             "_%dls" % args.ref_light_samples if area else ""))
         if not os.path.exists(ref):
-            print("reference: %s, recursive engine, %d spp, stratified ..." % (base, args.ref_spp), flush=True)
+            print("reference: %s, recursive engine, %d spp, stratified %s..." % (base, ref_spp, " ".join(ref_extra)),
+                  flush=True)
             tmp = ref + ".tmp.pfm"
-            pc.run_streamrt(exe, path, tmp, engine="recursive", jobs=args.jobs, spp=args.ref_spp, width=w, height=h,
-                            sampler="stratified")
+            pc.run_streamrt(exe, path, tmp, engine="recursive", jobs=args.jobs, spp=ref_spp, width=w, height=h,
+                            sampler="stratified", extra=ref_extra)
             os.replace(tmp, ref)
         pc.run_streamrt(exe, path, os.path.join(img_dir, "warm.pfm"), jobs=args.jobs, spp=1, width=w, height=h)
         for sampler in SAMPLERS:
@@ -88,6 +99,17 @@ def main(argv=None):
                         e["relmse"]), flush=True)
                 d = pc.image_error(imgs["stream"], imgs["recursive"])
                 prec.append(dict(scene=base, sampler=sampler, spp=spp, **d))
+        # Area lights: the light samples grow instead (1 spp); the CSV's spp column holds them.
+        for ls in spps if area else []:
+            for engine in ENGINES:
+                out = os.path.join(img_dir, "%s_%s.pfm" % (base, engine))
+                secs = [pc.run_streamrt(exe, path, out, engine=engine, jobs=args.jobs, spp=1, width=w, height=h,
+                                        sampler="stratified", extra=["--light-samples", str(ls)])["seconds"]
+                        for _ in range(args.runs)]
+                e = pc.image_error(out, ref)
+                rows.append(dict(scene=base, engine=engine, sampler="light", spp=ls, seconds=pc.median(secs), **e))
+                print("[%5.0fs] %-8s %-9s light samples %-3d %7.3f s  rmse %.5f  psnr %5.2f dB" % (
+                    time.time() - t0, base, engine, ls, rows[-1]["seconds"], e["rmse"], e["psnr"]), flush=True)
     fields = ["scene", "engine", "sampler", "spp", "seconds", "rmse", "psnr", "relmse"]
     csv_path = os.path.join(out_dir, "error_vs_time.csv")
     with open(csv_path, "w", newline="") as f:
@@ -108,6 +130,12 @@ def main(argv=None):
     for p in plot_perf.plot_errors(csv_path, args.img, suffix="-quick" if args.quick else ""):
         print("plot:", p)
     return 0
+
+
+def has_area_lights(path):
+    """Whether the scene file has a sphere or rect light (a plain look at its statements)."""
+    with open(path) as f:
+        return any(line.split()[:2] in (["light", "sphere"], ["light", "rect"]) for line in f)
 
 
 if __name__ == "__main__":

@@ -21,8 +21,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 COLORS = {"stream": "tab:blue", "recursive": "tab:red"}
-MARKERS = {"grid": "s", "stratified": "o", "random": "^"}
-STYLES = {"grid": ":", "stratified": "-", "random": "--"}
+MARKERS = {"grid": "s", "stratified": "o", "random": "^", "light": "D"}
+STYLES = {"grid": ":", "stratified": "-", "random": "--", "light": "-."}
 
 
 def _save(fig, path):
@@ -39,14 +39,15 @@ def plot_errors(csv_path, img_dir, suffix=""):
     for scene in sorted({r["scene"] for r in rows}):
         fig, ax = plt.subplots(figsize=(6.4, 4.2))
         for engine in ("stream", "recursive"):
-            for sampler in ("grid", "stratified", "random"):
+            # "light": 1 spp, stratified, --light-samples growing (scenes with area lights)
+            for sampler in ("grid", "stratified", "random", "light"):
                 pts = sorted((float(r["seconds"]), float(r["rmse"]), int(r["spp"])) for r in rows
                              if r["scene"] == scene and r["engine"] == engine and r["sampler"] == sampler)
                 if not pts:
                     continue
                 ax.plot([p[0] for p in pts], [p[1] for p in pts], color=COLORS[engine], marker=MARKERS[sampler],
                         linestyle=STYLES[sampler], markersize=4, label="%s, %s" % (engine, sampler))
-                if sampler == "stratified":
+                if sampler in ("stratified", "light"):
                     for x, y, spp in pts:
                         ax.annotate(str(spp), (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7,
                                     color=COLORS[engine])
@@ -54,7 +55,8 @@ def plot_errors(csv_path, img_dir, suffix=""):
         ax.set_yscale("log")
         ax.set_xlabel("render time (s)")
         ax.set_ylabel("RMSE vs converged reference")
-        ax.set_title("%s: error against time (labels: spp)" % scene)
+        has_light = any(r["scene"] == scene and r["sampler"] == "light" for r in rows)
+        ax.set_title("%s: error against time (labels: spp%s)" % (scene, ", light samples" if has_light else ""))
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=2)
         out.append(_save(fig, os.path.join(img_dir, "evt_%s%s.png" % (scene, suffix))))

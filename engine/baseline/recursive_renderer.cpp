@@ -19,7 +19,10 @@ struct RecursiveSink {
     const RecursiveRenderer& renderer;
     int depth;
     RayCounts& counts;
+    std::uint32_t key;  ///< the camera sample's light-sampling key
     ColorT<double> color{0, 0, 0};
+
+    std::uint32_t light_key() const { return key; }
 
     void local(const ColorT<double>& c) { color = c; }
     bool occluded(const Vec3d& from, const Vec3d& to, double t_max) {
@@ -30,7 +33,7 @@ struct RecursiveSink {
                const ColorT<double>& throughput, double cone, RayKind kind) {
         if (!send) return;
         ++(kind == RayKind::Reflected ? counts.reflected : counts.refracted);
-        color = color + mul(renderer.trace({from, dir, cone, throughput}, depth + 1, counts), weight);
+        color = color + mul(renderer.trace({from, dir, cone, throughput}, depth + 1, counts, key), weight);
     }
 };
 }  // namespace
@@ -143,7 +146,7 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
     return false;
 }
 
-ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& counts) const {
+ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& counts, std::uint32_t key) const {
     const RenderSettings& s = scene_.settings;
     HitD hit;
     if (!closest_hit(ray, 0.0, kInf, hit)) return {s.background.x, s.background.y, s.background.z};
@@ -162,7 +165,7 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
                            ? mesh_texture_color(material, ob.mesh->view(), hit.tri, hit.bu, hit.bv, scale, footprint)
                            : texture_color(material, ob.kind, hit.canonical, ob.param, scale, footprint);
     }
-    RecursiveSink sink{*this, depth, counts};
+    RecursiveSink sink{*this, depth, counts, key};
     const auto shade = [&]<bool kLit, bool kShadows>() {
         shade_hit<kLit, kShadows, true, true>(rules, material, lights_.data(), lights_.size(),
                                               arriving, hit.point, hit.normal, object_color, true, sink);
@@ -188,7 +191,7 @@ ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) 
             ray.dir = cam.direction(double(x + ps.x), double(y + ps.y));
         }
         ++counts.primary;
-        sum = sum + trace(ray, 0, counts);
+        sum = sum + trace(ray, 0, counts, light_key(pixel, k));
     }
     return sum * (1.0 / s.spp);
 }

@@ -46,7 +46,9 @@ class RecursiveRenderer {
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr) const;
 
     /// Colour brought back by one ray (the handout's recursive procedure).
-    ColorT<double> trace(const RayD& ray, int depth, RayCounts& counts) const;
+    /// `key`: the camera sample's light-sampling key (render/sampling.h light_key), which
+    /// every ray of the sample carries for area lights.
+    ColorT<double> trace(const RayD& ray, int depth, RayCounts& counts, std::uint32_t key = 0) const;
 
     /// Closest hit over all objects (through the scene's hierarchy when it has one), t in (t_min, t_max); false for a miss.
     bool closest_hit(const RayD& ray, double t_min, double t_max, HitD& hit) const;

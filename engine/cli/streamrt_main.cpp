@@ -54,6 +54,7 @@ struct Options {
     std::string output;
     std::optional<int> spp, width, height, degree, depth;
     std::optional<double> cutoff;
+    std::optional<int> light_samples;
     std::string engine = "stream";
     std::string accel = "auto";
     std::string isa;
@@ -213,6 +214,9 @@ Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
     if (opt.degree) s.degree = *opt.degree;
     if (opt.depth) s.depth = *opt.depth;
     if (opt.cutoff) s.cutoff = *opt.cutoff;
+    if (opt.light_samples)
+        for (Light& l : job.scene.lights)
+            if (l.is_area()) l.samples = *opt.light_samples;
     if (opt.sampler == "grid") s.pattern = SamplePattern::Grid;
     if (opt.sampler == "random") s.pattern = SamplePattern::Random;
     if (opt.sampler == "stratified") s.pattern = SamplePattern::Stratified;
@@ -550,6 +554,9 @@ int run(int argc, char** argv) {
                    "Weight cut-off: reflected and refracted rays worth less than this in every channel are not "
                    "traced (default 0: all; overrides the scene's image cutoff=)")
         ->check(CLI::Range(0.0, 1.0));
+    app.add_option("--light-samples", opt.light_samples,
+                   "Shadow rays per shaded point of every area light (overrides the lights' samples=)")
+        ->check(CLI::Range(1, 4096));
     app.add_option("--engine", opt.engine, "Renderer: stream (SIMD ray streams) or recursive (the handout's baseline)")
         ->check(CLI::IsMember({"stream", "recursive"}));
     app.add_option("--isa", opt.isa, "Force the stream kernels' level: sse2, sse4.2, avx2 or avx512 (default: best the CPU has)")

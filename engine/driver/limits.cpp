@@ -40,7 +40,9 @@ MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, in
         // regrouping buffer: each at most 2 x slice rays.
         e.generations = spawns ? s.depth + 2 : 1;
         const double streams = (double(e.generations) + 3) * 2 * slice * kRayBytes;
-        const double lights = s.degree >= 5 ? double(scene.lights.size()) : 0.0;
+        // Shadow rays per hit: one per light, `samples` per area light.
+        double lights = 0.0;
+        for (const Light& l : scene.lights) lights += s.degree >= 5 ? (l.is_area() ? double(l.samples) : 1.0) : 0.0;
         // The shadow rays of a slice, twice (regrouped by pixel after gathered shading).
         e.per_thread_bytes = streams + 2 * slice * kHitBytes + slice * kSortedBytes + 2 * slice * lights * kShadowBytes;
     } else {

@@ -35,6 +35,9 @@ struct RayStream {
     AlignedVec<float> cone;        ///< footprint width at the origin (ray cone, texture filtering)
     AlignedVec<std::int32_t> pixel;  ///< tile-local pixel the result accumulates into
     AlignedVec<std::uint8_t> kind;   ///< RayKind, for the profile
+    /// Scenes with area lights only (empty otherwise): the camera sample's light-sampling key
+    /// (render/sampling.h light_key), inherited by every ray the sample spawns.
+    AlignedVec<std::uint32_t> key;
 
     /// Makes room for n rays (padded, plus a packet of slack for the kernels' compacting
     /// stores) and sets count = 0; keeps capacity.
@@ -48,6 +51,10 @@ struct RayStream {
         count = 0;
     }
     std::size_t capacity() const { return ox.size(); }
+    /// Gives `key` the stream's capacity (scenes with area lights, after reserve).
+    void reserve_keys() {
+        if (key.size() < ox.size()) key.resize(ox.size());
+    }
     /// Makes the lanes between count and the next multiple of kMaxLanes inert.
     void pad_tail() { make_tail_inert(*this); }
 };

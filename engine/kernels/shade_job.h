@@ -20,6 +20,7 @@ struct RayAppend {
     std::int32_t* pixel;
     std::uint8_t* kind;
     std::size_t* count;
+    std::uint32_t* key = nullptr;  ///< scenes with area lights: the rays' light-sampling keys
 };
 
 /// Append-only view of a ShadowStream.
@@ -56,6 +57,7 @@ struct ShadeJob {
     const KernelObject* objects = nullptr;     ///< gathered: every object's record, by id
     const SurfaceRecord* surfaces = nullptr;   ///< gathered: every object's colour, by id
     ShapeKind kind = ShapeKind::Sphere;        ///< gathered: the run's shape kind (never Mesh)
+    const std::uint32_t* key = nullptr;        ///< area lights: per ray, its light-sampling key
 };
 
 /// Camera rays for one chunk. Per ray (arrays padded to whole packets): the pixel's corner

@@ -138,6 +138,9 @@ inline void append(const ShadeJob& job, std::size_t i, const M& active, const Ve
     const std::size_t n =
         compress_store(xsimd::batch<std::int32_t, A>::load_unaligned(job.pixel + i), bits, r.pixel + j);
     std::memset(r.kind + j, int(kind), n);
+    if (r.key)  // area lights: children inherit the key (uniform per scene)
+        compress_store(xsimd::batch<std::int32_t, A>::load_unaligned(reinterpret_cast<const std::int32_t*>(job.key + i)),
+                       bits, reinterpret_cast<std::int32_t*>(r.key + j));
     *r.count = j + n;
 }
 
@@ -176,6 +179,10 @@ struct SimdSink {
     void child(const Mask& send, const Vec3T<B>& from, const Vec3T<B>& dir, const ColorT<B>& weight, const ColorT<B>&,
                const B& cone, RayKind kind) const {
         append(job, i, send, from, dir, weight, cone, kind);
+    }
+    /// Area lights only: the packet's light-sampling keys.
+    xsimd::batch<std::uint32_t, typename B::arch_type> light_key() const {
+        return xsimd::batch<std::uint32_t, typename B::arch_type>::load_unaligned(job.key + i);
     }
 };
 

@@ -173,5 +173,22 @@ inline PixelSample lens_sample(SamplePattern pattern, int spp, std::uint64_t pix
     return concentric_disc(q.x, q.y);
 }
 
+// ---- Area lights (docs/scene-format.md, "Area lights and soft shadows") ----------------
+
+/// The key of camera sample k of a pixel (row-major index) for light sampling. Every ray a
+/// camera sample spawns (reflected, refracted) carries it, so a pixel's light samples are
+/// the same for every thread count and in both engines.
+inline std::uint32_t light_key(std::uint64_t pixel, int sample) {
+    return hash32(std::uint32_t(pixel) * 0x27d4eb2fu + std::uint32_t(sample) * 0x165667b1u + 0x3c6ef372u);
+}
+
+/// The two hashes of light sample j of light `light` for a ray of key `key` (U: uint32 or a
+/// batch of it, one key per lane).
+template <class U>
+inline void light_sample_hashes(const U& key, std::uint32_t light, std::uint32_t j, U& h1, U& h2) {
+    h1 = hash32(key ^ U(hash32(light * 0x85ebca77u + j * 0xc2b2ae3du + 0x9e3779b9u)));
+    h2 = hash32(h1 ^ U(0x5bd1e995u));
+}
+
 STREAMRT_ISA_END
 }  // namespace streamrt

@@ -3,6 +3,7 @@
 // written once for V = double (recursive baseline), float and xsimd float batches (the
 // stream engine's shade kernels). Materials and lights are per-object scalars, broadcast
 // into lanes; everything that varies per ray goes through select(), never a branch.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -10,6 +11,7 @@
 
 #include "core/vec3.h"
 #include "render/render_stats.h"
+#include "render/sampling.h"
 #include "scene/scene.h"
 #include "simd/isa_namespace.h"
 #include "simd/lanes.h"
@@ -78,11 +80,42 @@ struct LightT {
     Vec3T<T> dir;  ///< unit: spot axis or directional travel direction
     ColorT<T> color;
     T cos_angle;   ///< spot: cosine of the half-angle
+    // Area lights, falloff and soft edges: a light with `shaped` false (the handout's) takes
+    // shade_hit's original path and reads none of these.
+    bool shaped = false;          ///< Light::shaped(): lit by shade_shaped_light
+    bool inverse_square = false;  ///< falloff=inverse_square
+    bool soft = false;            ///< spot with a soft edge
+    T cos_inner = T(1);           ///< soft spot: cosine of angle - soft (full light inside)
+    T radius = T(0);              ///< sphere
+    Vec3T<T> u{}, v{};            ///< rect: edges from the corner pos
+    Vec3T<T> normal{};            ///< rect: unit u x v, the lit side
+    int samples = 1;              ///< area lights: samples per shaded point
+    int columns = 1;              ///< their stratification lattice: columns x (samples / columns)
 
     static LightT from(const Light& l) {
-        return {l.kind, {T(l.pos.x), T(l.pos.y), T(l.pos.z)},
-                {T(l.dir.x), T(l.dir.y), T(l.dir.z)}, {T(l.color.x), T(l.color.y), T(l.color.z)},
-                T(std::cos(l.angle * 3.14159265358979323846 / 180.0))};
+        constexpr double kDeg = 3.14159265358979323846 / 180.0;
+        LightT r{l.kind, {T(l.pos.x), T(l.pos.y), T(l.pos.z)},
+                 {T(l.dir.x), T(l.dir.y), T(l.dir.z)}, {T(l.color.x), T(l.color.y), T(l.color.z)},
+                 T(std::cos(l.angle * kDeg))};
+        r.shaped = l.shaped();
+        r.inverse_square = l.falloff == Falloff::InverseSquare;
+        r.soft = l.kind == LightKind::Spot && l.soft > 0.0;
+        r.cos_inner = T(std::cos((l.angle - l.soft) * kDeg));
+        r.radius = T(l.radius);
+        r.u = {T(l.u.x), T(l.u.y), T(l.u.z)};
+        r.v = {T(l.v.x), T(l.v.y), T(l.v.z)};
+        const glm::dvec3 n = glm::cross(l.u, l.v);
+        const double len = glm::length(n);
+        if (len > 0.0) r.normal = {T(n.x / len), T(n.y / len), T(n.z / len)};
+        r.samples = l.is_area() ? std::max(1, l.samples) : 1;
+        r.columns = l.is_area() ? area_light_columns(r.samples) : 1;
+        return r;
+    }
+    /// Columns of the lattice of n samples: as square as possible, columns dividing n.
+    static int area_light_columns(int n) {
+        int cols = int(std::ceil(std::sqrt(double(n))));
+        while (n % cols != 0) ++cols;
+        return cols;
     }
 };
 
@@ -333,6 +366,163 @@ struct ArrivingRay {
 
 STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
+// ---- Area lights, falloff and soft spot edges (docs/scene-format.md, "Area lights and soft
+// shadows"). A light is seen from p as the average, over its samples, of the handout's
+// point-light term from each sample point, times `scale` (falloff, soft edge, emitter
+// cosine): a tiny area light is a point light of the same colour.
+
+/// One sample of a shaped light seen from p: the point-light term's direction and reach
+/// (ls), the sample point `at` (lights at a point) and what the term is multiplied by.
+template <class V>
+struct ShapedSample {
+    LightSample<V> ls;
+    Vec3T<V> at;
+    V scale;
+};
+
+/// cos and sin of the angle 2 pi u, u in [0, 1), without library calls: a quarter turn by
+/// quadrant and Taylor polynomials to degree 12 / 13 on [0, pi/2] (error below 4e-8), in
+/// plain multiplies and adds, so every instruction-set level gives the same bits (xsimd's
+/// sin / cos fuse multiply-adds on some levels only).
+template <class V>
+inline void cos_sin_of_turn(const V& u, V& c, V& s) {
+    using namespace simd;
+    using std::floor;
+    using S = simd::scalar_t<V>;
+    const V x = u * V(S(4));
+    const V q = floor(x);
+    const V t = (x - q) * V(S(1.5707963267948966));
+    const V t2 = t * t;
+    // Horner forms of the Taylor series of cos t and sin t.
+    V pc = V(S(1.0 / 479001600.0));
+    pc = pc * t2 - V(S(1.0 / 3628800.0));
+    pc = pc * t2 + V(S(1.0 / 40320.0));
+    pc = pc * t2 - V(S(1.0 / 720.0));
+    pc = pc * t2 + V(S(1.0 / 24.0));
+    pc = pc * t2 - V(S(0.5));
+    pc = pc * t2 + V(1);
+    V ps = V(S(1.0 / 6227020800.0));
+    ps = ps * t2 - V(S(1.0 / 39916800.0));
+    ps = ps * t2 + V(S(1.0 / 362880.0));
+    ps = ps * t2 - V(S(1.0 / 5040.0));
+    ps = ps * t2 + V(S(1.0 / 120.0));
+    ps = ps * t2 - V(S(1.0 / 6.0));
+    ps = ps * t2 + V(1);
+    ps = ps * t;
+    // Quadrant q: the angle is q quarter turns plus t.
+    const auto odd = (q == V(1)) || (q == V(3));
+    const V c0 = select(odd, -ps, pc), s0 = select(odd, pc, ps);
+    const auto back = q >= V(2);
+    c = select(back, -c0, c0);
+    s = select(back, -s0, s0);
+}
+
+/// Sample (u1, u2) in [0, 1)^2 of light l seen from p. Sphere: a direction uniform in the
+/// solid angle of the cap of the sphere visible from p (cone sampling: cos theta uniform in
+/// [cos theta_max, 1]), ending on the sphere's near side. Rect: a point uniform on the
+/// parallelogram pos + u1 u + u2 v, weighted by the emitter cosine (zero behind it: one-sided).
+/// Spot with a soft edge: the smoothstep of the cosine from cos(angle) (0) to cos(angle - soft)
+/// (1). falloff=inverse_square: 1 / |p - at|^2 (directional lights, at infinity, have none).
+template <class V, class T>
+inline ShapedSample<V> sample_shaped_light(const LightT<T>& l, const Vec3T<V>& p, const V& u1, const V& u2) {
+    using namespace simd;
+    ShapedSample<V> r;
+    r.scale = V(1);
+    if (l.kind == LightKind::Directional) {
+        r.ls = sample_light(l, p);
+        r.at = p + r.ls.w;
+        return r;
+    }
+    if (l.kind == LightKind::Point || l.kind == LightKind::Spot) {
+        r.ls = sample_light(l, p);
+        r.at = splat<V>(l.pos);
+        if (l.soft) {
+            const V c = dot(-r.ls.w, splat<V>(l.dir));
+            const V x = min(max((c - V(l.cos_angle)) / V(l.cos_inner - l.cos_angle), V(0)), V(1));
+            r.scale = x * x * (V(3) - V(2) * x);
+        }
+    } else if (l.kind == LightKind::Sphere) {
+        const Vec3T<V> c = splat<V>(l.pos) - p;
+        const V d2 = dot(c, c);
+        const V r2(l.radius * l.radius);
+        const V dist = sqrt(d2);
+        // At the very centre (dist 0) any axis will do: a = 0 still gives a unit w below.
+        const Vec3T<V> a = c * (V(1) / max(dist, V(std::numeric_limits<T>::min())));
+        const V cos_max = sqrt(V(1) - min(r2 / d2, V(1)));
+        const V cos_t = V(1) - u1 * (V(1) - cos_max);
+        const V sin_t = sqrt(max(V(1) - cos_t * cos_t, V(0)));
+        V cos_phi, sin_phi;
+        cos_sin_of_turn(u2, cos_phi, sin_phi);
+        // An orthonormal basis around a (Duff et al. 2017, branch-free).
+        const V sg = sign_of(a.z);
+        const V k = V(-1) / (sg + a.z);
+        const V b = a.x * a.y * k;
+        const Vec3T<V> b1{V(1) + sg * a.x * a.x * k, sg * b, -sg * a.x};
+        const Vec3T<V> b2{b, sg + a.y * a.y * k, -a.y};
+        const Vec3T<V> w = b1 * (sin_t * cos_phi) + b2 * (sin_t * sin_phi) + a * cos_t;
+        // Along w to the sphere: its near side, or its far side from inside the light.
+        const V h = sqrt(max(r2 - d2 * sin_t * sin_t, V(0)));
+        const V t = select(d2 > r2, dist * cos_t - h, dist * cos_t + h);
+        r.at = p + w * t;
+        r.ls.w = w;
+        r.ls.to_light = w * t;
+        r.ls.t_max = V(1);
+        r.ls.reaches = t > V(0);
+    } else {  // Rect
+        r.at = splat<V>(l.pos) + splat<V>(l.u) * u1 + splat<V>(l.v) * u2;
+        r.ls.to_light = r.at - p;
+        r.ls.w = normalize(r.ls.to_light);
+        r.ls.t_max = V(1);
+        const V emit = -dot(r.ls.w, splat<V>(l.normal));
+        r.ls.reaches = emit > V(0);
+        r.scale = max(emit, V(0));
+    }
+    if (l.inverse_square)
+        r.scale = r.scale / max(dot(r.ls.to_light, r.ls.to_light), V(std::numeric_limits<T>::min()));
+    return r;
+}
+
+/// The light of one shaped light (l.shaped: area, falloff or soft edge; light number `index`)
+/// at a hit: l.samples samples, stratified on a columns x rows lattice with one point per cell
+/// placed by the hashes of (the ray's key, index, sample), each a shadow ray of 1 / samples of
+/// the light. Lights at a point take one sample, the point itself. Otherwise as shade_hit.
+template <bool kShadows, class V, class T, class M, class Sink>
+inline void shade_shaped_light(const ShadeRules<T>& rules, const MaterialT<T>& m, const ColorT<V>& base,
+                               const Vec3T<V>& n, const ArrivingRay<V>& ray, const LightT<T>& l,
+                               std::uint32_t index, const Vec3T<V>& p, const Vec3T<V>& shadow_origin,
+                               const M& active, ColorT<V>& local, Sink& sink) {
+    using namespace simd;
+    const bool area = l.kind == LightKind::Sphere || l.kind == LightKind::Rect;
+    const V share(T(1) / T(l.samples));
+    const int cols = l.columns;
+    const V inv_cols(T(1) / T(cols)), inv_rows(T(1) / T(l.samples / cols));
+    for (int j = 0; j < l.samples; ++j) {
+        V u1(T(0.5)), u2(T(0.5));
+        if (area) {
+            const auto key = sink.light_key();
+            auto h1 = key, h2 = key;
+            light_sample_hashes(key, index, std::uint32_t(j), h1, h2);
+            u1 = (V(T(j % cols)) + V(unit_from_hash(h1))) * inv_cols;
+            u2 = (V(T(j / cols)) + V(unit_from_hash(h2))) * inv_rows;
+        }
+        const ShapedSample<V> s = sample_shaped_light(l, p, u1, u2);
+        const DirectLight<V> dl = direct_light(rules.degree, m, base, n, ray.dir, l, s.ls);
+        const auto send = dl.lit && active && (s.scale > V(0));
+        if (!any(send)) continue;
+        const ColorT<V> c = mul(ray.weight, dl.color) * (s.scale * share);
+        if constexpr (kShadows) {
+            const Vec3T<V> to = l.kind == LightKind::Directional ? s.ls.to_light : s.at - shadow_origin;
+            if constexpr (Sink::kTestsShadowsNow) {
+                if (!sink.occluded(shadow_origin, to, s.ls.t_max)) local = local + c;
+            } else {
+                sink.shadow(send, shadow_origin, to, s.ls.t_max, c);
+            }
+        } else {
+            local = local + c;
+        }
+    }
+}
+
 /// The handout's shading of one hit (or one packet of hits), written once for the recursive
 /// baseline (V = double, one ray), the stream engine's scalar path (float) and its SIMD
 /// kernels (float batches): the surface colour (checker), the local terms by degree, shadow
@@ -344,6 +534,8 @@ STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h
 ///                                                  is unblocked (lanes `send`)
 ///   sink.child(send, origin, dir, weight, throughput, cone, kind)   a reflected or refracted
 ///                                                  ray to trace (lanes `send`)
+///   sink.light_key()                               the ray's light-sampling key (area
+///                                                  lights only: sampling.h light_key)
 /// A sink with kTestsShadowsNow (the recursive engine) answers sink.occluded(origin, to,
 /// t_max) at once instead, and the unblocked light joins the local colour.
 /// The features are compile-time flags so a scene's pipeline carries no code for what it
@@ -371,6 +563,11 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
         if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, ray.origin);
         for (std::size_t li = 0; li < n_lights; ++li) {
             const LightT<T>& l = lights[li];
+            if (l.shaped) {  // uniform per light: the handout's lights never enter
+                shade_shaped_light<kShadows>(rules, m, base, n, ray, l, std::uint32_t(li), p, shadow_origin, active,
+                                             local, sink);
+                continue;
+            }
             const LightSample<V> ls = sample_light(l, p);
             const DirectLight<V> dl = direct_light(rules.degree, m, base, n, d, l, ls);
             const auto send = dl.lit && active;

@@ -351,9 +351,12 @@ const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCa
 const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
 const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys, {"name"}});
 const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth", "materials"}});
-const std::vector<std::string_view> kPointLightKeys = {"pos", "color", "name"};
-const std::vector<std::string_view> kSpotLightKeys = {"pos", "dir", "angle", "color", "name"};
-const std::vector<std::string_view> kDirectionalLightKeys = {"dir", "color", "name"};
+const std::vector<std::string_view> kPointLightKeys = {"pos", "color", "falloff", "name"};
+const std::vector<std::string_view> kSpotLightKeys = {"pos", "dir", "angle", "color", "falloff", "soft", "name"};
+const std::vector<std::string_view> kDirectionalLightKeys = {"dir", "color", "falloff", "name"};
+// Area lights (docs/scene-format.md, "Area lights and soft shadows").
+const std::vector<std::string_view> kSphereLightKeys = {"pos", "radius", "color", "samples", "falloff", "name"};
+const std::vector<std::string_view> kRectLightKeys = {"pos", "u", "v", "color", "samples", "falloff", "name"};
 // The `key` statement's keys, by what the name names (animation, scene/animation.h).
 const std::vector<std::string_view> kObjectKeyKeys = {"frame", "translate", "rotate", "scale"};
 const std::vector<std::string_view> kLightKeyKeys = {"frame", "pos", "color"};
@@ -918,7 +921,7 @@ class Parser {
 
     void light(Statement& st, const std::vector<Token>& toks) {
         if (toks.size() < 2)
-            st.fail_here("expected a light kind (point, spot or directional) after 'light'");
+            st.fail_here("expected a light kind (point, spot, directional, sphere or rect) after 'light'");
         const Token& kt = toks[1];
         Light l;
         const std::vector<std::string_view>* keys = nullptr;
@@ -931,9 +934,15 @@ class Parser {
         } else if (kt.text == "directional") {
             l.kind = LightKind::Directional;
             keys = &kDirectionalLightKeys;
+        } else if (kt.text == "sphere") {
+            l.kind = LightKind::Sphere;
+            keys = &kSphereLightKeys;
+        } else if (kt.text == "rect") {
+            l.kind = LightKind::Rect;
+            keys = &kRectLightKeys;
         } else {
             st.fail(kt.column,
-                    "expected a light kind (point, spot or directional), got " + quote(kt.text));
+                    "expected a light kind (point, spot, directional, sphere or rect), got " + quote(kt.text));
         }
         st.read_args(toks, 2, *keys);
         for (const Arg& a : st.args) {
@@ -941,15 +950,47 @@ class Parser {
             else if (a.key == "dir") l.dir = st.direction(a);
             else if (a.key == "angle") l.angle = st.in_open(a, 0.0, 180.0);
             else if (a.key == "color") l.color = st.color(a);
+            else area_light_key(st, a, l);
         }
         const bool needs_pos = l.kind != LightKind::Directional;
-        const bool needs_dir = l.kind != LightKind::Point;
+        const bool needs_dir = l.kind == LightKind::Spot || l.kind == LightKind::Directional;
         const std::string kind(kt.text);
         if (needs_pos && !st.find("pos")) st.fail_here("light " + kind + " needs 'pos=x,y,z'");
         if (needs_dir && !st.find("dir")) st.fail_here("light " + kind + " needs 'dir=x,y,z'");
+        check_area_light(st, l);
         scene.lights.push_back(l);
         if (const Arg* n = st.find("name"))
             name_thing(st.file(), st.line(), *n, Named::Light, std::uint32_t(scene.lights.size() - 1));
+    }
+
+    /// The keys of area lights, falloff and soft spot edges.
+    static void area_light_key(const Statement& st, const Arg& a, Light& l) {
+        if (a.key == "radius") l.radius = st.positive(a);
+        else if (a.key == "u") l.u = st.vec3(a);
+        else if (a.key == "v") l.v = st.vec3(a);
+        else if (a.key == "samples") l.samples = st.integer(a, 1, 4096);
+        else if (a.key == "soft") l.soft = st.at_least_zero(a);
+        else if (a.key == "falloff") {
+            if (a.value == "none") l.falloff = Falloff::None;
+            else if (a.value == "inverse_square") l.falloff = Falloff::InverseSquare;
+            else st.fail(a.value_col, "expected none or inverse_square for 'falloff', got " + quote(a.value));
+        }
+    }
+
+    /// What an area light or a soft edge needs beyond its keys' own ranges.
+    static void check_area_light(const Statement& st, const Light& l) {
+        if (l.kind == LightKind::Sphere && !st.find("radius")) st.fail_here("light sphere needs 'radius=r'");
+        if (l.kind == LightKind::Rect) {
+            if (!st.find("u")) st.fail_here("light rect needs 'u=x,y,z'");
+            if (!st.find("v")) st.fail_here("light rect needs 'v=x,y,z'");
+            const double area = glm::length(glm::cross(l.u, l.v));
+            // Relative to the edges' lengths, so the test does not depend on the scene's unit.
+            if (!(area > 1e-12 * glm::length(l.u) * glm::length(l.v)) || !std::isfinite(area))
+                st.fail(st.find("v")->value_col, "light rect: 'u' and 'v' span no area (u x v = 0)");
+        }
+        if (const Arg* s = st.find("soft"); s && !(l.soft < l.angle))
+            st.fail(s->value_col, "'soft' must be below the spot's 'angle' (" + fmt_num(l.angle) + "), got " +
+                                      quote(s->value));
     }
 
     /// The material named by `a`, as defined at this statement: the chunked reader has read

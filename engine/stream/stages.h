@@ -26,6 +26,7 @@ namespace streamrt {
 struct SortedHits {
     AlignedVec<float> ox, oy, oz, dx, dy, dz, t, wr, wg, wb, cone, lr, lg, lb, bu, bv;
     AlignedVec<std::int32_t> pixel, prim, object;  ///< object: gathered runs only
+    AlignedVec<std::uint32_t> key;  ///< area lights only: light-sampling keys (reserve_keys)
     std::vector<std::uint32_t> run_start;  ///< per object, then one past the end
     void reserve(std::size_t n) {
         // Kernels read a whole packet past the last ray of a run.
@@ -36,6 +37,9 @@ struct SortedHits {
             prim.resize(cap);
             object.resize(cap);
         }
+    }
+    void reserve_keys() {
+        if (key.size() < ox.size()) key.resize(ox.size());
     }
 };
 
@@ -131,8 +135,12 @@ inline std::uint64_t lanes_for(std::size_t n, int width) {
 }
 
 /// Copies rays [from, from + n) of `src` into `dst` (which then holds exactly them).
-inline void copy_rays(const RayStream& src, std::size_t from, std::size_t n, RayStream& dst) {
+inline void copy_rays(const RayStream& src, std::size_t from, std::size_t n, RayStream& dst, bool keys) {
     dst.reserve(n);
+    if (keys) {  // area lights
+        dst.reserve_keys();
+        std::copy_n(src.key.begin() + std::ptrdiff_t(from), n, dst.key.begin());
+    }
     for (auto a : {&RayStream::ox, &RayStream::oy, &RayStream::oz, &RayStream::dx, &RayStream::dy, &RayStream::dz,
                    &RayStream::t_max, &RayStream::wr, &RayStream::wg, &RayStream::wb, &RayStream::cone})
         std::copy_n((src.*a).begin() + std::ptrdiff_t(from), n, (dst.*a).begin());
@@ -146,10 +154,10 @@ inline void copy_rays(const RayStream& src, std::size_t from, std::size_t n, Ray
 /// regroups `gen` so each slice is contiguous, keeping the rays' order within a slice. A
 /// pixel with more than `cap` rays alone is cut, in stream order, into slices of its own.
 /// Returns the slices' bounds in `gen` (first 0, last gen.count). `scratch` ends holding the
-/// generation's former buffer.
+/// generation's former buffer. `keys`: the rays carry light-sampling keys (area lights).
 inline std::vector<std::size_t> cut_into_slices(RayStream& gen, RayStream& scratch, std::size_t cap,
                                                 std::size_t tile_pixels, std::vector<std::uint32_t>& pixel_rays,
-                                                std::vector<std::uint32_t>& pixel_slice) {
+                                                std::vector<std::uint32_t>& pixel_slice, bool keys) {
     pixel_rays.assign(tile_pixels, 0);
     for (std::size_t i = 0; i < gen.count; ++i) ++pixel_rays[std::size_t(gen.pixel[i])];
     // Each pixel's first slice: pixels are packed greedily, in pixel order.
@@ -176,9 +184,11 @@ inline std::vector<std::size_t> cut_into_slices(RayStream& gen, RayStream& scrat
     std::vector<std::size_t> at(bounds.begin(), bounds.end() - 1);
     pixel_rays.assign(tile_pixels, 0);  // now: the pixel's rays placed so far
     scratch.reserve(gen.count);
+    if (keys) scratch.reserve_keys();
     for (std::size_t i = 0; i < gen.count; ++i) {
         const std::size_t p = std::size_t(gen.pixel[i]);
         const std::size_t j = at[pixel_slice[p] + pixel_rays[p]++ / cap]++;
+        if (keys) scratch.key[j] = gen.key[i];
         scratch.ox[j] = gen.ox[i], scratch.oy[j] = gen.oy[i], scratch.oz[j] = gen.oz[i];
         scratch.dx[j] = gen.dx[i], scratch.dy[j] = gen.dy[i], scratch.dz[j] = gen.dz[i];
         scratch.t_max[j] = gen.t_max[i];
@@ -268,6 +278,20 @@ struct PipelineStages {
                         g.lens_x.data(),
                         g.lens_y.data()};
         (lens ? kt.generate_lens : kt.generate)(job);
+        if (sc.features.area_lights) area_light_keys(sc, tile, first, n_pixels, rays);
+    }
+
+    /// Area lights: each camera ray's light-sampling key (render/sampling.h light_key), from
+    /// its global pixel and sample index (the rays of a pixel are its samples in order).
+    static void area_light_keys(const StreamScene& sc, const Tile& tile, int first, int n_pixels, RayStream& rays) {
+        rays.reserve_keys();
+        const int spp = sc.settings.spp;
+        std::size_t i = 0;
+        for (int p = first; p < first + n_pixels; ++p) {
+            const int x = tile.x0 + p % tile.width(), y = tile.y0 + p / tile.width();
+            const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x);
+            for (int k = 0; k < spp; ++k, ++i) rays.key[i] = light_key(pixel, k);
+        }
     }
 
     /// intersect: closest hit of every ray, one SIMD kernel per shape kind present.
@@ -319,6 +343,10 @@ struct PipelineStages {
         RayStream& next;
         ShadowStream& shadows;
         RayCounts& counts;
+        const std::uint32_t* keys;  ///< area lights only (else unread): the rays' keys
+        std::size_t i;              ///< the ray shaded
+
+        std::uint32_t light_key() const { return keys[i]; }
 
         void local(const ColorT<float>& c) { stage_detail::add(accum, px, c); }
         void shadow(bool send, const Vec3f& from, const Vec3f& to, float t_max, const ColorT<float>& c) {
@@ -339,6 +367,7 @@ struct PipelineStages {
         void child(bool send, const Vec3f& from, const Vec3f& dir, const ColorT<float>& weight, const ColorT<float>&,
                    float cone, RayKind kind) {
             if (!send) return;
+            if (keys) next.key[next.count] = keys[i];  // area lights: the child inherits the key
             push(next, next.count++, from, dir, weight, cone, px, kind);
             ++(kind == RayKind::Reflected ? counts.reflected : counts.refracted);
         }
@@ -357,6 +386,7 @@ struct PipelineStages {
         // cache misses: fetch them a few rays ahead (in leaf order, neighbouring rays mostly
         // hit objects close in memory).
         constexpr std::size_t kPrefetchDistance = 8;
+        const std::uint32_t* keys = sc.features.area_lights ? rays.key.data() : nullptr;
         for (std::size_t i = 0; i < rays.count; ++i) {
             if (i + kPrefetchDistance < rays.count && object[i + kPrefetchDistance] >= 0) {
                 const std::size_t ahead = std::size_t(object[i + kPrefetchDistance]);
@@ -387,7 +417,7 @@ struct PipelineStages {
                                          ob.xf.param != 0.f)
                     : visit_shape(kind, [&](auto shape) { return shape.template normal<float>(pc, ob.xf.param); });
             const ArrivingRay<float> arriving{o, d, t, rays.cone[i], w, w};
-            ScalarSink sink{accum, px, next, shadows, counts};
+            ScalarSink sink{accum, px, next, shadows, counts, keys, i};
             const Vec3f n_out = apply_normal(ob.xf.m, nc);
             ColorT<float> color{sf.color[0], sf.color[1], sf.color[2]};
             if (m.texture) {  // the texture replaces the object's colour (render/texture.h)
@@ -430,6 +460,7 @@ struct PipelineStages {
         }
         for (std::size_t k = 1; k <= n_keys; ++k) h.run_start[k] += h.run_start[k - 1];
         h.reserve(hits);
+        if (sc.features.area_lights) h.reserve_keys();
         {
             std::vector<std::uint32_t>& next_slot = ws.slot;
             next_slot.assign(h.run_start.begin(), h.run_start.end() - 1);
@@ -450,6 +481,7 @@ struct PipelineStages {
                 h.cone[j] = rays.cone[i];
                 h.pixel[j] = rays.pixel[i];
                 if (gathered) h.object[j] = id;
+                if (sc.features.area_lights) h.key[j] = rays.key[i];
                 if (sc.has_meshes) {
                     h.prim[j] = ws.mesh_hits.prim[i];
                     h.bu[j] = ws.mesh_hits.u[i];
@@ -473,6 +505,7 @@ struct PipelineStages {
         job.prim = h.prim.data();
         job.bu = h.bu.data();
         job.bv = h.bv.data();
+        if (sc.features.area_lights) job.key = h.key.data(), job.next.key = nx.key.data();
         const int variant = (kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0);
         const ShadeFn fn = gathered ? kt.shade_gathered[variant] : kt.shade[variant];
         if (gathered) {
@@ -601,7 +634,9 @@ struct PipelineStages {
             StageTimer timer(c.fig(Stage::Shade));
             // Room for every ray spawning both children and a shadow ray per light.
             ws.next.reserve(kSecondary ? rays.count * 2 : 0);
-            if constexpr (kShadows) ws.shadows.reserve(rays.count * sc.lights.size());
+            if (sc.features.area_lights) ws.next.reserve_keys();
+            // Area lights send `samples` shadow rays each (StreamScene::shadow_rays_per_hit).
+            if constexpr (kShadows) ws.shadows.reserve(rays.count * sc.shadow_rays_per_hit);
             if (c.shade_mode == ShadeMode::Scalar)
                 shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, c.accum, c.counts);
             else
@@ -649,10 +684,10 @@ struct PipelineStages {
         }
         const std::vector<std::size_t> bounds =
             stage_detail::cut_into_slices(gen, ws.regroup, c.slice_rays, std::size_t(c.tile.width() * c.tile.height()),
-                                          ws.pixel_rays, ws.pixel_slice);
+                                          ws.pixel_rays, ws.pixel_slice, c.sc.features.area_lights);
         for (std::size_t k = 0; k + 1 < bounds.size(); ++k) {
             RayStream slice = ws.take(), spawned = ws.take();
-            stage_detail::copy_rays(gen, bounds[k], bounds[k + 1] - bounds[k], slice);
+            stage_detail::copy_rays(gen, bounds[k], bounds[k + 1] - bounds[k], slice, c.sc.features.area_lights);
             trace_slice(c, depth, slice, spawned);
             ws.give(std::move(slice));
             descend(c, depth, std::move(spawned));

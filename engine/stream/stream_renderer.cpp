@@ -37,7 +37,11 @@ std::vector<std::string> StreamRenderer::built_stages() const {
     b.push_back(std::string(f.lighting ? "shade(lit" : "shade(flat") + (f.textures ? ",textured" : "") + how);
     if (f.reflect) b.push_back("spawn(reflect)");
     if (f.refract) b.push_back("spawn(refract)");
-    if (f.shadows) b.push_back("occlusion(any-hit)");
+    if (f.shadows)
+        b.push_back(f.area_lights ? "occlusion(any-hit,area x " + std::to_string(f.area_samples) + ")"
+                                  : std::string("occlusion(any-hit)"));
+    else if (f.area_lights)
+        b.push_back("area lights x " + std::to_string(f.area_samples) + " (no shadows)");
     b.push_back("accumulate");
     return b;
 }

@@ -90,6 +90,11 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
     features.refract = s.degree >= 4 && s.depth >= 1 && any_trans;
     features.jitter = s.spp > 1;
     features.lens = camera.has_lens();
+    for (const LightT<float>& l : lights) {
+        shadow_rays_per_hit += std::size_t(l.samples);
+        if (l.kind == LightKind::Sphere || l.kind == LightKind::Rect) features.area_samples += l.samples;
+    }
+    features.area_lights = features.lighting && features.area_samples > 0;
 }
 
 void StreamScene::fill_surfaces(const Scene& scene) {

@@ -25,6 +25,10 @@ struct StreamFeatures {
     bool jitter = false;    ///< spp > 1
     bool lens = false;      ///< camera aperture > 0: the thin-lens generate kernel
     bool textures = false;  ///< some material has a texture (only those materials read it)
+    /// Area lights (with shadows): rays carry light-sampling keys, and each hit sends
+    /// area_samples shadow rays for them through the occlusion stage.
+    bool area_lights = false;
+    int area_samples = 0;
 };
 
 struct StreamScene {
@@ -38,6 +42,8 @@ struct StreamScene {
     FillLaterVec<SurfaceRecord> surfaces;     ///< by id: colour and material index
     std::vector<MaterialT<float>> materials;  ///< by scene material index
     std::vector<LightT<float>> lights;
+    /// The most shadow rays one hit sends: one per light, `samples` per area light.
+    std::size_t shadow_rays_per_hit = 0;
     /// Without a hierarchy: per shape kind (indexed by ShapeKind), the objects of that kind;
     /// empty kinds get no kernel call at all.
     std::vector<ObjectXf> groups[kShapeKindCount];

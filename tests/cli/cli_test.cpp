@@ -735,3 +735,23 @@ TEST_CASE("cli: --frames composes with --shard: the merged parts of a frame are 
                                    " -o " + q(d.path / "mixed.pfm"));
     CHECK(mixed.code == 2);
 }
+
+TEST_CASE("cli: --light-samples overrides every area light's samples") {
+    Dir d;
+    const fs::path scene = d.write("area.cfg", "image width=16 height=12 spp=1 depth=0 degree=5\n"
+                                               "camera eye=0,1,6 look=0,0,0\n"
+                                               "light sphere pos=3,5,4 radius=1 samples=9\n"
+                                               "light rect pos=-3,5,0 u=1,0,0 v=0,0,1 samples=4\n"
+                                               "light point pos=0,5,5\n"
+                                               "sphere color=1,0,0\nplane translate=0,-1,0\n");
+    const Run as_is = run_streamrt(q(scene) + " --profile -o " + q(d.path / "a.png"));
+    CHECK(as_is.code == 0);
+    CHECK(as_is.out.find("occlusion(any-hit,area x 13)") != std::string::npos);
+    const Run three = run_streamrt(q(scene) + " --light-samples 3 --profile -o " + q(d.path / "b.png"));
+    CHECK(three.code == 0);
+    CHECK(three.out.find("occlusion(any-hit,area x 6)") != std::string::npos);
+    const Run zero = run_streamrt(q(scene) + " --light-samples 0 -o " + q(d.path / "c.png"));
+    CHECK(zero.code == 2);
+    INFO("stderr: ", zero.err);
+    CHECK(zero.err.find("--light-samples") != std::string::npos);
+}

@@ -203,3 +203,22 @@ TEST_CASE("pipeline: lane figures of the intersect stage, counted by hand") {
         }
     }
 }
+
+TEST_CASE("pipeline: area lights' samples go through the occlusion stage, and only when present") {
+    const std::string objs = std::string(kMatte) + "plane translate=0,-1,0\n";
+    const std::string base = "image width=32 height=24 spp=2 depth=0 degree=5\n" + std::string(kCamera) + objs;
+    // The handout's lights (and falloff / soft edges, which need no samples): no keys, the
+    // plain occlusion stage.
+    CHECK(has(stages_of(base + kLight), "occlusion(any-hit)"));
+    CHECK(has(stages_of(base + "light point pos=3,5,4 falloff=inverse_square\n"), "occlusion(any-hit)"));
+    // A sphere light of 9 samples and a rect light of 4: 13 shadow rays per hit for them.
+    const auto area = stages_of(base + "light sphere pos=3,5,4 radius=1 samples=9\n"
+                                       "light rect pos=-3,5,0 u=1,0,0 v=0,0,1 samples=4\n" + kLight);
+    CAPTURE(joined(area));
+    CHECK(has(area, "occlusion(any-hit,area x 13)"));
+    // Without shadows the samples still light the hit, with no occlusion stage.
+    const std::string dim = "image width=32 height=24 spp=2 depth=0 degree=2\n" + std::string(kCamera) + objs;
+    const auto unshadowed = stages_of(dim + "light sphere pos=3,5,4 radius=1 samples=9\n");
+    CHECK_FALSE(has_prefix(unshadowed, "occlusion"));
+    CHECK(has(unshadowed, "area lights x 9 (no shadows)"));
+}

@@ -262,8 +262,14 @@ TEST_CASE("stream engine: the scalar shade path gives the picture of the SIMD pa
         CAPTURE(d.share_over);
         // The arithmetic is the same at every level (unfused multiply-adds, one pow rounding):
         // what is left is the order of a pixel's sums. Measured (160x120, 2 spp): at most
-        // 1.19e-7, one float ulp at 1, on 28 of 48 scene x level pairs.
-        CHECK(d.max_abs <= 1.2e-7);
+        // 1.19e-7, one float ulp at 1, on 28 of 48 scene x level pairs. Area lights add
+        // spp x samples shadow terms per pixel, each rounded into the pixel's sum (below 1) in
+        // an order that depends on the path: at most half an ulp, 2^-24, per term between
+        // the two orders (scenes/soft_shadows.cfg: 64 terms, bound 3.8e-6, measured 4.2e-7).
+        double area_terms = 0;
+        for (const Light& l : ls.scene.lights)
+            if (l.is_area()) area_terms += double(l.samples) * ls.scene.settings.spp;
+        CHECK(d.max_abs <= std::max(1.2e-7, area_terms * 0x1p-24));
         CHECK(d.psnr >= kMinPsnr);
         CHECK(d.share_over <= kMaxShareOver);
     });
