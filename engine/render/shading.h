@@ -380,42 +380,6 @@ struct ShapedSample {
     V scale;
 };
 
-/// cos and sin of the angle 2 pi u, u in [0, 1), without library calls: a quarter turn by
-/// quadrant and Taylor polynomials to degree 12 / 13 on [0, pi/2] (error below 4e-8), in
-/// plain multiplies and adds, so every instruction-set level gives the same bits (xsimd's
-/// sin / cos fuse multiply-adds on some levels only).
-template <class V>
-inline void cos_sin_of_turn(const V& u, V& c, V& s) {
-    using namespace simd;
-    using std::floor;
-    using S = simd::scalar_t<V>;
-    const V x = u * V(S(4));
-    const V q = floor(x);
-    const V t = (x - q) * V(S(1.5707963267948966));
-    const V t2 = t * t;
-    // Horner forms of the Taylor series of cos t and sin t.
-    V pc = V(S(1.0 / 479001600.0));
-    pc = pc * t2 - V(S(1.0 / 3628800.0));
-    pc = pc * t2 + V(S(1.0 / 40320.0));
-    pc = pc * t2 - V(S(1.0 / 720.0));
-    pc = pc * t2 + V(S(1.0 / 24.0));
-    pc = pc * t2 - V(S(0.5));
-    pc = pc * t2 + V(1);
-    V ps = V(S(1.0 / 6227020800.0));
-    ps = ps * t2 - V(S(1.0 / 39916800.0));
-    ps = ps * t2 + V(S(1.0 / 362880.0));
-    ps = ps * t2 - V(S(1.0 / 5040.0));
-    ps = ps * t2 + V(S(1.0 / 120.0));
-    ps = ps * t2 - V(S(1.0 / 6.0));
-    ps = ps * t2 + V(1);
-    ps = ps * t;
-    // Quadrant q: the angle is q quarter turns plus t.
-    const auto odd = (q == V(1)) || (q == V(3));
-    const V c0 = select(odd, -ps, pc), s0 = select(odd, pc, ps);
-    const auto back = q >= V(2);
-    c = select(back, -c0, c0);
-    s = select(back, -s0, s0);
-}
 
 /// Sample (u1, u2) in [0, 1)^2 of light l seen from p. Sphere: a direction uniform in the
 /// solid angle of the cap of the sphere visible from p (cone sampling: cos theta uniform in
