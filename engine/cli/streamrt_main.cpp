@@ -101,14 +101,19 @@ void check_writable_path(const std::string& out, const std::string& scene_path) 
     const fs::path dir = target.parent_path();
     if (!fs::is_directory(dir, ec)) throw UsageError("output folder '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0) throw UsageError("output folder '" + dir.string() + "' is not writable");
-    // access() says yes to root everywhere; creating the file is what matters (read-only
-    // file systems, /proc, ...). Probe with a temporary name, removed at once.
-    const fs::path probe = dir / ("." + target.filename().string() + ".probe" + std::to_string(::getpid()));
-    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+    // access() says yes to root everywhere; creating a file is what matters (read-only file
+    // systems, /proc, ...). The probe is an unnamed file (O_TMPFILE): a process killed at any
+    // moment leaves nothing in the folder. File systems without O_TMPFILE get a named probe,
+    // removed at once.
+    int fd = ::open(dir.c_str(), O_TMPFILE | O_WRONLY, 0600);
+    if (fd < 0 && (errno == EOPNOTSUPP || errno == EISDIR || errno == EINVAL)) {
+        const fs::path probe = dir / ("." + target.filename().string() + ".probe" + std::to_string(::getpid()));
+        fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+        if (fd >= 0) ::unlink(probe.c_str());
+    }
     if (fd < 0)
         throw UsageError("output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
     ::close(fd);
-    ::unlink(probe.c_str());
 }
 
 void check_output_path(const std::string& out, const std::string& scene_path) {

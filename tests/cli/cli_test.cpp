@@ -7,6 +7,7 @@
 #include "scene/parser.h"
 #include <signal.h>
 #include <stb_image.h>
+#include <sys/inotify.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <fcntl.h>
@@ -637,6 +638,29 @@ TEST_CASE("cli: a killed render leaves no image and no temporary file") {
     const int status = wait_child(pid);
     CHECK(WIFSIGNALED(status));
     CHECK(d.files() == std::vector<std::string>{"long.cfg"});
+}
+
+TEST_CASE("cli: checking the output folder names no file there (a kill at any moment leaves nothing)") {
+    // The writability probe used to be a named file created and removed at once: a SIGKILL
+    // between the two left it behind (seen as a rare failure of the killed-render test
+    // above). Every file created in the folder during --check is recorded by inotify.
+    Dir d;
+    const fs::path scene = d.write("s.cfg", "image width=4 height=4\nsphere\n");
+    const int in = ::inotify_init1(IN_NONBLOCK);
+    REQUIRE(in >= 0);
+    REQUIRE(::inotify_add_watch(in, d.path.c_str(), IN_CREATE | IN_MOVED_TO) >= 0);
+    const Run r = run_streamrt("--check " + q(scene) + " -o " + q(d.path / "out.png"));
+    CHECK(r.code == 0);
+    std::vector<std::string> created;
+    alignas(inotify_event) char buf[4096];
+    for (ssize_t n; (n = ::read(in, buf, sizeof buf)) > 0;)
+        for (const char* p = buf; p < buf + n;) {
+            const auto* e = reinterpret_cast<const inotify_event*>(p);
+            if (e->len) created.emplace_back(e->name);
+            p += sizeof(inotify_event) + e->len;
+        }
+    ::close(in);
+    CHECK(created == std::vector<std::string>{});
 }
 
 // ---- animation: --frames, image frames=, output patterns, shards of a frame ----------------
