@@ -5,11 +5,11 @@
 
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <vector>
 
 #include "render/texture.h"
+#include "simd/lanes_test_util.h"
 
 using namespace streamrt;
 
@@ -18,17 +18,10 @@ namespace {
 using B = xsimd::batch<float>;
 constexpr std::size_t W = B::size;
 
-std::uint32_t bits(float f) {
-    std::uint32_t b;
-    std::memcpy(&b, &f, 4);
-    return b;
-}
-
 }  // namespace
 
-// Proven against: the batch level loop stopping at the highest l0 (lanes mixing in the next
-// level read black); the wrap of x0 = -1 left out of the batch path (u near 0 read the texel
-// before the row).
+// Proven against: the batch level loop stopping before the highest level a lane needs (lanes
+// mixing in the next level read black); i and j swapped in the gathered offsets.
 TEST_CASE("texture lanes: a batch lookup is the scalar float lookup in every lane") {
     // 7 x 5 (odd sides: levels 7x5, 3x2, 1x1), texel values from a fixed pattern.
     std::vector<float> rgb(7 * 5 * 3);
@@ -36,11 +29,8 @@ TEST_CASE("texture lanes: a batch lookup is the scalar float lookup in every lan
     const auto t = Texture::build("odd", 7, 5, rgb);
     const TextureView view = t->view();
     REQUIRE(view.count == 3);
-    std::uint64_t state = 12345;
-    const auto next = [&] {  // in [0, 1)
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return float(state >> 40) / 16777216.f;
-    };
+    test::Lcg gen;
+    const auto next = [&] { return float(gen.next()); };
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
     for (int k = 0; k < 4000; ++k) {
         alignas(64) float u[W], v[W], texels[W], r[W], g[W], b[W];
@@ -57,14 +47,14 @@ TEST_CASE("texture lanes: a batch lookup is the scalar float lookup in every lan
         c.z.store_aligned(b);
         for (std::size_t l = 0; l < W; ++l) {
             const ColorT<float> s = texture_sample(view, u[l], v[l], texels[l]);
-            CHECK(bits(r[l]) == bits(s.x));
-            CHECK(bits(g[l]) == bits(s.y));
-            CHECK(bits(b[l]) == bits(s.z));
+            CHECK(test::float_bits(r[l]) == test::float_bits(s.x));
+            CHECK(test::float_bits(g[l]) == test::float_bits(s.y));
+            CHECK(test::float_bits(b[l]) == test::float_bits(s.z));
         }
     }
 }
 
-// Proven against: the batch path reading x1 from the row below (3/4 red + 1/4 blue).
+// Proven against: i and j swapped in the gathered offsets (3/4 red + 1/4 blue).
 TEST_CASE("texture lanes: the hand-worked bilinear value in every lane") {
     // The 2 x 2 texture: top row red, green; bottom row blue, white. At (0.375, 0.75):
     // x = 0.375 x 2 - 0.5 = 0.25 on the top row: 3/4 red + 1/4 green.

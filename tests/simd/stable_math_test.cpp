@@ -7,8 +7,8 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 
+#include "simd/lanes_test_util.h"
 #include "simd/stable_math.h"
 
 using namespace streamrt;
@@ -26,25 +26,11 @@ double log2_truncation() {
     return 2.0 * std::pow(s, 11) / (11.0 * (1.0 - s * s)) / std::log(2.0);
 }
 
-/// A small deterministic generator (no timing, no global state).
-struct Lcg {
-    std::uint64_t x = 0x9e3779b97f4a7c15ull;
-    double next() {  // in [0, 1)
-        x = x * 6364136223846793005ull + 1442695040888963407ull;
-        return double(x >> 11) * (1.0 / 9007199254740992.0);
-    }
-};
-
-std::uint32_t bits(float f) {
-    std::uint32_t b;
-    std::memcpy(&b, &f, 4);
-    return b;
-}
+using test::Lcg;
 
 }  // namespace
 
-// Proven against: the last series term (-t^11 / 11) dropped (errors up to 4.6e-8 > 2.9e-9);
-// the pi/6 step's threshold moved to 0.3 (|t| up to 0.3: 7.7e-9 from the t^13 term).
+// Proven against: the last series term (-t^11 / 11) dropped (errors up to 4.6e-8 > 2.9e-9).
 TEST_CASE("stable_atan2: within (2 - sqrt 3)^13 / 13 of std::atan2 in double, every octant") {
     const double truncation = atan_truncation();
     CHECK(truncation < 2.9e-9);
@@ -85,8 +71,7 @@ TEST_CASE("stable_atan2 in float: within the truncation bound plus float roundin
     CHECK(worst <= bound);
 }
 
-// Proven against: the s^9 / 9 term dropped (errors up to 4.3e-8 > 1.1e-9); the mantissa left
-// in [1, 2) (s up to 1/3: 6e-7).
+// Proven against: the s^9 / 9 term dropped (errors up to about 4e-8 > 1.1e-9).
 TEST_CASE("stable_log2: within 2 s^11 / (11 (1 - s^2) ln 2) of std::log2 in double") {
     const double truncation = log2_truncation();
     CHECK(truncation < 1.1e-9);
@@ -125,8 +110,8 @@ TEST_CASE("stable_atan2 and stable_log2: a batch gives each lane the scalar floa
         simd::stable_atan2(B::load_aligned(y), B::load_aligned(x)).store_aligned(a);
         simd::stable_log2(B::load_aligned(p)).store_aligned(l);
         for (std::size_t i = 0; i < W; ++i) {
-            CHECK(bits(a[i]) == bits(simd::stable_atan2(y[i], x[i])));
-            CHECK(bits(l[i]) == bits(simd::stable_log2(p[i])));
+            CHECK(test::float_bits(a[i]) == test::float_bits(simd::stable_atan2(y[i], x[i])));
+            CHECK(test::float_bits(l[i]) == test::float_bits(simd::stable_log2(p[i])));
         }
     }
 }
