@@ -128,12 +128,6 @@ inline ColorT<T> texture_sample(const TextureView& t, T u, T v, T texels) {
     }
 }
 
-/// The lookup for every lane of V (kept for callers that name it): texture_sample.
-template <class V>
-inline ColorT<V> texture_sample_lanes(const TextureView& t, const V& u, const V& v, const V& texels) {
-    return texture_sample(t, u, v, texels);
-}
-
 /// Canonical units per world unit of an object's placement, from Mi's rows (row-major 3x4):
 /// the cube root of |det| of its linear part (exact for a uniform scale, the geometric mean
 /// of the three scales otherwise).
@@ -157,7 +151,7 @@ inline ColorT<V> texture_color_at(const MaterialT<T>& m, const UvT<V>& uv, const
     const TextureLevelView& top = m.texture.levels[0];
     const T side = T(top.width > top.height ? top.width : top.height);
     const V k(m.uv_scale);
-    return texture_sample_lanes(m.texture, uv.u * k, uv.v * k, footprint * scale * density * k * V(side));
+    return texture_sample(m.texture, uv.u * k, uv.v * k, footprint * scale * density * k * V(side));
 }
 
 /// The surface colour of a textured material on a canonical shape: uv from the canonical
