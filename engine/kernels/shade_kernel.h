@@ -74,45 +74,41 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
     return {B::load_aligned(nx), B::load_aligned(ny), B::load_aligned(nz)};
 }
 
-/// The texture colour of each lane's hit (render/texture.h), lane by lane in scalar float:
-/// the same calls and values as the scalar shade path, so the picture is the same bits at
-/// every ISA level (xsimd's atan2, asin and cbrt round differently at different levels).
-/// The texel reads are per lane anyway. `scale`: the run's canonical_per_world, or (gathered,
-/// scale < 0) each lane's, from its rows.
+/// The texture colour of each lane's hit (render/texture.h): the UV mapping, the mip level,
+/// the weights and the texel offsets in SIMD, the texels gathered; the same operations as the
+/// scalar shade path lane by lane, so the picture is the same bits at every ISA level (the
+/// angles come from simd/stable_math.h, not xsimd's atan2, which rounds differently per
+/// level). Meshes read their triangles' vt lane by lane. `scale`: the run's
+/// canonical_per_world, or (gathered, scale < 0) each lane's, from its rows (a cube root per
+/// lane, in scalar float).
 template <class B, class Rows>
 inline ColorT<B> texture_colors(const ShadeJob& job, std::size_t i, const MaterialT<float>& m, ShapeKind kind,
                                 bool mesh, const Vec3T<B>& pc, const B& param, const Rows& rows, float scale,
                                 const B& footprint) {
     constexpr std::size_t W = B::size;
-    alignas(64) float px[W], py[W], pz[W], fp[W], pa[W], r[W], g[W], b[W], sc[W];
-    pc.x.store_aligned(px);
-    pc.y.store_aligned(py);
-    pc.z.store_aligned(pz);
-    footprint.store_aligned(fp);
-    param.store_aligned(pa);
+    B sc(scale);
     if (scale < 0.f) {
-        alignas(64) float rw[12][W];
+        alignas(64) float rw[12][W], lanes[W];
         for (int k = 0; k < 12; ++k) B(rows[k]).store_aligned(rw[k]);
         for (std::size_t l = 0; l < W; ++l) {
             float mi[12];
             for (int k = 0; k < 12; ++k) mi[k] = rw[k][l];
-            sc[l] = canonical_per_world<float>(mi);
+            lanes[l] = canonical_per_world<float>(mi);
         }
-    } else {
-        for (std::size_t l = 0; l < W; ++l) sc[l] = scale;
+        sc = B::load_aligned(lanes);
     }
+    if (!mesh) return texture_color(m, kind, pc, param, sc, footprint);
+    const MeshView& mv = *job.object->xf.mesh;
+    alignas(64) float us[W], vs[W];
     for (std::size_t l = 0; l < W; ++l) {
-        ColorT<float> c{0.f, 0.f, 0.f};
-        if (!mesh)
-            c = texture_color(m, kind, Vec3T<float>{px[l], py[l], pz[l]}, pa[l], sc[l], fp[l]);
-        else if (i + l < job.end)  // lanes past the run have no triangle
-            c = mesh_texture_color(m, *job.object->xf.mesh, std::uint32_t(job.prim[i + l]), job.bu[i + l],
-                                   job.bv[i + l], sc[l], fp[l]);
-        r[l] = c.x;
-        g[l] = c.y;
-        b[l] = c.z;
+        // Lanes past the run have no triangle; meshes without vt read (0, 0), as the scalar path.
+        const UvT<float> uv = i + l < job.end && mv.uv
+                                  ? mesh_uv(mv, std::uint32_t(job.prim[i + l]), job.bu[i + l], job.bv[i + l])
+                                  : UvT<float>{0.f, 0.f};
+        us[l] = uv.u;
+        vs[l] = uv.v;
     }
-    return {B::load_aligned(r), B::load_aligned(g), B::load_aligned(b)};
+    return texture_color_at(m, UvT<B>{B::load_aligned(us), B::load_aligned(vs)}, B(mv.uv_density), sc, footprint);
 }
 
 /// Appends the active lanes' rays to the next generation's stream, compacted.

@@ -3,7 +3,9 @@
 // float on the stream engine's scalar path, xsimd float batches in its SIMD shade kernel):
 // the surface colour of a textured material at a hit (docs/scene-format.md, "Textures and
 // UV mapping"). Bilinear filtering inside a mip level, linear between the two levels around
-// the one the ray's footprint selects (trilinear). Texels are gathered lane by lane.
+// the one the ray's footprint selects (trilinear). Batches compute the coordinates, the mip
+// level and the weights in SIMD and gather the texels; the same operations as the scalar
+// path, so the same bits at every ISA level.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -13,8 +15,10 @@
 #include "render/shading.h"
 #include "scene/texture.h"
 #include "shapes/shapes.h"
+#include "simd/gather.h"
 #include "simd/isa_namespace.h"
 #include "simd/lanes.h"
+#include "simd/stable_math.h"
 
 namespace streamrt {
 STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
@@ -22,76 +26,105 @@ STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h
 namespace texture_detail {
 /// Wraps a texel coordinate x in [-1, n] into [0, n) (repeat).
 inline std::int32_t wrap(std::int32_t x, std::int32_t n) { return x < 0 ? x + n : (x >= n ? x - n : x); }
+/// The same for a batch of whole numbers in [-1, n] held as floats (exact: n < 2^24).
+template <class T>
+inline T wrap_lanes(const T& x, std::int32_t n) {
+    const T w = T(float(n));
+    return xsimd::select(x < T(0), x + w, xsimd::select(x >= w, x - w, x));
+}
+
+template <class T>
+inline ColorT<T> texel(const TextureLevelView& l, std::int32_t i, std::int32_t j) {
+    const float* p = l.rgb + (std::size_t(j) * std::size_t(l.width) + std::size_t(i)) * 3;
+    return {T(p[0]), T(p[1]), T(p[2])};
+}
+/// The texels (i, j) of every lane (whole numbers held as floats), gathered: the texel's
+/// number j width + i is below 2^24 (scene/texture.h kMaxTextureTexels), so exact in float.
+template <class T>
+inline ColorT<T> texel_lanes(const TextureLevelView& l, const T& i, const T& j) {
+    using I = xsimd::batch<std::int32_t, typename T::arch_type>;
+    const I n = xsimd::to_int(j * T(float(l.width)) + i);
+    const I at = n + n + n;
+    return {simd::gather(l.rgb, at), simd::gather(l.rgb + 1, at), simd::gather(l.rgb + 2, at)};
+}
+
+template <class T, class M>
+inline ColorT<T> select_color(const M& m, const ColorT<T>& a, const ColorT<T>& b) {
+    return {simd::select(m, a.x, b.x), simd::select(m, a.y, b.y), simd::select(m, a.z, b.z)};
+}
 }  // namespace texture_detail
 
 /// Bilinear value of one level at (u, v), repeated outside [0, 1)^2. Texel (i, j) (column i,
 /// row j from the top) has its centre at u = (i + 0.5) / width, v = 1 - (j + 0.5) / height:
-/// v grows upwards in the image, as in OBJ files.
+/// v grows upwards in the image, as in OBJ files. Written once for scalars and batches (the
+/// same operations lane by lane: the same bits).
 template <class T>
 inline ColorT<T> texture_bilinear(const TextureLevelView& l, T u, T v) {
     using std::floor;
-    if (!(u - u == T(0)) || !(v - v == T(0))) u = v = T(0);  // NaN or inf: any texel, no UB
+    using namespace texture_detail;
+    const auto finite = (u - u == T(0)) && (v - v == T(0));  // NaN or inf: any texel, no UB
+    u = simd::select(finite, u, T(0));
+    v = simd::select(finite, v, T(0));
     const T x = (u - floor(u)) * T(l.width) - T(0.5);
     const T y = (T(1) - (v - floor(v))) * T(l.height) - T(0.5);
     const T fx = floor(x), fy = floor(y);
     const T ax = x - fx, ay = y - fy;
-    const std::int32_t x0 = texture_detail::wrap(std::int32_t(fx), l.width);
-    const std::int32_t y0 = texture_detail::wrap(std::int32_t(fy), l.height);
-    const std::int32_t x1 = texture_detail::wrap(x0 + 1, l.width), y1 = texture_detail::wrap(y0 + 1, l.height);
-    const auto at = [&](std::int32_t i, std::int32_t j) {
-        const float* p = l.rgb + (std::size_t(j) * std::size_t(l.width) + std::size_t(i)) * 3;
-        return ColorT<T>{T(p[0]), T(p[1]), T(p[2])};
-    };
-    const ColorT<T> top = at(x0, y0) * (T(1) - ax) + at(x1, y0) * ax;
-    const ColorT<T> bottom = at(x0, y1) * (T(1) - ax) + at(x1, y1) * ax;
+    ColorT<T> c00, c10, c01, c11;
+    if constexpr (!simd::is_batch<T>) {
+        const std::int32_t x0 = wrap(std::int32_t(fx), l.width), y0 = wrap(std::int32_t(fy), l.height);
+        const std::int32_t x1 = wrap(x0 + 1, l.width), y1 = wrap(y0 + 1, l.height);
+        c00 = texel<T>(l, x0, y0), c10 = texel<T>(l, x1, y0), c01 = texel<T>(l, x0, y1), c11 = texel<T>(l, x1, y1);
+    } else {
+        const T x0 = wrap_lanes(fx, l.width), y0 = wrap_lanes(fy, l.height);
+        const T x1 = wrap_lanes(x0 + T(1), l.width), y1 = wrap_lanes(y0 + T(1), l.height);
+        c00 = texel_lanes<T>(l, x0, y0), c10 = texel_lanes<T>(l, x1, y0);
+        c01 = texel_lanes<T>(l, x0, y1), c11 = texel_lanes<T>(l, x1, y1);
+    }
+    const ColorT<T> top = c00 * (T(1) - ax) + c10 * ax;
+    const ColorT<T> bottom = c01 * (T(1) - ax) + c11 * ax;
     return top * (T(1) - ay) + bottom * ay;
 }
 
-/// The mip level for a footprint `texels` texels of the finest level wide: log2(texels),
-/// 0 (the finest) for footprints up to one texel, at most the coarsest level.
+/// The mip level for a footprint `texels` texels of the finest level wide: log2(texels)
+/// (simd/stable_math.h, within 1.1e-9), 0 (the finest) for footprints up to one texel or
+/// NaN, at most the coarsest level.
 template <class T>
 inline T texture_lod(const TextureView& t, T texels) {
-    using std::log2;
-    const T lod = texels > T(1) ? log2(texels) : T(0);
+    using namespace simd;
     const T last = T(t.count - 1);
-    return lod < last ? lod : last;  // NaN footprints give the coarsest level
+    const T x = select(texels > T(1), min(texels, T(1e30)), T(1));  // finite and normal
+    return min(stable_log2(x), last);
 }
 
-/// Trilinear lookup of one point: bilinear in the two levels around texture_lod(texels),
-/// mixed linearly.
+/// Trilinear lookup: bilinear in the two levels around texture_lod(texels), mixed linearly.
+/// A batch's lanes may need different levels: each level some lane needs is read for the
+/// whole batch (one or two, rarely three, for the lanes of one packet) and kept where needed.
 template <class T>
 inline ColorT<T> texture_sample(const TextureView& t, T u, T v, T texels) {
     using std::floor;
+    using namespace texture_detail;
     const T lod = texture_lod(t, texels);
     const T l0 = floor(lod);
     const T f = lod - l0;
-    const std::int32_t i = std::int32_t(l0);
-    const ColorT<T> c0 = texture_bilinear(t.levels[i], u, v);
-    if (!(f > T(0)) || i + 1 >= t.count) return c0;
-    return c0 * (T(1) - f) + texture_bilinear(t.levels[i + 1], u, v) * f;
-}
-
-/// The lookup for every lane of V: one point for a scalar, lane by lane for a batch (the
-/// texels of different lanes are anywhere in the image). The SIMD shade kernel calls the
-/// scalar functions lane by lane instead (kernels/shade_kernel.h texture_colors), for the same
-/// bits at every ISA level; batches serve tests and callers that need no such guarantee.
-template <class V>
-inline ColorT<V> texture_sample_lanes(const TextureView& t, const V& u, const V& v, const V& texels) {
-    if constexpr (!simd::is_batch<V>) {
-        return texture_sample(t, u, v, texels);
+    if constexpr (!simd::is_batch<T>) {
+        const std::int32_t i = std::int32_t(l0);
+        const ColorT<T> c0 = texture_bilinear(t.levels[i], u, v);
+        if (!(f > T(0)) || i + 1 >= t.count) return c0;
+        return c0 * (T(1) - f) + texture_bilinear(t.levels[i + 1], u, v) * f;
     } else {
-        constexpr std::size_t W = V::size;
-        alignas(64) float us[W], vs[W], ts[W], r[W], g[W], b[W];
-        u.store_aligned(us);
-        v.store_aligned(vs);
-        texels.store_aligned(ts);
-        for (std::size_t l = 0; l < W; ++l) {
-            const ColorT<float> c = texture_sample(t, us[l], vs[l], ts[l]);
-            r[l] = c.x;
-            g[l] = c.y;
-            b[l] = c.z;
+        const auto mix = f > T(0) && l0 + T(1) < T(t.count);
+        alignas(64) float first[T::size], last[T::size];
+        l0.store_aligned(first);
+        (l0 + simd::select(mix, T(1), T(0))).store_aligned(last);
+        float lo = first[0], hi = last[0];
+        for (std::size_t k = 1; k < T::size; ++k) lo = first[k] < lo ? first[k] : lo, hi = last[k] > hi ? last[k] : hi;
+        ColorT<T> c0{T(0), T(0), T(0)}, c1{T(0), T(0), T(0)};
+        for (std::int32_t i = std::int32_t(lo); i <= std::int32_t(hi); ++i) {
+            const ColorT<T> c = texture_bilinear(t.levels[i], u, v);
+            c0 = select_color(l0 == T(float(i)), c, c0);
+            c1 = select_color(l0 + T(1) == T(float(i)), c, c1);
         }
-        return {V::load_aligned(r), V::load_aligned(g), V::load_aligned(b)};
+        return select_color(mix, c0 * (T(1) - f) + c1 * f, c0);
     }
 }
 
@@ -118,7 +151,7 @@ inline ColorT<V> texture_color_at(const MaterialT<T>& m, const UvT<V>& uv, const
     const TextureLevelView& top = m.texture.levels[0];
     const T side = T(top.width > top.height ? top.width : top.height);
     const V k(m.uv_scale);
-    return texture_sample_lanes(m.texture, uv.u * k, uv.v * k, footprint * scale * density * k * V(side));
+    return texture_sample(m.texture, uv.u * k, uv.v * k, footprint * scale * density * k * V(side));
 }
 
 /// The surface colour of a textured material on a canonical shape: uv from the canonical

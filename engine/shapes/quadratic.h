@@ -6,6 +6,7 @@
 #include "core/vec3.h"
 #include "shapes/shape_traits.h"
 #include "simd/lanes.h"
+#include "simd/stable_math.h"
 #include "simd/isa_namespace.h"
 
 namespace streamrt {
@@ -54,10 +55,10 @@ inline V keep_cap(V best, const Vec3T<V>& o, const Vec3T<V>& d, V level, V t_min
 
 /// The texture coordinate of an angle around the y axis: 0.5 + atan2(x, z) / (2 pi), so
 /// u = 0.5 on +z, 0.75 on +x, 0 and 1 on -z (the seam, where the lookup wraps).
+/// atan2 is simd/stable_math.h's (the same bits at every ISA level, within 2.9e-9 rad).
 template <class V>
 inline V uv_angle(const V& x, const V& z) {
-    using std::atan2;
-    return V(0.5) + atan2(x, z) * V(0.15915494309189535);
+    return V(0.5) + simd::stable_atan2(x, z) * V(0.15915494309189535);
 }
 
 /// Planar coordinates of the square [-1, 1]^2 in [0, 1]^2: ((a + 1) / 2, (b + 1) / 2).

@@ -37,13 +37,13 @@ struct SphereMath {
     template <class V>
     static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) { return p; }
     /// Longitude and latitude: u = 0.5 + atan2(x, z) / (2 pi), v = 0.5 + asin(y / |p|) / pi
-    /// (v = 0 at the south pole y = -1, 1 at the north pole).
+    /// (v = 0 at the south pole y = -1, 1 at the north pole), the latitude computed as
+    /// atan2(y, sqrt(x^2 + z^2)) (simd/stable_math.h, the same bits at every ISA level).
     template <class V>
     static UvT<V> uv(const Vec3T<V>& p, V /*param*/) {
-        using std::asin;
         using namespace simd;
-        const V s = p.y / sqrt(dot(p, p));
-        return {uv_angle(p.x, p.z), V(0.5) + asin(max(V(-1), min(V(1), s))) * V(0.3183098861837907)};
+        const V latitude = stable_atan2(p.y, sqrt(p.x * p.x + p.z * p.z));
+        return {uv_angle(p.x, p.z), V(0.5) + latitude * V(0.3183098861837907)};
     }
     /// dv/ds = 1 / pi along a meridian (du/ds = 1 / (2 pi) at the equator).
     template <class V>
