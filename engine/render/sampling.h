@@ -8,6 +8,7 @@
 
 #include "scene/scene.h"
 #include "simd/lanes.h"
+#include "simd/stable_math.h"
 #include "simd/isa_namespace.h"
 
 namespace streamrt {
@@ -130,41 +131,6 @@ inline void lens_hashes(const U& pixel, const U& k, U& h1, U& h2) {
     h2 = hash32(h1 ^ U(0x1b873593u));
 }
 
-namespace detail {
-/// sin and cos on [-pi/4, pi/4] by their Taylor polynomials (errors below 2e-9 and 1.2e-10),
-/// with plain multiplies and adds: the same bits in scalar float and at every SIMD level,
-/// where xsimd's sin/cos would round differently from one level to the next. V is float,
-/// double (the recursive engine) or a float batch.
-template <class V>
-inline void sin_cos_quarter(const V& a, V& s, V& c) {
-    using S = simd::scalar_t<V>;
-    const V a2 = a * a;
-    s = a * (V(S(1)) + a2 * (V(S(-1.0 / 6)) + a2 * (V(S(1.0 / 120)) + a2 * (V(S(-1.0 / 5040)) +
-                                                                             a2 * V(S(1.0 / 362880))))));
-    c = V(S(1)) + a2 * (V(S(-0.5)) + a2 * (V(S(1.0 / 24)) + a2 * (V(S(-1.0 / 720)) + a2 * (V(S(1.0 / 40320)) +
-                                                                                       a2 * V(S(-1.0 / 3628800))))));
-}
-}  // namespace detail
-
-/// cos and sin of the angle 2 pi u, u in [0, 1), without library calls (area-light
-/// sampling): the nearest quarter turn q is taken off exactly, the rest (within an eighth of
-/// a turn) goes through detail::sin_cos_quarter, and the quarter turns rotate (cos, sin) by
-/// swaps and sign changes, which are exact.
-template <class V>
-inline void cos_sin_of_turn(const V& u, V& c, V& s) {
-    using namespace simd;
-    using std::floor;
-    using S = simd::scalar_t<V>;
-    const V x = u * V(S(4));
-    const V q = floor(x + V(S(0.5)));  // 0 .. 4; x - q is exact, in [-0.5, 0.5]
-    V st, ct;
-    detail::sin_cos_quarter((x - q) * V(S(1.5707963267948966)), st, ct);
-    const auto odd = (q == V(S(1))) || (q == V(S(3)));
-    const auto back = (q == V(S(2))) || (q == V(S(3)));
-    const V c0 = select(odd, -st, ct), s0 = select(odd, ct, st);
-    c = select(back, -c0, c0);
-    s = select(back, -s0, s0);
-}
 
 /// Shirley and Chiu's concentric map of the unit square onto the unit disc: area-preserving
 /// (uniform points stay uniform) and it keeps strata compact, unlike the polar map
@@ -178,7 +144,7 @@ inline PixelSampleT<V> concentric_disc(const V& u, const V& v) {
     const V num = select(wide, b, a);
     const V den = select(r == V(0.f), V(1.f), r);  // the centre (a = b = 0): r = 0 anyway
     V s, c;
-    detail::sin_cos_quarter(V(0.785398163397448f) * (num / den), s, c);
+    simd::sin_cos_quarter(V(0.785398163397448f) * (num / den), s, c);
     return {r * select(wide, c, s), r * select(wide, s, c)};
 }
 

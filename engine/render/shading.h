@@ -416,7 +416,7 @@ inline ShapedSample<V> sample_shaped_light(const LightT<T>& l, const Vec3T<V>& p
         const V cos_t = V(1) - u1 * (V(1) - cos_max);
         const V sin_t = sqrt(max(V(1) - cos_t * cos_t, V(0)));
         V cos_phi, sin_phi;
-        cos_sin_of_turn(u2, cos_phi, sin_phi);
+        simd::cos_sin_of_turn(u2, cos_phi, sin_phi);
         // An orthonormal basis around a (Duff et al. 2017, branch-free).
         const V sg = sign_of(a.z);
         const V k = V(-1) / (sg + a.z);

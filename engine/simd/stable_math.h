@@ -1,14 +1,17 @@
 #pragma once
-// atan2 and log2 written once for scalars (float, double) and xsimd float batches, as short
-// truncated series with plain multiplies, adds and divides (never fused: the kernel files
-// are built with -ffp-contract=off, see simd/lanes.h mul_add), so every ISA level and the
-// scalar float path give the same bits. xsimd's atan2/log2 round differently at different
-// levels. Used by the texture lookups (shapes' uv<V>, render/texture.h texture_lod).
+// sin/cos, atan2 and log2 written once for scalars (float, double) and xsimd float batches,
+// as short truncated series with plain multiplies, adds and divides (never fused: the kernel
+// files are built with -ffp-contract=off, see simd/lanes.h mul_add), so every ISA level and
+// the scalar float path give the same bits; xsimd's versions round differently at different
+// levels. Used by the lens and area-light sampling (render/sampling.h, render/shading.h) and
+// the texture lookups (shapes' uv<V>, render/texture.h texture_lod).
 //
-// Error bounds (truncation; tests/simd/stable_math_test.cpp checks them in double against
-// std::, float evaluation adds a few roundings of the result's size):
-//   stable_atan2: |error| <= (2 - sqrt 3)^13 / 13 < 2.9e-9 rad
-//   stable_log2:  |error| <= 2 s^11 / (11 (1 - s^2) ln 2) < 1.1e-9, s = 3 - 2 sqrt 2
+// Error bounds (truncation; the tests check them in double against std::, float evaluation
+// adds a few roundings of the result's size):
+//   sin_cos_quarter: |error| <= (pi/4)^11 / 11! < 1.8e-9 (sin), (pi/4)^12 / 12! < 1.2e-10 (cos)
+//                    (tests/render/area_light_test.cpp, through cos_sin_of_turn)
+//   stable_atan2:    |error| <= (2 - sqrt 3)^13 / 13 < 2.9e-9 rad   (tests/simd/stable_math_test.cpp)
+//   stable_log2:     |error| <= 2 s^11 / (11 (1 - s^2) ln 2) < 1.1e-9, s = 3 - 2 sqrt 2
 #include <xsimd/xsimd.hpp>
 
 #include <cmath>
@@ -83,6 +86,39 @@ inline V stable_log2(const V& x) {
     const V z = s * s;
     const V p = V(1) + z * (V(1.0 / 3.0) + z * (V(1.0 / 5.0) + z * (V(1.0 / 7.0) + z * V(1.0 / 9.0))));
     return e + s * p * V(2.8853900817779268);  // 2 / ln 2
+}
+
+/// sin and cos on [-pi/4, pi/4] by their Taylor polynomials (errors below 2e-9 and 1.2e-10),
+/// with plain multiplies and adds: the same bits in scalar float and at every SIMD level,
+/// where xsimd's sin/cos would round differently from one level to the next. V is float,
+/// double (the recursive engine) or a float batch.
+template <class V>
+inline void sin_cos_quarter(const V& a, V& s, V& c) {
+    using S = scalar_t<V>;
+    const V a2 = a * a;
+    s = a * (V(S(1)) + a2 * (V(S(-1.0 / 6)) + a2 * (V(S(1.0 / 120)) + a2 * (V(S(-1.0 / 5040)) +
+                                                                             a2 * V(S(1.0 / 362880))))));
+    c = V(S(1)) + a2 * (V(S(-0.5)) + a2 * (V(S(1.0 / 24)) + a2 * (V(S(-1.0 / 720)) + a2 * (V(S(1.0 / 40320)) +
+                                                                                       a2 * V(S(-1.0 / 3628800))))));
+}
+
+/// cos and sin of the angle 2 pi u, u in [0, 1) (the sphere light's azimuth): the nearest
+/// quarter turn q is taken off exactly, the rest (within an eighth of a turn) goes through
+/// sin_cos_quarter, and the quarter turns rotate (cos, sin) by swaps and sign changes, which
+/// are exact.
+template <class V>
+inline void cos_sin_of_turn(const V& u, V& c, V& s) {
+    using std::floor;
+    using S = scalar_t<V>;
+    const V x = u * V(S(4));
+    const V q = floor(x + V(S(0.5)));  // 0 .. 4; x - q is exact, in [-0.5, 0.5]
+    V st, ct;
+    sin_cos_quarter((x - q) * V(S(1.5707963267948966)), st, ct);
+    const auto odd = (q == V(S(1))) || (q == V(S(3)));
+    const auto back = (q == V(S(2))) || (q == V(S(3)));
+    const V c0 = select(odd, -st, ct), s0 = select(odd, ct, st);
+    c = select(back, -c0, c0);
+    s = select(back, -s0, s0);
 }
 
 STREAMRT_ISA_END

@@ -148,7 +148,7 @@ TEST_CASE("the sphere light's azimuth: cos and sin of a turn against std::cos an
     for (int i = 0; i < 4000; ++i) {
         const double u = i / 4000.0;
         double c = 0, s = 0;
-        cos_sin_of_turn(u, c, s);
+        simd::cos_sin_of_turn(u, c, s);
         CAPTURE(u);
         CHECK(std::abs(c - std::cos(2 * kPi * u)) <= 1e-8);
         CHECK(std::abs(s - std::sin(2 * kPi * u)) <= 1e-8);
