@@ -15,10 +15,12 @@ mkdir -p "$out/corpus" "$out/artifacts"
 # parser.cpp reads large texts in parallel (TBB) and `mesh` statements with engine/mesh/mesh.cpp, which builds each mesh's
 # triangle hierarchy (engine/accel/bvh.cpp, in parallel with TBB) and reads OBJ files with
 # tinyobjloader; the memory estimate (limits.cpp) asks the image writer (image_io.cpp, zlib,
-# stb) for its buffer size.
+# stb, OpenEXR) for its buffer size; `key` statements use engine/scene/animation.cpp and
+# `texture=` keys read images with engine/scene/texture.cpp (stb_image).
 sources=(tests/fuzz/scene_fuzz.cpp engine/scene/parser.cpp engine/scene/scene.cpp
+         engine/scene/animation.cpp engine/scene/texture.cpp
          engine/core/transform.cpp engine/driver/limits.cpp engine/mesh/mesh.cpp
-         engine/accel/bvh.cpp engine/image/image_io.cpp)
+         engine/accel/bvh.cpp engine/image/image_io.cpp engine/image/exr_io.cpp)
 bin="$out/scene_fuzz"
 # Rebuild when a source is newer than the binary.
 rebuild=0
@@ -31,7 +33,8 @@ if ((rebuild)); then
   echo "fuzz.sh: building $bin with $CXX"
   "$CXX" -std=c++20 -O1 -g -fno-omit-frame-pointer \
     -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-    -Iengine -Itests -I/usr/include/stb "${sources[@]}" -ltinyobjloader -ltbb -lz -o "$bin"
+    -Iengine -Itests -I/usr/include/stb $(pkg-config --cflags OpenEXR) "${sources[@]}" \
+    -ltinyobjloader -ltbb -lz $(pkg-config --libs OpenEXR) -o "$bin"
 fi
 # Seed corpus: every example scene, the fuzz seeds (tests/fuzz/corpus: mesh statements on the
 # include tree's tri.obj) and the regression inputs.
