@@ -20,6 +20,27 @@ struct SourceLoc {
     }
 };
 
+/// 's' for messages: at most 60 bytes, control bytes written as \xNN so that a message is
+/// always one printable line (what the user typed may hold any byte).
+inline std::string quote(std::string_view s) {
+    constexpr std::size_t kMax = 60;
+    std::string out = "'";
+    for (std::size_t i = 0; i < s.size() && i < kMax; ++i) {
+        const unsigned char c = static_cast<unsigned char>(s[i]);
+        if (c < 0x20 || c == 0x7f) {
+            static const char hex[] = "0123456789abcdef";
+            out += "\\x";
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        } else {
+            out += char(c);
+        }
+    }
+    if (s.size() > kMax) out += "...";
+    out += '\'';
+    return out;
+}
+
 /// A mistake in a scene file: "file:line:col: message". Exit status 2.
 class SceneError : public std::runtime_error {
   public:

@@ -12,9 +12,7 @@ namespace streamrt {
 namespace {
 /// A frame number: decimal digits only, at most kMaxFrame.
 bool frame_number(std::string_view s, int& out, std::string& why, const char* which) {
-    std::string shown(1, '\'');  // appended, not "'" + string: GCC 12's -Wrestrict false alarm
-    shown.append(s.substr(0, 40));
-    shown += '\'';
+    const std::string shown = quote(s);  // what was typed may hold control bytes
     if (s.empty() || s.size() > 9 || !std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; })) {
         why = std::string("the ") + which + " frame must be an integer >= 0, got " + shown;
         return false;

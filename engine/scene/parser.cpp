@@ -61,27 +61,6 @@ struct Arg {
     int value_col = 0;
 };
 
-/// 's' for messages: at most 60 bytes, control bytes written as \xNN so that a message is
-/// always one printable line.
-std::string quote(std::string_view s) {
-    constexpr std::size_t kMax = 60;
-    std::string out = "'";
-    for (std::size_t i = 0; i < s.size() && i < kMax; ++i) {
-        const unsigned char c = static_cast<unsigned char>(s[i]);
-        if (c < 0x20 || c == 0x7f) {
-            static const char hex[] = "0123456789abcdef";
-            out += "\\x";
-            out += hex[c >> 4];
-            out += hex[c & 15];
-        } else {
-            out += char(c);
-        }
-    }
-    if (s.size() > kMax) out += "...";
-    out += '\'';
-    return out;
-}
-
 std::string fmt_num(double v) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%g", v);
