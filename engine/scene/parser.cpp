@@ -636,7 +636,10 @@ class Parser {
         chunked_ = true;
         ++files_;
 
-        // The other statements, in file order; they stop at their first error.
+        // The other statements, in file order; they stop at their first error. Their name=
+        // (lights, camera) is recorded with the shapes' below, in file order.
+        deferred_names_.clear();
+        defer_names_ = true;
         std::exception_ptr other_error;
         int other_error_line = INT_MAX;
         for (const Chunk& c : chunks) {
@@ -652,6 +655,7 @@ class Parser {
             }
             if (other_error) break;
         }
+        defer_names_ = false;
 
         const std::uint32_t file = file_index(display);
         scene.objects.reserve(objects);
@@ -669,13 +673,23 @@ class Parser {
             read_shapes(text, display, file, chunks[i]);
             if (mapped) advise_inside(text.data() + chunks[i].begin, text.data() + chunks[i].end, MADV_DONTNEED);
         });
+        // name= of every statement in file order, up to the first error (a bad or repeated name
+        // before it is the first error, as in a one-pass read).
+        int first_error_line = other_error_line;
+        for (const Chunk& c : chunks)
+            if (c.error) first_error_line = std::min(first_error_line, c.error_line);
+        for (const Chunk& c : chunks)
+            for (const Chunk::Name& n : c.names)
+                deferred_names_.push_back({display, n.line, Arg{"name", n.column, n.text, n.column}, Named::Object,
+                                           std::uint32_t(n.slot)});
+        std::stable_sort(deferred_names_.begin(), deferred_names_.end(),
+                         [](const DeferredName& a, const DeferredName& b) { return a.line < b.line; });
+        for (const DeferredName& n : deferred_names_)
+            if (n.line < first_error_line) name_thing(n.file, n.line, n.arg, n.what, n.index);
         for (const Chunk& c : chunks)
             if (c.error && c.error_line < other_error_line) std::rethrow_exception(c.error);
         if (other_error) std::rethrow_exception(other_error);
-        for (const Chunk& c : chunks)
-            for (const Chunk::Name& n : c.names)
-                name_thing(display, n.line, Arg{"name", n.column, n.text, n.column}, Named::Object,
-                           std::uint32_t(n.slot));
+        deferred_names_.clear();
         // The chunks' materials into the scene's list in chunk order, then each object's
         // chunk-local index replaced by the scene's (skipped where they coincide).
         std::vector<std::vector<std::uint32_t>> remap(chunks.size());
@@ -1241,6 +1255,16 @@ class Parser {
         int line;
     };
     std::map<std::string, NameDef, std::less<>> names_;  // one namespace for objects, lights, camera
+    /// A chunked read records the names of all statements first and checks them in file order.
+    struct DeferredName {
+        std::string file;
+        int line;
+        Arg arg;
+        Named what;
+        std::uint32_t index;
+    };
+    std::vector<DeferredName> deferred_names_;
+    bool defer_names_ = false;
     std::map<std::pair<std::string, int>, int> key_lines_;  // (name, frame) -> line of its key
     std::unordered_map<std::uint32_t, std::size_t> object_tracks_, light_tracks_;  // index -> track
 
@@ -1251,6 +1275,10 @@ class Parser {
     /// Records `name=` of a statement at file:line; names are unique across objects, lights
     /// and the camera.
     void name_thing(const std::string& file, int line, const Arg& a, Named what, std::uint32_t index) {
+        if (defer_names_) {
+            deferred_names_.push_back({file, line, a, what, index});
+            return;
+        }
         const auto fail = [&](std::string_view msg) { throw SceneError(SourceLoc{file, line, a.value_col}, msg); };
         const std::string_view n = a.value;
         const auto word_char = [](char c) {
