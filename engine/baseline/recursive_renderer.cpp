@@ -146,6 +146,17 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
     return false;
 }
 
+// Out of line: the lookup's locals stay out of trace's frame, which recurses once per bounce.
+[[gnu::noinline]] ColorT<double> RecursiveRenderer::texture_color_at(const MaterialT<double>& material, const RayD& ray,
+                                                                   const HitD& hit) const {
+    const PreparedObject& ob = objects_[std::size_t(hit.object)];
+    const double footprint = footprint_width(ray.cone, camera_.spread, hit.t, dot(ray.dir, hit.normal));
+    const double scale = canonical_per_world<double>(RowsOf{ob.mi});
+    return ob.kind == ShapeKind::Mesh
+               ? mesh_texture_color(material, ob.mesh->view(), hit.tri, hit.bu, hit.bv, scale, footprint)
+               : texture_color(material, ob.kind, hit.canonical, ob.param, scale, footprint);
+}
+
 ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& counts, std::uint32_t key) const {
     const RenderSettings& s = scene_.settings;
     HitD hit;
@@ -155,16 +166,10 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     const ShadeRules<double> rules{s.degree, s.ambient, depth < s.depth, s.cutoff, camera_.spread};
     // Weight 1: the caller multiplies what this ray brings back by its weight.
     const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
-    ColorT<double> object_color{object.color.x, object.color.y, object.color.z};
     const MaterialT<double>& material = materials_[object.material];
-    if (material.texture) {  // the texture replaces the object's colour (render/texture.h)
-        const PreparedObject& ob = objects_[std::size_t(hit.object)];
-        const double footprint = footprint_width(ray.cone, camera_.spread, hit.t, dot(ray.dir, hit.normal));
-        const double scale = canonical_per_world<double>(RowsOf{ob.mi});
-        object_color = ob.kind == ShapeKind::Mesh
-                           ? mesh_texture_color(material, ob.mesh->view(), hit.tri, hit.bu, hit.bv, scale, footprint)
-                           : texture_color(material, ob.kind, hit.canonical, ob.param, scale, footprint);
-    }
+    // The texture replaces the object's colour (render/texture.h).
+    const ColorT<double> object_color = material.texture ? texture_color_at(material, ray, hit)
+                                                         : ColorT<double>{object.color.x, object.color.y, object.color.z};
     RecursiveSink sink{*this, depth, counts, key};
     const auto shade = [&]<bool kLit, bool kShadows>() {
         shade_hit<kLit, kShadows, true, true>(rules, material, lights_.data(), lights_.size(),

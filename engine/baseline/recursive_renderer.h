@@ -72,6 +72,8 @@ class RecursiveRenderer {
         ShapeKind kind;
         const Mesh* mesh;  ///< Mesh only
     };
+    /// The texture colour at a hit of a textured material (out of trace's frame).
+    ColorT<double> texture_color_at(const MaterialT<double>& material, const RayD& ray, const HitD& hit) const;
     /// What a closer hit leaves behind: the canonical ray, and for a mesh the triangle and
     /// its barycentric coordinates.
     struct Candidate {

@@ -162,7 +162,7 @@ const SrgbTables& srgb_tables() {
 // them is 1), NaN and infinities as 0.
 template <bool kReinhard, bool kSrgb>
 [[gnu::always_inline]] inline void display_row_body(const Framebuffer& fb, int y, float pre, float post,
-                                                    const SrgbTables& t, unsigned char* __restrict out) {
+                                                    const SrgbTables* t, unsigned char* __restrict out) {
     const float* __restrict v = fb.pixel(0, y);
     const std::size_t n = std::size_t(fb.width) * 3;
     for (std::size_t i = 0; i < n; ++i) {
@@ -176,8 +176,8 @@ template <bool kReinhard, bool kSrgb>
         const float high = low > 1.f ? 1.f : low;
         const float c = finite ? high : 0.f;
         if constexpr (kSrgb) {
-            const std::int32_t code = t.start[static_cast<int>(c * float(SrgbTables::kSteps))];
-            out[i] = static_cast<unsigned char>(code + (c >= t.up[code] ? 1 : 0));
+            const std::int32_t code = t->start[static_cast<int>(c * float(SrgbTables::kSteps))];
+            out[i] = static_cast<unsigned char>(code + (c >= t->up[code] ? 1 : 0));
         } else {
             const float scaled = c * 255.f;
             const int whole = static_cast<int>(scaled);
@@ -186,15 +186,15 @@ template <bool kReinhard, bool kSrgb>
     }
 }
 
-STREAMRT_ROW_CLONES void row_clamp_srgb(const Framebuffer& fb, int y, float pre, float post, const SrgbTables& t,
+STREAMRT_ROW_CLONES void row_clamp_srgb(const Framebuffer& fb, int y, float pre, float post, const SrgbTables* t,
                                         unsigned char* __restrict out) {
     display_row_body<false, true>(fb, y, pre, post, t, out);
 }
-STREAMRT_ROW_CLONES void row_reinhard_srgb(const Framebuffer& fb, int y, float pre, float post, const SrgbTables& t,
+STREAMRT_ROW_CLONES void row_reinhard_srgb(const Framebuffer& fb, int y, float pre, float post, const SrgbTables* t,
                                            unsigned char* __restrict out) {
     display_row_body<true, true>(fb, y, pre, post, t, out);
 }
-STREAMRT_ROW_CLONES void row_reinhard_linear(const Framebuffer& fb, int y, float pre, float post, const SrgbTables& t,
+STREAMRT_ROW_CLONES void row_reinhard_linear(const Framebuffer& fb, int y, float pre, float post, const SrgbTables* t,
                                              unsigned char* __restrict out) {
     display_row_body<true, false>(fb, y, pre, post, t, out);
 }
@@ -220,12 +220,12 @@ class EightBitRows {
         if (d.colorspace == ColorSpace::Srgb) tables_ = &srgb_tables();
     }
     void operator()(int y, unsigned char* out) const {
-        if (row_) row_(fb_, y, pre_, post_, *tables_, out);
+        if (row_) row_(fb_, y, pre_, post_, tables_, out);
         else row_to_bytes(fb_, y, pre_, out);
     }
 
   private:
-    using Row = void (*)(const Framebuffer&, int, float, float, const SrgbTables&, unsigned char*);
+    using Row = void (*)(const Framebuffer&, int, float, float, const SrgbTables*, unsigned char*);  // tables: sRGB rows only
     const Framebuffer& fb_;
     float pre_ = 1.f, post_ = 1.f;
     Row row_ = nullptr;

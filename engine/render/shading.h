@@ -450,8 +450,11 @@ inline ShapedSample<V> sample_shaped_light(const LightT<T>& l, const Vec3T<V>& p
 /// at a hit: l.samples samples, stratified on a columns x rows lattice with one point per cell
 /// placed by the hashes of (the ray's key, index, sample), each a shadow ray of 1 / samples of
 /// the light. Lights at a point take one sample, the point itself. Otherwise as shade_hit.
+// Out of line: its sample loop's locals then stay out of shade_hit's frame, which the
+// recursive engine stacks once per bounce (depth 256 under AddressSanitizer overflowed a
+// worker's stack when this was inlined).
 template <bool kShadows, class V, class T, class M, class Sink>
-inline void shade_shaped_light(const ShadeRules<T>& rules, const MaterialT<T>& m, const ColorT<V>& base,
+[[gnu::noinline]] inline void shade_shaped_light(const ShadeRules<T>& rules, const MaterialT<T>& m, const ColorT<V>& base,
                                const Vec3T<V>& n, const ArrivingRay<V>& ray, const LightT<T>& l,
                                std::uint32_t index, const Vec3T<V>& p, const Vec3T<V>& shadow_origin,
                                const M& active, ColorT<V>& local, Sink& sink) {
