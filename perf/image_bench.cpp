@@ -101,7 +101,7 @@ std::size_t libdeflate_up(const Framebuffer& fb, int level) {
 }
 #endif
 
-std::size_t streamrt_encode(const Framebuffer& fb, ImageFormat format, const Display& d, const WriteOptions& o) {
+std::size_t streamrt_encode(const Framebuffer& fb, const ImageFormat& format, const Display& d, const WriteOptions& o) {
     std::size_t n = 0;
     encode_image(fb, format, d, [&](std::span<const iovec> p) {
         for (const iovec& v : p) n += v.iov_len;
@@ -110,7 +110,7 @@ std::size_t streamrt_encode(const Framebuffer& fb, ImageFormat format, const Dis
 }
 
 // The handout's linear output, as before the display colour keys.
-std::size_t streamrt_encode(const Framebuffer& fb, ImageFormat format, const WriteOptions& o) {
+std::size_t streamrt_encode(const Framebuffer& fb, const ImageFormat& format, const WriteOptions& o) {
     return streamrt_encode(fb, format, Display::raw(Calibration::Clamp), o);
 }
 
@@ -137,13 +137,13 @@ void display_rows(const Framebuffer& fb) {
         reinhard.tonemap = Tonemap::Reinhard;
         normalize.tonemap = Tonemap::Reinhard;
         normalize.calibration = Calibration::Normalize;
-        report(("PPM linear clamp (handout)" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Ppm, o); });
-        report(("PPM srgb clamp (default)" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Ppm, srgb, o); });
-        report(("PPM srgb reinhard" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Ppm, reinhard, o); });
+        report(("PPM linear clamp (handout)" + j).c_str(), [&] { return streamrt_encode(fb, image_format(".ppm"), o); });
+        report(("PPM srgb clamp (default)" + j).c_str(), [&] { return streamrt_encode(fb, image_format(".ppm"), srgb, o); });
+        report(("PPM srgb reinhard" + j).c_str(), [&] { return streamrt_encode(fb, image_format(".ppm"), reinhard, o); });
         report(("PPM srgb reinhard normalize" + j).c_str(),
-               [&] { return streamrt_encode(fb, ImageFormat::Ppm, normalize, o); });
-        report(("PNG linear clamp (handout)" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Png, o); });
-        report(("PNG srgb clamp (default)" + j).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Png, srgb, o); });
+               [&] { return streamrt_encode(fb, image_format(".ppm"), normalize, o); });
+        report(("PNG linear clamp (handout)" + j).c_str(), [&] { return streamrt_encode(fb, image_format(".png"), o); });
+        report(("PNG srgb clamp (default)" + j).c_str(), [&] { return streamrt_encode(fb, image_format(".png"), srgb, o); });
         for (const ExrPixels px : {ExrPixels::Half, ExrPixels::Float}) {
             Display d;
             d.exr = px;
@@ -201,12 +201,12 @@ int main(int argc, char** argv) {
             o.par = &par;
             o.png = v.png;
             const std::string name = std::string("streamrt bands: ") + v.name + ", -j" + std::to_string(jobs);
-            report(name.c_str(), [&] { return streamrt_encode(fb, ImageFormat::Png, o); });
+            report(name.c_str(), [&] { return streamrt_encode(fb, image_format(".png"), o); });
         }
         WriteOptions o;
         o.par = &par;
-        report(("streamrt PPM, -j" + std::to_string(jobs)).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Ppm, o); });
-        report(("streamrt PFM, -j" + std::to_string(jobs)).c_str(), [&] { return streamrt_encode(fb, ImageFormat::Pfm, o); });
+        report(("streamrt PPM, -j" + std::to_string(jobs)).c_str(), [&] { return streamrt_encode(fb, image_format(".ppm"), o); });
+        report(("streamrt PFM, -j" + std::to_string(jobs)).c_str(), [&] { return streamrt_encode(fb, image_format(".pfm"), o); });
         report(("write_image to /tmp .png (default), -j" + std::to_string(jobs)).c_str(), [&] {
             write_image("/tmp/streamrt_image_bench.png", fb, Display::raw(Calibration::Clamp), o);
             return std::size_t(0);

@@ -14,13 +14,16 @@ out=build-fuzz
 mkdir -p "$out/corpus" "$out/artifacts"
 # parser.cpp reads large texts in parallel (TBB) and `mesh` statements with engine/mesh/mesh.cpp, which builds each mesh's
 # triangle hierarchy (engine/accel/bvh.cpp, in parallel with TBB) and reads OBJ files with
-# tinyobjloader; the memory estimate (limits.cpp) asks the image writer (image_io.cpp, zlib,
+# tinyobjloader; the memory estimate (limits.cpp) asks the image writer (image/*_format.cpp through image_io.cpp, zlib,
 # stb, OpenEXR) for its buffer size; `key` statements use engine/scene/animation.cpp and
 # `texture=` keys read images with engine/scene/texture.cpp (stb_image).
 sources=(tests/fuzz/scene_fuzz.cpp engine/scene/parser.cpp engine/scene/scene.cpp
          engine/scene/animation.cpp engine/scene/texture.cpp
          engine/core/transform.cpp engine/driver/limits.cpp engine/mesh/mesh.cpp
-         engine/accel/bvh.cpp engine/image/image_io.cpp engine/image/exr_io.cpp)
+         engine/accel/bvh.cpp engine/image/image_io.cpp engine/image/exr_io.cpp
+         engine/image/image_formats.cpp engine/image/display.cpp engine/image/atomic_file.cpp
+         engine/image/ppm_format.cpp engine/image/png_format.cpp engine/image/pfm_format.cpp
+         engine/image/hdr_format.cpp)
 bin="$out/scene_fuzz"
 # Rebuild when a source is newer than the binary.
 rebuild=0

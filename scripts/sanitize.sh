@@ -33,7 +33,7 @@ case "$kind" in
   tsan|tsan-std)
     dir=build-$kind
     sanitize="thread"
-    # (engine/image/image_io.cpp builds its one target_clones function without clones under TSan:
+    # (engine/image/display.cpp builds its one target_clones function without clones under TSan:
     # GCC instruments the clones' load-time resolver, which runs before the TSan runtime.)
     extra=()
     # Suppressions (each with its reason) live in tests/tsan.supp.

@@ -118,7 +118,7 @@ void check_writable_path(const std::string& out, const std::string& scene_path) 
 
 void check_output_path(const std::string& out, const std::string& scene_path) {
     if (!image_format_for(out))
-        throw UsageError("output '" + out + "': unknown image format (expected .ppm, .png, .pfm or .exr)");
+        throw UsageError("output '" + out + "': unknown image format (expected " + image_format_extensions() + ")");
     check_writable_path(out, scene_path);
 }
 

@@ -141,4 +141,14 @@ double exr_write_buffer_bytes(int width, int height) {
     return band + 3 * lines + 8.0 * (double(height) / kZipLines + 1);
 }
 
+namespace {
+bool write_exr_file(int fd, const std::string& path, const Framebuffer& fb, const Display& display,
+                    const WriteOptions& options) {
+    return write_exr(fd, path, fb, display.exr, options);
+}
+}  // namespace
+
+// The writer seeks back for its line offset table: written to the file, not to a byte sink.
+extern const ImageFormat kExrFormat{"EXR", ".exr", false, nullptr, &write_exr_file, &read_exr, &exr_write_buffer_bytes};
+
 }  // namespace streamrt

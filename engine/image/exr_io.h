@@ -4,7 +4,7 @@
 #include <string>
 
 #include "image/framebuffer.h"
-#include "image/image_io.h"
+#include "image/image_format.h"
 
 namespace streamrt {
 

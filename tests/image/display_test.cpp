@@ -43,7 +43,7 @@ std::vector<int> ppm_codes(const Framebuffer& fb, const Display& d, int jobs = 1
     WriteOptions o;
     o.par = &par;
     std::string out;
-    encode_image(fb, ImageFormat::Ppm, d, [&](std::span<const iovec> pieces) {
+    encode_image(fb, image_format(".ppm"), d, [&](std::span<const iovec> pieces) {
         for (const iovec& v : pieces) out.append(static_cast<const char*>(v.iov_base), v.iov_len);
     }, o);
     const std::size_t header = out.size() - fb.rgb.size();
@@ -277,5 +277,5 @@ TEST_CASE("EXR: failures and Ctrl-C leave no file, and errors name the path") {
         CHECK(std::string(e.what()).find(junk.string() + ": cannot read EXR") == 0);
     }
     fs::remove(junk);
-    CHECK_THROWS_AS(encode_image(fb, ImageFormat::Exr, Display{}, [](std::span<const iovec>) {}), RenderError);
+    CHECK_THROWS_AS(encode_image(fb, image_format(".exr"), Display{}, [](std::span<const iovec>) {}), RenderError);
 }

@@ -61,7 +61,7 @@ std::string file_bytes(const fs::path& p) {
     return std::string((std::istreambuf_iterator<char>(in)), {});
 }
 
-std::string encoded(const Framebuffer& fb, ImageFormat format, Calibration how, int jobs) {
+std::string encoded(const Framebuffer& fb, const ImageFormat& format, Calibration how, int jobs) {
     Parallelism par(jobs);
     WriteOptions o;
     o.par = &par;
@@ -168,7 +168,7 @@ TEST_CASE("PNG: read back by stb_image, the exact 8-bit values, at every band la
 TEST_CASE("PPM: the fused calibration stores lround(calibrated * 255) exactly") {
     for (const Calibration how : {Calibration::Clamp, Calibration::Normalize}) {
         const Framebuffer fb = awkward(33, 17);
-        const std::string ppm = encoded(fb, ImageFormat::Ppm, how, 2);
+        const std::string ppm = encoded(fb, image_format(".ppm"), how, 2);
         const std::string header = "P6\n33 17\n255\n";
         REQUIRE(ppm.size() == header.size() + 33 * 17 * 3);
         CHECK(ppm.substr(0, header.size()) == header);
@@ -195,10 +195,10 @@ TEST_CASE("PPM and PFM larger than one write chunk keep every row in place") {
 
 TEST_CASE("the file's bytes are the same at -j1 and -j2") {
     const Framebuffer fb = awkward(301, 3 * png_band_rows(301) + 7);
-    for (const ImageFormat f : {ImageFormat::Png, ImageFormat::Ppm, ImageFormat::Pfm}) {
-        const std::string one = encoded(fb, f, Calibration::Clamp, 1);
+    for (const ImageFormat* f : {&image_format(".png"), &image_format(".ppm"), &image_format(".pfm")}) {
+        const std::string one = encoded(fb, *f, Calibration::Clamp, 1);
         CHECK(one.size() > 1000);
-        CHECK(one == encoded(fb, f, Calibration::Clamp, 2));
+        CHECK(one == encoded(fb, *f, Calibration::Clamp, 2));
     }
 }
 
