@@ -17,7 +17,8 @@ mkdir -p "$out/corpus" "$out/artifacts"
 # tinyobjloader; the memory estimate (limits.cpp) asks the image writer (image/*_format.cpp through image_io.cpp, zlib,
 # stb, OpenEXR) for its buffer size; `key` statements use engine/scene/animation.cpp and
 # `texture=` keys read images with engine/scene/texture.cpp (stb_image).
-sources=(tests/fuzz/scene_fuzz.cpp engine/scene/parser.cpp engine/scene/scene.cpp
+sources=(tests/fuzz/scene_fuzz.cpp engine/scene/parser.cpp engine/scene/parse_statements.cpp
+         engine/scene/parse_shapes.cpp engine/scene/parse_animation.cpp engine/scene/scene.cpp
          engine/scene/animation.cpp engine/scene/texture.cpp
          engine/core/transform.cpp engine/driver/limits.cpp engine/mesh/mesh.cpp
          engine/accel/bvh.cpp engine/image/image_io.cpp engine/image/exr_io.cpp

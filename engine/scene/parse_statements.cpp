@@ -1,0 +1,254 @@
+// The scene reader's settings, camera, light and material statements (docs/scene-format.md).
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "scene/animation.h"
+#include "scene/parser_state.h"
+
+namespace streamrt::scene_reader {
+
+const Token& Parser::single_value(const Statement& st, const std::vector<Token>& toks,
+                                 std::string_view what) {
+    if (toks.size() < 2)
+        st.fail_here("expected " + std::string(what) + " after '" + std::string(st.word()) + "'");
+    if (toks.size() > 2)
+        st.fail(toks[2].column, "unexpected " + quote(toks[2].text) + " after the value of '" +
+                                    std::string(st.word()) + "'");
+    return toks[1];
+}
+
+void Parser::image(Statement& st, const std::vector<Token>& toks) {
+    st.read_args(toks, 1, kImageKeys);
+    RenderSettings& s = scene.settings;
+    for (const Arg& a : st.args) {
+        const auto k = a.key;
+        if (k == "width") s.width = st.integer(a, 1, 32768);
+        else if (k == "height") s.height = st.integer(a, 1, 32768);
+        else if (k == "spp") s.spp = st.integer(a, 1, 65536);
+        else if (k == "depth") s.depth = st.integer(a, 0, 256);
+        else if (k == "degree") s.degree = st.integer(a, 0, 5);
+        else if (k == "cutoff") s.cutoff = st.in_closed(a, 0.0, 1.0);
+        else if (k == "output") s.output = std::string(a.value);
+        else if (k == "frames") frame_range(st, a, s.frames_first, s.frames_last);
+        else if (k == "sampler") {
+            if (a.value == "stratified") s.pattern = SamplePattern::Stratified;
+            else if (a.value == "grid") s.pattern = SamplePattern::Grid;
+            else if (a.value == "random") s.pattern = SamplePattern::Random;
+            else
+                st.fail(a.value_col, "expected stratified, grid or random for 'sampler', got " +
+                                         quote(a.value));
+        } else if (k == "calibration") {
+            if (a.value == "clamp") s.calibration = Calibration::Clamp;
+            else if (a.value == "normalize") s.calibration = Calibration::Normalize;
+            else
+                st.fail(a.value_col,
+                        "expected clamp or normalize for 'calibration', got " + quote(a.value));
+        } else {
+            display_key(st, a, s);
+        }
+    }
+}
+
+void Parser::display_key(const Statement& st, const Arg& a, RenderSettings& s) {
+    const auto k = a.key;
+    if (k == "exposure") {
+        // Bounded so that it stays a normal float factor for the 8-bit conversion.
+        const double v = st.number(a);
+        if (!(v >= 1e-6 && v <= 1e6))
+            st.fail(a.value_col, "'exposure' must be a multiplier > 0, in [1e-6, 1e6], got " + quote(a.value));
+        s.exposure = v;
+    } else if (k == "colorspace") {
+        if (a.value == "srgb") s.colorspace = ColorSpace::Srgb;
+        else if (a.value == "linear") s.colorspace = ColorSpace::Linear;
+        else st.fail(a.value_col, "expected srgb or linear for 'colorspace', got " + quote(a.value));
+    } else if (k == "tonemap") {
+        if (a.value == "clamp") s.tonemap = Tonemap::Clamp;
+        else if (a.value == "reinhard") s.tonemap = Tonemap::Reinhard;
+        else st.fail(a.value_col, "expected clamp or reinhard for 'tonemap', got " + quote(a.value));
+    } else if (k == "exr") {
+        if (a.value == "half") s.exr = ExrPixels::Half;
+        else if (a.value == "float") s.exr = ExrPixels::Float;
+        else st.fail(a.value_col, "expected half or float for 'exr', got " + quote(a.value));
+    }
+}
+
+void Parser::ambient(Statement& st, const std::vector<Token>& toks) {
+    const Token& t = single_value(st, toks, "a number in [0, 1]");
+    const Arg a{"ambient", t.column, t.text, t.column};
+    scene.settings.ambient = st.in_closed(a, 0.0, 1.0);
+}
+
+void Parser::background(Statement& st, const std::vector<Token>& toks) {
+    const Token& t = single_value(st, toks, "a colour r,g,b");
+    const Arg a{"background", t.column, t.text, t.column};
+    scene.settings.background = st.color(a);
+}
+
+void Parser::camera(Statement& st, const std::vector<Token>& toks) {
+    st.read_args(toks, 1, kCameraKeys);
+    Camera cam;
+    // The lens keys and name= belong to both forms; the first other key chooses the form.
+    const auto either_form = [](const Arg& a) { return same(a.key, "name") || contains(kLensKeys, a.key); };
+    if (const auto placing = std::find_if_not(st.args.begin(), st.args.end(), either_form);
+        placing != st.args.end()) {
+        const Arg& first = *placing;
+        const bool look_at = contains(kLookAtKeys, first.key);
+        for (const Arg& a : st.args)
+            if (!either_form(a) && contains(kLookAtKeys, a.key) != look_at)
+                st.fail(a.key_col, "camera: " + quote(a.key) + " belongs to the " +
+                                       (look_at ? "explicit" : "look-at") + " form but " +
+                                       quote(first.key) + " chose the " +
+                                       (look_at ? "look-at" : "explicit") +
+                                       " form; use one form per camera statement");
+        cam.look_at = look_at;
+    }
+    for (const Arg& a : st.args) {  // depth of field (the stream engine's lens is float)
+        if (a.key != "aperture" && a.key != "focus") continue;
+        const double v = a.key == "aperture" ? st.at_least_zero(a) : st.positive(a);
+        if (!(v <= double(std::numeric_limits<float>::max())))
+            st.fail(a.value_col, quote(a.key) + " must be at most 3.4e38 (single precision), got " + quote(a.value));
+        (a.key == "aperture" ? cam.aperture : cam.focus) = v;
+    }
+    if (cam.look_at) {
+        const Arg* up = nullptr;
+        for (const Arg& a : st.args) {
+            if (a.key == "eye") cam.eye = st.vec3(a);
+            else if (a.key == "look") cam.look = st.vec3(a);
+            else if (a.key == "up") {
+                cam.up = st.direction(a);
+                up = &a;
+            } else if (a.key == "fov") cam.fov = st.in_open(a, 0.0, 180.0);
+        }
+        const glm::dvec3 fwd = cam.look - cam.eye;
+        if (!(glm::length(fwd) > 0.0) || !std::isfinite(glm::length(fwd)))
+            st.fail_here("camera: 'eye' and 'look' must be distinct points");
+        const double side = glm::length(glm::cross(glm::normalize(fwd), cam.up));
+        if (!(side > 1e-9)) {
+            const std::string msg = "camera: 'up' must not be parallel to the view direction";
+            if (up) st.fail(up->value_col, msg);
+            st.fail_here(msg);
+        }
+        // The conversion happens once the image size is known; check it is invertible.
+        if (singular(cam.world_from_canonical(1, 1)))
+            st.fail_here("camera: the look-at placement gives a singular transform");
+    } else {
+        double rx = 1.0, ry = 1.0, df = 1.0;
+        glm::dmat4 xf(1.0);
+        for (const Arg& a : st.args) {
+            if (a.key == "rx") rx = st.positive(a);
+            else if (a.key == "ry") ry = st.positive(a);
+            else if (a.key == "df") df = st.positive(a);
+            else apply_transform_key(st, a, xf);
+        }
+        cam.md = xf * scale_matrix({rx, ry, df});
+        if (singular(cam.md)) st.fail_here("camera: the composed transform is singular");
+    }
+    scene.camera = cam;
+    if (const Arg* n = st.find("name")) name_thing(st.file(), st.line(), *n, Named::Camera, 0);
+}
+
+void Parser::light(Statement& st, const std::vector<Token>& toks) {
+    if (toks.size() < 2)
+        st.fail_here("expected a light kind (point, spot, directional, sphere or rect) after 'light'");
+    const Token& kt = toks[1];
+    Light l;
+    const std::vector<std::string_view>* keys = nullptr;
+    if (kt.text == "point") {
+        l.kind = LightKind::Point;
+        keys = &kPointLightKeys;
+    } else if (kt.text == "spot") {
+        l.kind = LightKind::Spot;
+        keys = &kSpotLightKeys;
+    } else if (kt.text == "directional") {
+        l.kind = LightKind::Directional;
+        keys = &kDirectionalLightKeys;
+    } else if (kt.text == "sphere") {
+        l.kind = LightKind::Sphere;
+        keys = &kSphereLightKeys;
+    } else if (kt.text == "rect") {
+        l.kind = LightKind::Rect;
+        keys = &kRectLightKeys;
+    } else {
+        st.fail(kt.column,
+                "expected a light kind (point, spot, directional, sphere or rect), got " + quote(kt.text));
+    }
+    st.read_args(toks, 2, *keys);
+    for (const Arg& a : st.args) {
+        if (a.key == "pos") l.pos = st.vec3(a);
+        else if (a.key == "dir") l.dir = st.direction(a);
+        else if (a.key == "angle") l.angle = st.in_open(a, 0.0, 180.0);
+        else if (a.key == "color") l.color = st.color(a);
+        else area_light_key(st, a, l);
+    }
+    const bool needs_pos = l.kind != LightKind::Directional;
+    const bool needs_dir = l.kind == LightKind::Spot || l.kind == LightKind::Directional;
+    const std::string kind(kt.text);
+    if (needs_pos && !st.find("pos")) st.fail_here("light " + kind + " needs 'pos=x,y,z'");
+    if (needs_dir && !st.find("dir")) st.fail_here("light " + kind + " needs 'dir=x,y,z'");
+    check_area_light(st, l);
+    scene.lights.push_back(l);
+    if (const Arg* n = st.find("name"))
+        name_thing(st.file(), st.line(), *n, Named::Light, std::uint32_t(scene.lights.size() - 1));
+}
+
+void Parser::area_light_key(const Statement& st, const Arg& a, Light& l) {
+    if (a.key == "radius") l.radius = st.positive(a);
+    else if (a.key == "u") l.u = st.vec3(a);
+    else if (a.key == "v") l.v = st.vec3(a);
+    else if (a.key == "samples") l.samples = st.integer(a, 1, 4096);
+    else if (a.key == "soft") l.soft = st.at_least_zero(a);
+    else if (a.key == "falloff") {
+        if (a.value == "none") l.falloff = Falloff::None;
+        else if (a.value == "inverse_square") l.falloff = Falloff::InverseSquare;
+        else st.fail(a.value_col, "expected none or inverse_square for 'falloff', got " + quote(a.value));
+    }
+}
+
+void Parser::check_area_light(const Statement& st, const Light& l) {
+    if (l.kind == LightKind::Sphere && !st.find("radius")) st.fail_here("light sphere needs 'radius=r'");
+    if (l.kind == LightKind::Rect) {
+        if (!st.find("u")) st.fail_here("light rect needs 'u=x,y,z'");
+        if (!st.find("v")) st.fail_here("light rect needs 'v=x,y,z'");
+        const double area = glm::length(glm::cross(l.u, l.v));
+        // Relative to the edges' lengths, so the test does not depend on the scene's unit.
+        if (!(area > 1e-12 * glm::length(l.u) * glm::length(l.v)) || !std::isfinite(area))
+            st.fail(st.find("v")->value_col, "light rect: 'u' and 'v' span no area (u x v = 0)");
+    }
+    if (const Arg* s = st.find("soft"); s && !(l.soft < l.angle))
+        st.fail(s->value_col, "'soft' must be below the spot's 'angle' (" + fmt_num(l.angle) + "), got " +
+                                  quote(s->value));
+}
+
+const Appearance& Parser::lookup_material(const Statement& st, const Arg& a) const {
+    const auto it = materials_.find(a.value);
+    if (it == materials_.end() || it->second.from_line > st.line())
+        st.fail(a.value_col, "unknown material " + quote(a.value) +
+                                 " (a material must be defined before it is used)");
+    return it->second.look;
+}
+
+void Parser::material(Statement& st, const std::vector<Token>& toks) {
+    if (toks.size() < 2 || toks[1].text.find('=') != std::string_view::npos)
+        st.fail(toks.size() < 2 ? toks[0].column : toks[1].column,
+                "expected a material name after 'material'");
+    const Token& name = toks[1];
+    if (const auto it = materials_.find(name.text); it != materials_.end())
+        st.fail(name.column, "material " + quote(name.text) + " is already defined");
+    st.read_args(toks, 2, kMaterialStatementKeys);  // "material": a base to start from
+    Appearance m;
+    if (const Arg* base = st.find("material")) m = lookup_material(st, *base);
+    for (const Arg& a : st.args)
+        if (same(a.key, "texture")) m.m.texture = texture_file(st, a);
+        else apply_material_key(st, a, m);
+    materials_.emplace(std::string(name.text), MaterialDef{m, chunked_ ? st.line() : 0});
+}
+
+void Parser::frame_range(const Statement& st, const Arg& a, int& first, int& last) {
+    std::string why;
+    if (!parse_frame_range(a.value, first, last, why)) st.fail(a.value_col, "'frames': " + why);
+}
+
+}  // namespace streamrt::scene_reader

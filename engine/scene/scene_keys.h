@@ -1,0 +1,142 @@
+#pragma once
+// The scene format's key vocabularies (docs/scene-format.md lists the same), what a material
+// key or a transform key does, and the statement words. Internal to the reader.
+#include <algorithm>
+#include <array>
+#include <initializer_list>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scene/statement.h"
+#include "shapes/shapes.h"
+
+namespace streamrt::scene_reader {
+
+// ---- key vocabularies ------------------------------------------------------------------
+inline const std::vector<std::string_view> kMaterialKeys = {"color", "ambi",    "diff", "spec",
+                                                     "shininess", "refl", "trans", "ior",
+                                                     "checker", "cell", "fresnel",
+                                                     "texture", "uvscale"};  // textures
+inline const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rotate_y", "rotate_z",
+                                                      "translate"};
+inline const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
+                                                  "depth",  "degree",  "output",
+                                                  "sampler", "calibration", "cutoff",
+                                                  "colorspace", "exposure", "tonemap", "exr",
+                                                  "frames"};
+inline const std::vector<std::string_view> kLookAtKeys = {"eye", "look", "up", "fov"};
+inline const std::vector<std::string_view> kExplicitCameraKeys = {"rx",       "ry",       "df",
+                                                           "scale",    "rotate_x", "rotate_y",
+                                                           "rotate_z", "translate"};
+/// Depth of field: keys of both camera forms.
+inline const std::vector<std::string_view> kLensKeys = {"aperture", "focus"};
+
+inline std::vector<std::string_view> join(std::initializer_list<std::vector<std::string_view>> lists) {
+    std::vector<std::string_view> out;
+    for (const auto& l : lists) out.insert(out.end(), l.begin(), l.end());
+    return out;
+}
+
+// The joined lists, built once (the order is the one messages list them in).
+inline const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys, kLensKeys, {"name"}});
+inline const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
+inline const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys, {"name"}});
+inline const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth", "materials"}});
+inline const std::vector<std::string_view> kPointLightKeys = {"pos", "color", "falloff", "name"};
+inline const std::vector<std::string_view> kSpotLightKeys = {"pos", "dir", "angle", "color", "falloff", "soft", "name"};
+inline const std::vector<std::string_view> kDirectionalLightKeys = {"dir", "color", "falloff", "name"};
+// Area lights (docs/scene-format.md, "Area lights and soft shadows").
+inline const std::vector<std::string_view> kSphereLightKeys = {"pos", "radius", "color", "samples", "falloff", "name"};
+inline const std::vector<std::string_view> kRectLightKeys = {"pos", "u", "v", "color", "samples", "falloff", "name"};
+// The `key` statement's keys, by what the name names (animation, scene/animation.h).
+inline const std::vector<std::string_view> kObjectKeyKeys = {"frame", "translate", "rotate", "scale"};
+inline const std::vector<std::string_view> kLightKeyKeys = {"frame", "pos", "color"};
+inline const std::vector<std::string_view> kCameraKeyKeys = {"frame", "eye", "look", "fov"};
+inline const std::vector<std::string_view> kKeyKeys = join({kObjectKeyKeys, {"pos", "color", "eye", "look", "fov"}});
+
+/// Each kind's keys: the common ones, plus its parameter key (shapes/shapes.h) or the mesh's.
+inline const std::array<std::vector<std::string_view>, kShapeKindCount> kKeysOfKind = [] {
+    std::array<std::vector<std::string_view>, kShapeKindCount> keys;
+    for (int k = 0; k < kShapeKindCount; ++k) {
+        const ShapeParam p = shape_param(ShapeKind(k));
+        keys[std::size_t(k)] = p.present() ? join({kShapeKeys, {p.key}}) : kShapeKeys;
+    }
+    keys[std::size_t(ShapeKind::Mesh)] = kMeshKeys;
+    return keys;
+}();
+
+inline const std::vector<std::string_view>& shape_keys(ShapeKind kind) { return kKeysOfKind[std::size_t(kind)]; }
+
+inline bool contains(const std::vector<std::string_view>& v, std::string_view k) {
+    return std::find(v.begin(), v.end(), k) != v.end();
+}
+
+/// What a `material` statement names and a shape's material keys set: the optical
+/// parameters and the colour (stored apart in the scene: Object::color, Scene::materials).
+struct Appearance {
+    Material m;
+    glm::dvec3 color{1.0, 1.0, 1.0};
+};
+
+/// Applies one material key; false when `a` is not a material key.
+inline bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
+    const auto k = a.key;
+    Material& m = ap.m;
+    if (same(k, "color")) ap.color = st.color(a);
+    else if (same(k, "ambi")) m.ambi = st.at_least_zero(a);
+    else if (same(k, "diff")) m.diff = st.at_least_zero(a);
+    else if (same(k, "spec")) m.spec = st.at_least_zero(a);
+    else if (same(k, "shininess")) m.shininess = st.at_least_zero(a);
+    else if (same(k, "refl")) m.refl = st.at_least_zero(a);
+    else if (same(k, "trans")) m.trans = st.at_least_zero(a);
+    else if (same(k, "ior")) m.ior = st.positive(a);
+    else if (same(k, "checker")) {
+        m.checker_color = st.color(a);
+        m.checker = true;
+    } else if (same(k, "cell")) m.cell = st.positive(a);
+    else if (same(k, "fresnel")) m.fresnel = st.boolean(a);
+    else if (same(k, "uvscale")) m.uv_scale = st.positive(a);  // texture= is the Parser's (texture_file)
+    else return false;
+    return true;
+}
+
+/// Applies one transform key on the left of `md` (written order = application order).
+inline bool apply_transform_key(const Statement& st, const Arg& a, glm::dmat4& md) {
+    const auto k = a.key;
+    glm::dmat4 t;
+    // Scale and translate, the common keys, touch only what they change: the same values as
+    // the full products S Md and T Md of an affine Md (the skipped terms are exact zeros).
+    if (same(k, "scale")) {
+        const glm::dvec3 s = st.scale(a);
+        for (int c = 0; c < 4; ++c) md[c] *= glm::dvec4(s, 1.0);
+        return true;
+    }
+    if (same(k, "translate")) {
+        const glm::dvec3 v = st.vec3(a);
+        for (int c = 0; c < 4; ++c) md[c] += glm::dvec4(v * md[c][3], 0.0);
+        return true;
+    }
+    if (same(k, "rotate_x")) t = rotate_x_matrix(st.number(a));
+    else if (same(k, "rotate_y")) t = rotate_y_matrix(st.number(a));
+    else if (same(k, "rotate_z")) t = rotate_z_matrix(st.number(a));
+    else return false;
+    md = t * md;
+    return true;
+}
+
+inline std::optional<ShapeKind> shape_from_word(std::string_view w) { return canonical_shape_named(w); }
+
+/// The statement words, in the order the unknown-statement message lists them.
+inline const std::string kStatementList = [] {
+    std::string list = "image, ambient, background, camera, light, material, key, ";
+    CanonicalShapes::for_each([&](auto s) { list += std::string(s.name) + ", "; });
+    return list + "mesh or include";
+}();
+
+/// The statement words the chunked reader parses in parallel (mesh and include fall back to
+/// one sequential pass: they read other files).
+inline bool is_plain_shape(std::string_view w) { return shape_from_word(w).has_value(); }
+
+}  // namespace streamrt::scene_reader
