@@ -222,3 +222,60 @@ TEST_CASE("pipeline: area lights' samples go through the occlusion stage, and on
     CHECK_FALSE(has_prefix(unshadowed, "occlusion"));
     CHECK(has(unshadowed, "area lights x 9 (no shadows)"));
 }
+
+// The stages a scene needs, checked by what they do rather than by their labels: a camera
+// looking straight down at the canonical plane (y = 0, infinite) sees it in every pixel, and a
+// light straight above lights every point of it, so every ray count follows by hand from the
+// scene text. A stage the scene does not need must not run at all: no ray in, no CPU time.
+// Proven against: the occlusion stage built from degree 3 (stream_scene.cpp: shadow rays
+// counted at degree 3, and the stage's CPU time); the occlusion stage built without a light
+// (no ray, but the stage ran: its CPU time). Not seen here, since no count changes: the
+// spawn stage built for a scene with no mirror (refl=0 spawns nothing either way); the stage
+// lists above catch that one.
+TEST_CASE("pipeline: ray counts of each stage, worked out by hand on a plane seen from above") {
+    constexpr int W = 20, H = 15, S = 2;
+    constexpr std::uint64_t P = std::uint64_t(W) * H * S;  // primary rays; every one hits the plane
+    struct Case {
+        int degree;
+        const char* plane;
+        bool light;
+        std::uint64_t intersect, shadow, reflected, refracted;
+    };
+    const Case cases[] = {
+        // matte, lit, degree 5: one shadow ray per hit, nothing spawned
+        {5, "plane", true, P, P, 0, 0},
+        // a mirror: each hit spawns a reflected ray (upwards: it meets nothing); shadow rays from
+        // the primary hits only
+        {5, "plane refl=0.5", true, 2 * P, P, P, 0},
+        // a glass plane: each hit spawns a refracted ray (downwards, through: nothing beyond)
+        {5, "plane trans=0.5 ior=1.5", true, 2 * P, P, 0, P},
+        // degree 3: reflections but no shadow rays
+        {3, "plane refl=0.5", true, 2 * P, 0, P, 0},
+        // degree 2: neither
+        {2, "plane refl=0.5 trans=0.5", true, P, 0, 0, 0},
+        // no light: no shadow rays even at degree 5
+        {5, "plane refl=0.5", false, 2 * P, 0, P, 0},
+    };
+    for (const Case& c : cases) {
+        CAPTURE(c.degree); CAPTURE(c.plane); CAPTURE(c.light);
+        const std::string text = "image width=" + std::to_string(W) + " height=" + std::to_string(H) +
+                                 " spp=" + std::to_string(S) + " depth=4 degree=" + std::to_string(c.degree) +
+                                 "\ncamera eye=0,5,0 look=0,0,0 up=0,0,-1 fov=40\n" +
+                                 (c.light ? "light point pos=0,10,0\n" : "") + c.plane + "\n";
+        const Scene sc = parse_scene(text, "plane_counts.cfg");
+        StreamProfile prof;
+        Parallelism par(1);
+        EngineOptions opt;
+        opt.profile = &prof;
+        const RenderResult r = render_scene(sc, EngineKind::Stream, par, nullptr, opt);
+        CHECK(r.counts.primary == P);
+        CHECK(r.counts.shadow == c.shadow);
+        CHECK(r.counts.reflected == c.reflected);
+        CHECK(r.counts.refracted == c.refracted);
+        CHECK(prof.stages[int(Stage::Intersect)].rays_in == c.intersect);
+        // Every shadow ray reaches the light: nothing but the plane, which it leaves.
+        CHECK(prof.stages[int(Stage::Occlusion)].rays_in == c.shadow);
+        CHECK(prof.stages[int(Stage::Occlusion)].rays_out == c.shadow);
+        if (c.shadow == 0) CHECK(prof.stages[int(Stage::Occlusion)].nanoseconds == 0);
+    }
+}
