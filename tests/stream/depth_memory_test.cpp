@@ -18,8 +18,10 @@
 #include "image/image_compare.h"
 #include "parallel/parallelism.h"
 #include "scene/parser.h"
+#include "stream/child_peak_rss.h"
 
 using namespace streamrt;
+using streamrt::test::child_peak_rss_kib;
 namespace fs = std::filesystem;
 
 namespace {
@@ -48,47 +50,6 @@ Framebuffer render_with(const Scene& s, EngineKind engine, int jobs, std::size_t
 bool same_bits(const Framebuffer& a, const Framebuffer& b) {
     return a.width == b.width && a.height == b.height &&
            std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(float)) == 0;
-}
-
-/// Peak resident memory (KiB, VmHWM) of one `streamrt` run with these arguments, which must
-/// succeed; -1 where this process may not trace its children. Read when the child is about
-/// to exit (ptrace's exit stop, its memory still mapped): wait4's ru_maxrss would not do,
-/// Linux carries the parent's peak across the exec.
-long child_peak_rss_kib(const std::vector<std::string>& args) {
-    std::vector<char*> argv{const_cast<char*>(STREAMRT_BINARY)};
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    const pid_t pid = ::fork();
-    REQUIRE(pid >= 0);
-    if (pid == 0) {
-        if (::ptrace(PTRACE_TRACEME, 0, nullptr, nullptr) != 0) ::_exit(126);  // not allowed here
-        ::execv(STREAMRT_BINARY, argv.data());
-        ::_exit(127);
-    }
-    int status = 0;
-    REQUIRE(::waitpid(pid, &status, 0) == pid);  // stopped at the exec
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 126) return -1;
-    REQUIRE(WIFSTOPPED(status));
-    REQUIRE(::ptrace(PTRACE_SETOPTIONS, pid, nullptr, reinterpret_cast<void*>(long(PTRACE_O_TRACEEXIT))) == 0);
-    long peak = -1;
-    int signal = 0;
-    for (;;) {
-        REQUIRE(::ptrace(PTRACE_CONT, pid, nullptr, reinterpret_cast<void*>(long(signal))) == 0);
-        REQUIRE(::waitpid(pid, &status, 0) == pid);
-        if (!WIFSTOPPED(status)) break;
-        signal = 0;
-        if (status >> 8 == (SIGTRAP | (PTRACE_EVENT_EXIT << 8))) {
-            std::ifstream in("/proc/" + std::to_string(pid) + "/status");
-            for (std::string line; std::getline(in, line);)
-                if (line.rfind("VmHWM:", 0) == 0) peak = std::stol(line.substr(6));
-        } else {
-            signal = WSTOPSIG(status);  // not ours: deliver it
-        }
-    }
-    REQUIRE(WIFEXITED(status));
-    REQUIRE(WEXITSTATUS(status) == 0);
-    REQUIRE(peak > 0);
-    return peak;
 }
 
 }  // namespace
