@@ -13,7 +13,9 @@ stratified, made once and cached in BUILD/perf/reference/. Writes
                                    equal spp and equal samples: what single precision costs
 (BUILD/perf-quick/ with --quick) and, when matplotlib is there (/usr/bin/python3), one log-log plot per scene into docs/img/
 (scripts/plot_perf.py --errors draws them again from the CSV).
-Seconds are streamrt's render clock (-j as given, default 2), median of --runs.
+Seconds are streamrt's render clock (-j as given, default 2), median of --runs. The renders run
+in this process through the streamrt Python module (build/python, docs/python.md): the
+pictures are NumPy arrays, no image file is written but the cached references.
 Scenes with area lights (scenes/soft_shadows.cfg) also get a sweep of --light-samples
 1, 2, ... max-spp at 1 spp, stratified (sampler "light" in the CSV), and their reference
 takes min(--ref-spp, 2 x max-spp) spp (above the sweep's, so no pixel sample is shared) with
@@ -55,12 +57,10 @@ def main(argv=None):
     names = args.scenes.split(",") if args.scenes else (
         ["scenes/whitted.cfg"] if args.quick else ["scenes/whitted.cfg", "scenes/shapes.cfg", "scenes/cornell.cfg",
                                                     "scenes/dof.cfg", "scenes/soft_shadows.cfg"])
-    exe = pc.binary(args.build)
+    rt = pc.module(args.build)
     out_dir = os.path.join(args.build, "perf-quick" if args.quick else "perf")
     ref_dir = os.path.join(out_dir, "reference")
-    img_dir = os.path.join(out_dir, "evt-images")
-    for d in (ref_dir, img_dir):
-        os.makedirs(d, exist_ok=True)
+    os.makedirs(ref_dir, exist_ok=True)
     spps = []
     s = 1
     while s <= max_spp:
@@ -74,40 +74,42 @@ def main(argv=None):
         area = has_area_lights(path)
         ref_spp = min(args.ref_spp, 2 * max_spp) if area else args.ref_spp
         ref_extra = ["--light-samples", str(args.ref_light_samples)] if area else []
+        ref_light = dict(light_samples=args.ref_light_samples) if area else {}
         ref = os.path.join(ref_dir, "%s_%dx%d_%dspp%s.pfm" % (base, w, h, ref_spp,
                                                              "_%dls" % args.ref_light_samples if area else ""))
         if not os.path.exists(ref):
             print("reference: %s, recursive engine, %d spp, stratified %s..." % (base, ref_spp, " ".join(ref_extra)),
                   flush=True)
+            r = rt.render(path, engine="recursive", threads=args.jobs, spp=ref_spp, width=w, height=h,
+                          sampler="stratified", **ref_light)
             tmp = ref + ".tmp.pfm"
-            pc.run_streamrt(exe, path, tmp, engine="recursive", jobs=args.jobs, spp=ref_spp, width=w, height=h,
-                            sampler="stratified", extra=ref_extra)
+            rt.save(r.image, tmp)
             os.replace(tmp, ref)
-        pc.run_streamrt(exe, path, os.path.join(img_dir, "warm.pfm"), jobs=args.jobs, spp=1, width=w, height=h)
+        reference = pc.read_pfm(ref)[2]
+        rt.render(path, threads=args.jobs, spp=1, width=w, height=h)  # warm-up
         for sampler in SAMPLERS:
             for spp in spps:
                 imgs = {}
                 for engine in ENGINES:
-                    out = os.path.join(img_dir, "%s_%s.pfm" % (base, engine))
-                    secs = [pc.run_streamrt(exe, path, out, engine=engine, jobs=args.jobs, spp=spp, width=w, height=h,
-                                            sampler=sampler)["seconds"] for _ in range(args.runs)]
-                    e = pc.image_error(out, ref)
-                    imgs[engine] = out
-                    rows.append(dict(scene=base, engine=engine, sampler=sampler, spp=spp, seconds=pc.median(secs), **e))
+                    runs = [rt.render(path, engine=engine, threads=args.jobs, spp=spp, width=w, height=h,
+                                      sampler=sampler) for _ in range(args.runs)]
+                    e = pc.array_error(runs[-1].image, reference)
+                    imgs[engine] = runs[-1].image
+                    rows.append(dict(scene=base, engine=engine, sampler=sampler, spp=spp,
+                                     seconds=pc.median([r.seconds["render"] for r in runs]), **e))
                     print("[%5.0fs] %-8s %-9s %-10s spp %-3d %7.3f s  rmse %.5f  psnr %5.2f dB  relmse %.5f" % (
                         time.time() - t0, base, engine, sampler, spp, rows[-1]["seconds"], e["rmse"], e["psnr"],
                         e["relmse"]), flush=True)
-                d = pc.image_error(imgs["stream"], imgs["recursive"])
+                d = pc.array_error(imgs["stream"], imgs["recursive"])
                 prec.append(dict(scene=base, sampler=sampler, spp=spp, **d))
         # Area lights: the light samples grow instead (1 spp); the CSV's spp column holds them.
         for ls in spps if area else []:
             for engine in ENGINES:
-                out = os.path.join(img_dir, "%s_%s.pfm" % (base, engine))
-                secs = [pc.run_streamrt(exe, path, out, engine=engine, jobs=args.jobs, spp=1, width=w, height=h,
-                                        sampler="stratified", extra=["--light-samples", str(ls)])["seconds"]
-                        for _ in range(args.runs)]
-                e = pc.image_error(out, ref)
-                rows.append(dict(scene=base, engine=engine, sampler="light", spp=ls, seconds=pc.median(secs), **e))
+                runs = [rt.render(path, engine=engine, threads=args.jobs, spp=1, width=w, height=h,
+                                  sampler="stratified", light_samples=ls) for _ in range(args.runs)]
+                e = pc.array_error(runs[-1].image, reference)
+                rows.append(dict(scene=base, engine=engine, sampler="light", spp=ls,
+                                 seconds=pc.median([r.seconds["render"] for r in runs]), **e))
                 print("[%5.0fs] %-8s %-9s light samples %-3d %7.3f s  rmse %.5f  psnr %5.2f dB" % (
                     time.time() - t0, base, engine, ls, rows[-1]["seconds"], e["rmse"], e["psnr"]), flush=True)
     fields = ["scene", "engine", "sampler", "spp", "seconds", "rmse", "psnr", "relmse"]

@@ -5,6 +5,7 @@ set -euo pipefail
 packages=(g++ cmake ninja-build pkg-config libxsimd-dev xtl-dev libtbb-dev libglm-dev libstb-dev
           doctest-dev libcli11-dev libbenchmark-dev libtinyobjloader-dev python3-matplotlib
           zlib1g-dev libdeflate-dev libopenexr-dev python3-numpy clang-14 libclang-rt-14-dev
+          pybind11-dev python3-dev python3-pytest  # the Python module (docs/python.md) and its tests
           libopenmpi-dev openmpi-bin  # MPI (streamrt --mpi): optional for the build, tested when found
           dpkg-dev)  # dpkg-dev: dpkg-source, for the oneTBB source package (sanitize.sh tsan)
 missing=()

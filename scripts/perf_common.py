@@ -104,6 +104,28 @@ def read_pfm(path):
     return w, h, [v for row in rows for v in row]
 
 
+def module(build_dir):
+    """The streamrt Python module of that build (build/python, docs/python.md)."""
+    path = os.path.join(build_dir, "python")
+    sys.path.insert(0, path)
+    try:
+        import streamrt
+    except ImportError as exc:
+        sys.exit("the streamrt module is not in %s (%s): build first with scripts/build.sh, and run "
+                 "this script with /usr/bin/python3" % (path, exc))
+    return streamrt
+
+
+def array_error(image, reference):
+    """image_error of two height x width x 3 arrays (NumPy)."""
+    a = np.clip(np.nan_to_num(np.asarray(image, np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0, 1)
+    b = np.clip(np.nan_to_num(np.asarray(reference, np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0, 1)
+    e2 = (a - b) ** 2
+    mse = float(e2.mean())
+    psnr = 10 * math.log10(1 / mse) if mse > 0 else float("inf")
+    return {"rmse": math.sqrt(mse), "psnr": psnr, "relmse": float((e2 / (b * b + 1e-2)).mean())}
+
+
 def image_error(image_path, reference_path):
     """RMSE, PSNR (dB) and relative MSE of image against reference, both clamped to [0, 1]
     (non-finite values count as 0), over every pixel component: the definitions of
@@ -113,21 +135,17 @@ def image_error(image_path, reference_path):
     if (wa, ha) != (wb, hb):
         raise ValueError("images of different sizes: %s, %s" % (image_path, reference_path))
     if np is not None:
-        a = np.clip(np.nan_to_num(a.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0, 1)
-        b = np.clip(np.nan_to_num(b.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0, 1)
-        e2 = (a - b) ** 2
-        mse = float(e2.mean())
-        rel = float((e2 / (b * b + 1e-2)).mean())
-    else:
-        def c(v):
-            return min(max(v, 0.0), 1.0) if math.isfinite(v) else 0.0
-        s2 = rel = 0.0
-        for x, y in zip(a, b):
-            x, y = c(x), c(y)
-            e = (x - y) ** 2
-            s2 += e
-            rel += e / (y * y + 1e-2)
-        mse, rel = s2 / len(a), rel / len(a)
+        return array_error(a, b)
+    # No NumPy: the same definitions, value by value.
+    def c(v):
+        return min(max(v, 0.0), 1.0) if math.isfinite(v) else 0.0
+    s2 = rel = 0.0
+    for x, y in zip(a, b):
+        x, y = c(x), c(y)
+        e = (x - y) ** 2
+        s2 += e
+        rel += e / (y * y + 1e-2)
+    mse, rel = s2 / len(a), rel / len(a)
     psnr = 10 * math.log10(1 / mse) if mse > 0 else float("inf")
     return {"rmse": math.sqrt(mse), "psnr": psnr, "relmse": rel}
 

@@ -1,0 +1,129 @@
+#include "driver/render_job.h"
+
+#include <charconv>
+#include <functional>
+#include <utility>
+
+#include "core/error.h"
+#include "kernels/kernel_table.h"
+#include "scene/animation.h"
+#include "scene/scene_bvh.h"
+
+namespace streamrt {
+
+namespace {
+
+int to_int(const std::string& name, const std::string& v) {
+    int out = 0;
+    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), out);
+    if (ec != std::errc() || end != v.data() + v.size()) throw UsageError(name + ": expected an integer, got '" + v + "'");
+    return out;
+}
+double to_double(const std::string& name, const std::string& v) {
+    try {
+        std::size_t used = 0;
+        const double d = std::stod(v, &used);
+        if (used == v.size()) return d;
+    } catch (const std::exception&) {
+    }
+    throw UsageError(name + ": expected a number, got '" + v + "'");
+}
+std::string one_of(const std::string& name, const std::string& v, std::initializer_list<const char*> words) {
+    std::string list;
+    for (const char* w : words) {
+        if (v == w) return v;
+        list += (list.empty() ? "" : ", ") + std::string(w);
+    }
+    throw UsageError(name + ": expected one of " + list + ", got '" + v + "'");
+}
+
+struct Field {
+    const char* name;
+    std::function<void(RenderOverrides&, const std::string&)> set;
+};
+const Field kFields[] = {
+    {"width", [](RenderOverrides& o, const std::string& v) { o.width = to_int("width", v); }},
+    {"height", [](RenderOverrides& o, const std::string& v) { o.height = to_int("height", v); }},
+    {"spp", [](RenderOverrides& o, const std::string& v) { o.spp = to_int("spp", v); }},
+    {"depth", [](RenderOverrides& o, const std::string& v) { o.depth = to_int("depth", v); }},
+    {"degree", [](RenderOverrides& o, const std::string& v) { o.degree = to_int("degree", v); }},
+    {"sampler", [](RenderOverrides& o, const std::string& v) { o.sampler = one_of("sampler", v, {"stratified", "grid", "random"}); }},
+    {"cutoff", [](RenderOverrides& o, const std::string& v) { o.cutoff = to_double("cutoff", v); }},
+    {"light_samples", [](RenderOverrides& o, const std::string& v) { o.light_samples = to_int("light_samples", v); }},
+    {"engine", [](RenderOverrides& o, const std::string& v) { o.engine = one_of("engine", v, {"stream", "recursive"}); }},
+    {"isa", [](RenderOverrides& o, const std::string& v) { o.isa = one_of("isa", v, {"sse2", "sse4.2", "avx2", "avx512"}); }},
+    {"accel", [](RenderOverrides& o, const std::string& v) { o.accel = one_of("accel", v, {"auto", "bvh", "flat"}); }},
+    {"threads", [](RenderOverrides& o, const std::string& v) { o.threads = to_int("threads", v); }},
+    {"frame", [](RenderOverrides& o, const std::string& v) { o.frame = to_int("frame", v); }},
+    {"colorspace", [](RenderOverrides& o, const std::string& v) { o.colorspace = one_of("colorspace", v, {"srgb", "linear"}); }},
+    {"tonemap", [](RenderOverrides& o, const std::string& v) { o.tonemap = one_of("tonemap", v, {"clamp", "reinhard"}); }},
+    {"exposure", [](RenderOverrides& o, const std::string& v) { o.exposure = to_double("exposure", v); }},
+};
+
+}  // namespace
+
+bool set_override(RenderOverrides& o, const std::string& name, const std::string& value) {
+    for (const Field& f : kFields)
+        if (name == f.name) {
+            f.set(o, value);
+            return true;
+        }
+    return false;
+}
+
+std::string override_names() {
+    std::string s;
+    for (const Field& f : kFields) s += (s.empty() ? "" : ", ") + std::string(f.name);
+    return s;
+}
+
+RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile) {
+    RenderJob job;
+    job.scene = std::move(scene);
+    RenderSettings& s = job.scene.settings;
+    const auto in = [](const char* name, int v, int lo, int hi) {
+        if (v < lo || v > hi)
+            throw UsageError(std::string(name) + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                             "], got " + std::to_string(v));
+        return v;
+    };
+    if (o.width) s.width = in("width", *o.width, 1, 32768);
+    if (o.height) s.height = in("height", *o.height, 1, 32768);
+    if (o.spp) s.spp = in("spp", *o.spp, 1, 65536);
+    if (o.depth) s.depth = in("depth", *o.depth, 0, 256);
+    if (o.degree) s.degree = in("degree", *o.degree, 0, 5);
+    if (o.cutoff) {
+        if (!(*o.cutoff >= 0 && *o.cutoff <= 1)) throw UsageError("cutoff must be in [0, 1]");
+        s.cutoff = *o.cutoff;
+    }
+    if (o.light_samples)
+        for (Light& l : job.scene.lights)
+            if (l.is_area()) l.samples = in("light_samples", *o.light_samples, 1, 4096);
+    if (o.sampler)
+        s.pattern = *o.sampler == "grid" ? SamplePattern::Grid
+                    : *o.sampler == "random" ? SamplePattern::Random
+                                             : SamplePattern::Stratified;
+    if (o.colorspace) s.colorspace = *o.colorspace == "linear" ? ColorSpace::Linear : ColorSpace::Srgb;
+    if (o.tonemap) s.tonemap = *o.tonemap == "reinhard" ? Tonemap::Reinhard : Tonemap::Clamp;
+    if (o.exposure) s.exposure = *o.exposure;
+    if (o.frame) {
+        if (*o.frame < 0) throw UsageError("frame must be >= 0");
+        if (job.scene.animation) set_frame(job.scene, *o.frame);
+    }
+    job.engine = o.engine && *o.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
+    job.threads = o.threads.value_or(0);
+    accel::accel_config().mode = !o.accel || *o.accel == "auto" ? accel::AccelMode::Auto
+                                 : *o.accel == "bvh"            ? accel::AccelMode::Bvh
+                                                                : accel::AccelMode::Flat;
+    if (o.isa) {
+        parse_isa(*o.isa, job.options.isa);
+        if (!isa_supported(job.options.isa)) throw UsageError("isa " + *o.isa + ": this CPU does not support it");
+    }
+    if (profile) {
+        job.profile = std::make_unique<StreamProfile>();
+        job.options.profile = job.profile.get();
+    }
+    return job;
+}
+
+}  // namespace streamrt

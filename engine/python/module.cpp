@@ -1,0 +1,259 @@
+// The `streamrt` Python module (docs/python.md): render, profile and compare from Python,
+// pictures as NumPy arrays. It calls the engine's one entry point (driver/render.h) on the
+// render job the command line builds, so a picture from Python is the CLI's picture, bit for
+// bit. Rendering runs on a worker thread with the GIL released; the calling thread waits,
+// looking at Python's signals (Ctrl-C becomes KeyboardInterrupt, the render is cancelled
+// within a chunk) and calling the progress callback.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "core/error.h"
+#include "driver/render.h"
+#include "driver/render_job.h"
+#include "image/image_compare.h"
+#include "image/image_io.h"
+#include "parallel/parallelism.h"
+#include "scene/parser.h"
+
+namespace py = pybind11;
+using namespace streamrt;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// A scene given as a path to a .cfg file, or as the text of one (anything that is not an
+/// existing file): the text's messages name it "<string>".
+Scene read_scene(const std::string& scene, int threads) {
+    std::error_code ec;
+    if (scene.find('\n') == std::string::npos && std::filesystem::is_regular_file(scene, ec))
+        return load_scene(scene, threads);
+    ReadOptions options;
+    options.jobs = threads;
+    return parse_scene(scene, "<string>", options);
+}
+
+/// The picture as a float32 NumPy array, height x width x 3, top row first, owning the
+/// framebuffer's memory (no copy).
+py::array_t<float> to_array(Framebuffer&& fb) {
+    auto* owned = new Framebuffer(std::move(fb));
+    py::capsule free_it(owned, [](void* p) { delete static_cast<Framebuffer*>(p); });
+    const py::ssize_t h = owned->height, w = owned->width;
+    return py::array_t<float>({h, w, py::ssize_t(3)},
+                              {py::ssize_t(sizeof(float)) * w * 3, py::ssize_t(sizeof(float)) * 3,
+                               py::ssize_t(sizeof(float))},
+                              owned->rgb.data(), free_it);
+}
+
+/// One finished render, as Python sees it.
+struct Result {
+    py::array_t<float> image;
+    py::dict seconds, rays;
+    py::object profile = py::none();
+    std::string engine;
+};
+
+/// Renders `job` on a worker thread while this (the Python) thread waits with the GIL
+/// released, waking every 50 ms to run Python's signal handlers and the progress callback.
+/// A pending KeyboardInterrupt (or an exception from the callback) cancels the render.
+RenderResult render_watched(RenderJob& job, EngineKind engine, const py::object& progress) {
+    std::atomic<bool> cancel{false};
+    RenderProgress watch;
+    watch.cancel = &cancel;
+    RenderResult result;
+    std::exception_ptr failure;
+    std::atomic<bool> done{false};
+    std::thread worker([&] {
+        try {
+            Parallelism par(job.threads);
+            auto prepared = prepare_render(job.scene, engine, job.options);
+            watch.tiles_total = tile_count(prepared->width, prepared->height);
+            result = render_prepared(*prepared, par, &watch);
+        } catch (...) {
+            failure = std::current_exception();
+        }
+        done = true;
+    });
+    std::optional<py::error_already_set> interrupted;
+    int reported = -1;
+    while (!done) {
+        {
+            py::gil_scoped_release release;
+            for (int i = 0; i < 10 && !done; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
+        if (interrupted) continue;  // cancelled: wait for the worker to stop
+        if (PyErr_CheckSignals() != 0) {
+            interrupted.emplace();  // takes the pending exception (KeyboardInterrupt)
+            cancel = true;
+            continue;
+        }
+        const int tiles = watch.tiles_done.load();
+        if (!progress.is_none() && tiles != reported) {
+            reported = tiles;
+            try {
+                progress(tiles, watch.tiles_total);
+            } catch (py::error_already_set& e) {
+                interrupted.emplace(std::move(e));
+                cancel = true;
+            }
+        }
+    }
+    {
+        py::gil_scoped_release release;
+        worker.join();
+    }
+    if (interrupted) throw std::move(*interrupted);
+    if (failure) std::rethrow_exception(failure);
+    if (!progress.is_none()) progress(watch.tiles_total, watch.tiles_total);
+    return result;
+}
+
+Result make_result(RenderResult&& r, const RenderJob& job, EngineKind engine, double read_seconds) {
+    Result out;
+    out.engine = engine_name(engine);
+    out.seconds["read"] = read_seconds;
+    out.seconds["setup"] = r.setup_seconds;
+    out.seconds["render"] = r.seconds;
+    out.rays["primary"] = r.counts.primary;
+    out.rays["shadow"] = r.counts.shadow;
+    out.rays["reflected"] = r.counts.reflected;
+    out.rays["refracted"] = r.counts.refracted;
+    out.rays["total"] = r.counts.total();
+    if (job.profile && engine == EngineKind::Stream)
+        out.profile = py::module_::import("json").attr("loads")(job.profile->json());
+    out.image = to_array(std::move(r.image));
+    return out;
+}
+
+/// The keyword arguments every call takes, as the command line's overrides.
+RenderOverrides overrides_of(const py::kwargs& kw, bool& profile, py::object& progress) {
+    RenderOverrides o;
+    for (const auto& [key, value] : kw) {
+        const std::string k = py::str(key);
+        if (value.is_none()) continue;
+        if (k == "profile") profile = value.cast<bool>();
+        else if (k == "progress") progress = py::reinterpret_borrow<py::object>(value);
+        else if (!set_override(o, k, py::str(value).cast<std::string>()))
+            throw py::type_error("unexpected keyword argument '" + k + "' (expected one of: " + override_names() +
+                                 ", profile, progress)");
+    }
+    return o;
+}
+
+Result render(const std::string& scene, const py::kwargs& kw) {
+    bool profile = false;
+    py::object progress = py::none();
+    const RenderOverrides o = overrides_of(kw, profile, progress);
+    const auto start = Clock::now();
+    Scene sc;
+    {
+        py::gil_scoped_release release;
+        sc = read_scene(scene, o.threads.value_or(0));
+    }
+    const double read_seconds = since(start);
+    RenderJob job = build_render_job(std::move(sc), o, profile);
+    RenderResult r = render_watched(job, job.engine, progress);
+    return make_result(std::move(r), job, job.engine, read_seconds);
+}
+
+py::dict compare(const std::string& scene, const py::kwargs& kw) {
+    bool profile = false;
+    py::object progress = py::none();
+    const RenderOverrides o = overrides_of(kw, profile, progress);
+    const auto start = Clock::now();
+    Scene sc;
+    {
+        py::gil_scoped_release release;
+        sc = read_scene(scene, o.threads.value_or(0));
+    }
+    const double read_seconds = since(start);
+    RenderJob job = build_render_job(std::move(sc), o, profile);
+    RenderResult stream = render_watched(job, EngineKind::Stream, progress);
+    RenderResult recursive = render_watched(job, EngineKind::Recursive, progress);
+    const ImageDifference d = compare_images(stream.image, recursive.image);
+    py::dict out;
+    out["speedup"] = recursive.seconds / std::max(stream.seconds, 1e-9);
+    out["rmse"] = d.rmse;
+    out["psnr"] = d.psnr;
+    out["max_abs"] = d.max_abs;
+    out["share_over"] = d.share_over;
+    out["stream"] = make_result(std::move(stream), job, EngineKind::Stream, read_seconds);
+    out["recursive"] = make_result(std::move(recursive), job, EngineKind::Recursive, read_seconds);
+    return out;
+}
+
+void save(py::array_t<float, py::array::c_style | py::array::forcecast> image, const std::string& path,
+          const std::string& colorspace, const std::string& tonemap, double exposure) {
+    if (image.ndim() != 3 || image.shape(2) != 3)
+        throw py::value_error("expected an image of shape (height, width, 3)");
+    Framebuffer fb = Framebuffer::uninitialized(int(image.shape(1)), int(image.shape(0)));
+    std::copy(image.data(), image.data() + fb.rgb.size(), fb.rgb.begin());
+    Display d;
+    if (colorspace == "linear") d.colorspace = ColorSpace::Linear;
+    else if (colorspace != "srgb") throw py::value_error("colorspace: expected 'srgb' or 'linear'");
+    if (tonemap == "reinhard") d.tonemap = Tonemap::Reinhard;
+    else if (tonemap != "clamp") throw py::value_error("tonemap: expected 'clamp' or 'reinhard'");
+    d.exposure = float(exposure);
+    py::gil_scoped_release release;
+    write_image(path, fb, d);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(streamrt, m) {
+    m.doc() = "streamrt: a SIMD ray-stream ray tracer and its recursive baseline (docs/python.md).";
+
+    static py::exception<SceneError> scene_error(m, "SceneError", PyExc_ValueError);
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const SceneError& e) {
+            py::object err = py::reinterpret_borrow<py::object>(scene_error.ptr())(py::str(e.what()));
+            err.attr("file") = e.where().file;
+            err.attr("line") = e.where().line;
+            err.attr("column") = e.where().column;
+            err.attr("message") = e.message();
+            PyErr_SetObject(scene_error.ptr(), err.ptr());
+        } catch (const UsageError& e) {
+            PyErr_SetString(PyExc_ValueError, e.what());
+        } catch (const RenderError& e) {
+            PyErr_SetString(PyExc_RuntimeError, e.what());
+        }
+    });
+
+    py::class_<Result>(m, "Result", "One render: the picture, its times, its rays and (profile=True) the stream profile.")
+        .def_readonly("image", &Result::image, "float32 array, height x width x 3, linear, top row first")
+        .def_readonly("seconds", &Result::seconds, "{'read', 'setup', 'render'}: seconds")
+        .def_readonly("rays", &Result::rays, "{'primary', 'shadow', 'reflected', 'refracted', 'total'}")
+        .def_readonly("profile", &Result::profile, "the content of --profile=json as a dict, or None")
+        .def_readonly("engine", &Result::engine, "'stream' or 'recursive'")
+        .def("__repr__", [](const Result& r) {
+            return "<streamrt.Result " + r.engine + " " + std::to_string(r.image.shape(1)) + "x" +
+                   std::to_string(r.image.shape(0)) + ", " + py::str(r.seconds["render"]).cast<std::string>() + " s>";
+        });
+
+    m.def("render", &render, py::arg("scene"),
+          "render(scene, **overrides) -> Result\n\n"
+          "scene: a path to a .cfg file or the text of one. overrides: the command line's\n"
+          "(width, height, spp, depth, degree, sampler, cutoff, light_samples, engine, isa, accel,\n"
+          "threads, frame), profile=True for the stream profile, progress=callable(done, total).");
+    m.def("compare", &compare, py::arg("scene"),
+          "compare(scene, **overrides) -> dict: both engines' Results ('stream', 'recursive') and\n"
+          "their difference ('speedup', 'rmse', 'psnr', 'max_abs', 'share_over').");
+    m.def("save", &save, py::arg("image"), py::arg("path"), py::arg("colorspace") = "srgb",
+          py::arg("tonemap") = "clamp", py::arg("exposure") = 1.0,
+          "save(image, path, colorspace='srgb', tonemap='clamp', exposure=1.0): writes a linear\n"
+          "height x width x 3 image in the format of the path's extension (.png, .ppm, .pfm, .exr, .hdr).");
+}

@@ -1,0 +1,62 @@
+"""Type stubs of the streamrt module (docs/python.md)."""
+from typing import Any, Callable, Optional, TypedDict
+
+import numpy as np
+import numpy.typing as npt
+
+class SceneError(ValueError):
+    """A mistake in a scene: where it is and what is wrong."""
+    file: str
+    line: int
+    column: int
+    message: str
+
+class Result:
+    """One render."""
+    @property
+    def image(self) -> npt.NDArray[np.float32]:
+        """height x width x 3, linear, top row first: the numbers of the CLI's PFM."""
+    @property
+    def seconds(self) -> dict[str, float]:
+        """'read', 'setup', 'render'."""
+    @property
+    def rays(self) -> dict[str, int]:
+        """'primary', 'shadow', 'reflected', 'refracted', 'total'."""
+    @property
+    def profile(self) -> Optional[dict[str, Any]]:
+        """The content of --profile=json (stream engine, profile=True), else None."""
+    @property
+    def engine(self) -> str:
+        """'stream' or 'recursive'."""
+
+def render(
+    scene: str,
+    *,
+    width: Optional[int] = ...,
+    height: Optional[int] = ...,
+    spp: Optional[int] = ...,
+    depth: Optional[int] = ...,
+    degree: Optional[int] = ...,
+    sampler: Optional[str] = ...,
+    cutoff: Optional[float] = ...,
+    light_samples: Optional[int] = ...,
+    engine: Optional[str] = ...,
+    isa: Optional[str] = ...,
+    accel: Optional[str] = ...,
+    threads: Optional[int] = ...,
+    frame: Optional[int] = ...,
+    colorspace: Optional[str] = ...,
+    tonemap: Optional[str] = ...,
+    exposure: Optional[float] = ...,
+    profile: bool = ...,
+    progress: Optional[Callable[[int, int], None]] = ...,
+) -> Result:
+    """Renders a scene (a .cfg path or its text) with the command line's overrides."""
+
+def compare(scene: str, **overrides: Any) -> dict[str, Any]:
+    """Both engines: 'stream' and 'recursive' Results, 'speedup', 'rmse', 'psnr', 'max_abs', 'share_over'."""
+
+def save(
+    image: npt.ArrayLike, path: str, colorspace: str = ..., tonemap: str = ..., exposure: float = ...
+) -> None:
+    """Writes a linear height x width x 3 image in the format of the path's extension."""

@@ -1,0 +1,128 @@
+"""The streamrt Python module (docs/python.md), run by ctest with Debian's pytest.
+
+Every expected value comes from outside the module: the command line's PFM, files parsed here,
+or values worked out from the scene text."""
+import os
+import pathlib
+import signal
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+import streamrt
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+STREAMRT = os.environ.get("STREAMRT_BINARY", str(ROOT / "build/engine/streamrt"))
+WHITTED = str(ROOT / "scenes/whitted.cfg")
+
+
+def read_pfm(path):
+    """A PFM read here, independently of the engine: header, then rows from the bottom."""
+    data = pathlib.Path(path).read_bytes()
+    parts = data.split(b"\n", 3)
+    assert parts[0] == b"PF"
+    width, height = map(int, parts[1].split())
+    assert float(parts[2]) < 0  # little-endian
+    rows = np.frombuffer(parts[3], dtype="<f4", count=width * height * 3).reshape(height, width, 3)
+    return rows[::-1]
+
+
+def cli_pfm(scene, *args):
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "x.pfm")
+        subprocess.run([STREAMRT, scene, "-q", "-o", out, *args], check=True)
+        return read_pfm(out)
+
+
+def test_image_is_the_command_lines_pfm_bit_for_bit():
+    r = streamrt.render(WHITTED, width=96, height=64, spp=2)
+    assert r.image.shape == (64, 96, 3)
+    assert r.image.dtype == np.float32
+    np.testing.assert_array_equal(r.image, cli_pfm(WHITTED, "--width", "96", "--height", "64", "--spp", "2"))
+    assert r.engine == "stream"
+    assert r.rays["primary"] == 96 * 64 * 2
+    assert set(r.seconds) == {"read", "setup", "render"}
+
+
+@pytest.mark.parametrize(
+    "overrides, flags",
+    [
+        (dict(depth=1, degree=3), ["--depth", "1", "--degree", "3"]),
+        (dict(sampler="random", spp=3), ["--sampler", "random", "--spp", "3"]),
+        (dict(cutoff=0.05), ["--cutoff", "0.05"]),
+        (dict(engine="recursive"), ["--engine", "recursive"]),
+        (dict(isa="sse2", accel="bvh"), ["--isa", "sse2", "--accel", "bvh"]),
+        (dict(accel="flat", threads=1), ["--accel", "flat", "-j", "1"]),
+    ],
+)
+def test_overrides_give_the_command_lines_picture(overrides, flags):
+    size = dict(width=48, height=32)
+    r = streamrt.render(WHITTED, **size, **overrides)
+    np.testing.assert_array_equal(r.image, cli_pfm(WHITTED, "--width", "48", "--height", "32", *flags))
+
+
+def test_scene_text_and_flat_colours():
+    # Degree 0: the flat colour of what a ray hits. A red sphere in front of the camera
+    # covers the centre; the corners see the background.
+    text = "image width=9 height=9 degree=0\nbackground 0,0,1\ncamera eye=0,0,5 look=0,0,0 fov=30\nsphere color=1,0,0\n"
+    img = streamrt.render(text).image
+    np.testing.assert_array_equal(img[4, 4], [1, 0, 0])
+    np.testing.assert_array_equal(img[0, 0], [0, 0, 1])
+
+
+def test_scene_errors_carry_file_line_and_column():
+    with pytest.raises(streamrt.SceneError) as e:
+        streamrt.render("image width=9\nsphere colour=1,0,0\n")
+    assert (e.value.file, e.value.line, e.value.column) == ("<string>", 2, 8)
+    assert "unknown key 'colour'" in e.value.message
+    assert str(e.value).startswith("<string>:2:8: unknown key 'colour'")
+    with pytest.raises(TypeError, match="unexpected keyword argument 'spp_'"):
+        streamrt.render(WHITTED, spp_=2)
+    with pytest.raises(ValueError, match="sampler"):
+        streamrt.render(WHITTED, sampler="halton")
+    with pytest.raises(ValueError, match="spp must be in"):
+        streamrt.render(WHITTED, spp=0)
+
+
+def test_profile_is_the_json_of_the_command_line():
+    r = streamrt.render(WHITTED, width=32, height=32, profile=True)
+    assert r.profile is not None
+    assert r.profile["isa"]
+    assert streamrt.render(WHITTED, width=32, height=32).profile is None
+
+
+def test_progress_reaches_every_tile():
+    seen = []
+    streamrt.render(WHITTED, width=64, height=48, progress=lambda done, total: seen.append((done, total)))
+    assert seen[-1] == (12, 12)  # 64x48 in 16x16 tiles
+    assert all(d <= t for d, t in seen)
+
+
+def test_ctrl_c_cancels_the_render_and_raises_keyboard_interrupt():
+    # Far too big to finish: the interrupt (sent at the first progress report) must stop it.
+    calls = []
+
+    def interrupt(done, total):
+        calls.append((done, total))
+        if len(calls) == 1:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt):
+        streamrt.render(WHITTED, width=4096, height=4096, spp=64, progress=interrupt)
+    assert len(calls) == 1  # nothing reported after the interrupt: the render stopped
+    assert calls[0][0] < calls[0][1]
+
+
+def test_compare_and_save_round_trip(tmp_path):
+    c = streamrt.compare(WHITTED, width=48, height=32)
+    assert c["stream"].engine == "stream" and c["recursive"].engine == "recursive"
+    assert c["psnr"] > 50
+    rmse = float(np.sqrt(np.mean((np.clip(c["stream"].image, 0, 1) - np.clip(c["recursive"].image, 0, 1)) ** 2)))
+    assert c["rmse"] == pytest.approx(rmse, rel=1e-6)
+    img = c["stream"].image
+    streamrt.save(img, str(tmp_path / "x.pfm"))
+    np.testing.assert_array_equal(read_pfm(tmp_path / "x.pfm"), img)
+    with pytest.raises(ValueError):
+        streamrt.save(np.zeros((4, 4)), str(tmp_path / "bad.png"))
