@@ -32,6 +32,7 @@
 #include "parallel/parallelism.h"
 #include "driver/limits.h"
 #include "driver/render.h"
+#include "driver/render_job.h"
 #include "scene/animation.h"
 #include "scene/parser.h"
 
@@ -199,6 +200,7 @@ int report_error(std::exception_ptr error, bool quiet = false) {
 /// A render ready to go: the scene with the command line's settings, the engine's options.
 struct Job {
     Scene scene;
+    PixelSettings settings;  ///< everything the pixels depend on beside the scene's files
     EngineKind engine = EngineKind::Stream;
     EngineOptions eo;
     std::unique_ptr<StreamProfile> profile;  ///< when profiling (eo.profile points to it)
@@ -206,29 +208,40 @@ struct Job {
     int frame = -1;  ///< the frame being rendered (animation; -1: a still picture)
 };
 
+/// The command line's overrides of the scene's settings (driver/render_job.h: the Python
+/// module builds its jobs from the same record).
+RenderOverrides overrides_of(const Options& opt) {
+    RenderOverrides o;
+    o.width = opt.width, o.height = opt.height, o.spp = opt.spp, o.depth = opt.depth, o.degree = opt.degree;
+    o.cutoff = opt.cutoff, o.light_samples = opt.light_samples, o.exposure = opt.exposure;
+    const auto text = [](const std::string& v) { return v.empty() ? std::nullopt : std::optional<std::string>(v); };
+    o.sampler = text(opt.sampler), o.colorspace = text(opt.colorspace), o.tonemap = text(opt.tonemap);
+    o.engine = opt.engine, o.accel = opt.accel, o.shade = opt.shade;
+    o.threads = opt.jobs;
+    return o;
+}
+
 /// Applies the command line to a loaded scene and checks everything before rendering.
 /// `writes`: this process writes the output (false on MPI ranks other than 0).
 /// `check_isa`: --isa must be supported here (MPI ranks agree on it together instead).
 Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
+    if (!opt.isa.empty() && opt.engine == "recursive" && !opt.compare)
+        throw UsageError("--isa chooses the stream engine's kernels; the recursive engine has none (scalar, double)");
+    if ((opt.profile || !opt.profile_json.empty()) && opt.engine != "stream" && !opt.compare)
+        throw UsageError("--profile needs the stream engine");
+    RenderOverrides overrides = overrides_of(opt);
+    if (check_isa && !opt.isa.empty()) overrides.isa = opt.isa;  // checked against this CPU there
+    RenderJob built = build_render_job(std::move(scene), overrides, opt.profile || !opt.profile_json.empty());
     Job job;
-    job.scene = std::move(scene);
+    job.scene = std::move(built.scene);
+    job.settings = built.settings;
+    job.engine = built.engine;
+    job.eo = built.options;
+    job.profile = std::move(built.profile);
+    if (!check_isa && !opt.isa.empty()) parse_isa(opt.isa, job.eo.isa);  // MPI: the ranks agree on it later
+    job.settings.isa = job.eo.isa;
     RenderSettings& s = job.scene.settings;
-    if (opt.spp) s.spp = *opt.spp;
-    if (opt.width) s.width = *opt.width;
-    if (opt.height) s.height = *opt.height;
-    if (opt.degree) s.degree = *opt.degree;
-    if (opt.depth) s.depth = *opt.depth;
-    if (opt.cutoff) s.cutoff = *opt.cutoff;
-    if (opt.light_samples)
-        for (Light& l : job.scene.lights)
-            if (l.is_area()) l.samples = *opt.light_samples;
-    if (opt.sampler == "grid") s.pattern = SamplePattern::Grid;
-    if (opt.sampler == "random") s.pattern = SamplePattern::Random;
-    if (opt.sampler == "stratified") s.pattern = SamplePattern::Stratified;
     if (!opt.output.empty()) s.output = opt.output;
-    if (!opt.colorspace.empty()) s.colorspace = opt.colorspace == "linear" ? ColorSpace::Linear : ColorSpace::Srgb;
-    if (!opt.tonemap.empty()) s.tonemap = opt.tonemap == "reinhard" ? Tonemap::Reinhard : Tonemap::Clamp;
-    if (opt.exposure) s.exposure = *opt.exposure;
     if (opt.mpi && s.frames_last > s.frames_first)
         throw UsageError("--mpi renders one picture, the scene's image frames= asks for several (render them as a job "
                          "array, docs/distributed.md)");
@@ -240,28 +253,8 @@ Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
         if (!opt.tile_costs.empty()) check_writable_path(opt.tile_costs, opt.scene_path);
     }
     // Refuse, before allocating anything big, a render that cannot fit in this machine.
-    job.engine = opt.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
     const int jobs = opt.jobs > 0 ? opt.jobs : default_jobs();
     check_render_memory(job.scene, job.engine == EngineKind::Stream || opt.compare, jobs);
-    accel::accel_config().mode = opt.accel == "bvh"    ? accel::AccelMode::Bvh
-                                 : opt.accel == "flat" ? accel::AccelMode::Flat
-                                                       : accel::AccelMode::Auto;
-    if (!opt.isa.empty()) {
-        if (job.engine == EngineKind::Recursive && !opt.compare)
-            throw UsageError("--isa chooses the stream engine's kernels; the recursive engine has none (scalar, double)");
-        parse_isa(opt.isa, job.eo.isa);
-        if (check_isa && !isa_supported(job.eo.isa))
-            throw UsageError("--isa " + opt.isa + ": this CPU does not support it");
-    }
-    job.eo.shade = opt.shade == "scalar"     ? ShadeMode::Scalar
-                   : opt.shade == "sorted"   ? ShadeMode::Sorted
-                   : opt.shade == "gathered" ? ShadeMode::Gathered
-                                             : ShadeMode::Auto;
-    if (opt.profile || !opt.profile_json.empty()) {
-        if (job.engine != EngineKind::Stream && !opt.compare) throw UsageError("--profile needs the stream engine");
-        job.profile = std::make_unique<StreamProfile>();
-        job.eo.profile = job.profile.get();
-    }
     return job;
 }
 
@@ -318,8 +311,10 @@ int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBund
     }
     TileFileHeader header;
     header.scene = bundle.content_hash();
-    header.settings = render_settings_token(s, job.engine, job.eo, opt.accel);
-    if (job.frame >= 0) header.settings += ",frame=" + std::to_string(job.frame);  // parts of one frame only
+    PixelSettings settings = job.settings;
+    settings.isa = job.eo.isa;  // MPI: the level the ranks agreed on
+    settings.frame = job.frame;  // parts of one frame only
+    header.settings = settings_token(settings);
     header.width = s.width;
     header.height = s.height;
     header.tiles = tile_count(s.width, s.height);

@@ -118,39 +118,15 @@ std::string TileFileHeader::setting(std::string_view key) const {
     return "";
 }
 
-std::string render_settings_token(const RenderSettings& s, EngineKind engine, const EngineOptions& options,
-                                  const std::string& accel) {
-    const char* sampler = s.pattern == SamplePattern::Grid     ? "grid"
-                          : s.pattern == SamplePattern::Random ? "random"
-                                                               : "stratified";
-    const char* shade = options.shade == ShadeMode::Scalar     ? "scalar"
-                        : options.shade == ShadeMode::Sorted   ? "sorted"
-                        : options.shade == ShadeMode::Gathered ? "gathered"
-                                                               : "simd";
-    return "spp=" + std::to_string(s.spp) + ",degree=" + std::to_string(s.degree) + ",depth=" + std::to_string(s.depth) +
-           ",sampler=" + sampler + ",engine=" + engine_name(engine) +
-           ",isa=" + (engine == EngineKind::Stream ? isa_name(options.isa) : "none") + ",accel=" + accel +
-           ",shade=" + shade + ",calibration=" + (s.calibration == Calibration::Normalize ? "normalize" : "clamp") +
-           display_settings_token(s);
-}
-
-std::string display_settings_token(const RenderSettings& s) {
-    char exposure[32];
-    std::snprintf(exposure, sizeof exposure, "%.17g", s.exposure);
-    return std::string(",colorspace=") + (s.colorspace == ColorSpace::Linear ? "linear" : "srgb") +
-           ",tonemap=" + (s.tonemap == Tonemap::Reinhard ? "reinhard" : "clamp") + ",exposure=" + exposure +
-           ",exr=" + (s.exr == ExrPixels::Float ? "float" : "half");
-}
-
 void apply_display_settings(const TileFileHeader& h, RenderSettings& s) {
-    s.calibration = h.setting("calibration") == "normalize" ? Calibration::Normalize : Calibration::Clamp;
-    // Parts written before the display keys existed hold the handout's linear output.
-    s.colorspace = h.setting("colorspace") == "srgb" ? ColorSpace::Srgb : ColorSpace::Linear;
-    s.tonemap = h.setting("tonemap") == "reinhard" ? Tonemap::Reinhard : Tonemap::Clamp;
+    // The names of the settings token (driver/render_job.h, settings_token).
+    s.calibration = value_named(kCalibrationNames, h.setting("calibration")).value_or(Calibration::Clamp);
+    s.colorspace = value_named(kColorSpaceNames, h.setting("colorspace")).value_or(ColorSpace::Srgb);
+    s.tonemap = value_named(kTonemapNames, h.setting("tonemap")).value_or(Tonemap::Clamp);
     const std::string e = h.setting("exposure");
     const double exposure = e.empty() ? 1.0 : std::strtod(e.c_str(), nullptr);
     s.exposure = exposure > 0 ? exposure : 1.0;
-    s.exr = h.setting("exr") == "float" ? ExrPixels::Float : ExrPixels::Half;
+    s.exr = value_named(kExrPixelsNames, h.setting("exr")).value_or(ExrPixels::Half);
 }
 
 void append_tile_record(std::string& out, const TileOutput& t) {

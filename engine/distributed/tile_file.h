@@ -35,14 +35,8 @@ struct TileFileHeader {
     std::string setting(std::string_view key) const;
 };
 
-/// The settings token of a render: size, samples, degree, depth, sampler, engine, kernels,
-/// hierarchy, shade grouping and calibration (all the pixels and the written file depend on).
-std::string render_settings_token(const RenderSettings& s, EngineKind engine, const EngineOptions& options,
-                                  const std::string& accel);
-
-/// The display colour part of that token (",colorspace=...,tonemap=...,exposure=...,exr=..."),
-/// and the settings a merge writes the image with, read back from a part's header.
-std::string display_settings_token(const RenderSettings& s);
+/// The display settings a merge writes the image with, read back from a part's header (its
+/// settings token, driver/render_job.h).
 void apply_display_settings(const TileFileHeader& h, RenderSettings& s);
 
 /// Reads shard parts (streamrt --shard) and puts the image together. Throws UsageError, one

@@ -9,7 +9,7 @@
 
 namespace streamrt {
 
-const char* engine_name(EngineKind e) { return e == EngineKind::Stream ? "stream" : "recursive"; }
+const char* engine_name(EngineKind e) { return name_of(kEngineNames, e).data(); }  // the literals end in NUL
 
 namespace {
 

@@ -18,6 +18,7 @@
 namespace streamrt {
 
 enum class EngineKind { Stream, Recursive };
+inline constexpr EnumName<EngineKind> kEngineNames[] = {{EngineKind::Stream, "stream"}, {EngineKind::Recursive, "recursive"}};
 const char* engine_name(EngineKind e);
 
 struct RenderResult {

@@ -1,6 +1,8 @@
 #include "driver/render_job.h"
 
 #include <charconv>
+#include <cstdio>
+#include <type_traits>
 #include <functional>
 #include <utility>
 
@@ -28,13 +30,10 @@ double to_double(const std::string& name, const std::string& v) {
     }
     throw UsageError(name + ": expected a number, got '" + v + "'");
 }
-std::string one_of(const std::string& name, const std::string& v, std::initializer_list<const char*> words) {
-    std::string list;
-    for (const char* w : words) {
-        if (v == w) return v;
-        list += (list.empty() ? "" : ", ") + std::string(w);
-    }
-    throw UsageError(name + ": expected one of " + list + ", got '" + v + "'");
+template <class E, std::size_t N>
+std::string one_of(const std::string& name, const std::string& v, const EnumName<E> (&names)[N]) {
+    if (value_named(names, v)) return v;
+    throw UsageError(name + ": expected " + names_list(names) + ", got '" + v + "'");
 }
 
 struct Field {
@@ -47,18 +46,36 @@ const Field kFields[] = {
     {"spp", [](RenderOverrides& o, const std::string& v) { o.spp = to_int("spp", v); }},
     {"depth", [](RenderOverrides& o, const std::string& v) { o.depth = to_int("depth", v); }},
     {"degree", [](RenderOverrides& o, const std::string& v) { o.degree = to_int("degree", v); }},
-    {"sampler", [](RenderOverrides& o, const std::string& v) { o.sampler = one_of("sampler", v, {"stratified", "grid", "random"}); }},
+    {"sampler", [](RenderOverrides& o, const std::string& v) { o.sampler = one_of("sampler", v, kSamplePatternNames); }},
     {"cutoff", [](RenderOverrides& o, const std::string& v) { o.cutoff = to_double("cutoff", v); }},
     {"light_samples", [](RenderOverrides& o, const std::string& v) { o.light_samples = to_int("light_samples", v); }},
-    {"engine", [](RenderOverrides& o, const std::string& v) { o.engine = one_of("engine", v, {"stream", "recursive"}); }},
-    {"isa", [](RenderOverrides& o, const std::string& v) { o.isa = one_of("isa", v, {"sse2", "sse4.2", "avx2", "avx512"}); }},
-    {"accel", [](RenderOverrides& o, const std::string& v) { o.accel = one_of("accel", v, {"auto", "bvh", "flat"}); }},
+    {"engine", [](RenderOverrides& o, const std::string& v) { o.engine = one_of("engine", v, kEngineNames); }},
+    {"isa", [](RenderOverrides& o, const std::string& v) { o.isa = one_of("isa", v, kIsaNames); }},
+    {"accel", [](RenderOverrides& o, const std::string& v) { o.accel = one_of("accel", v, accel::kAccelModeNames); }},
     {"threads", [](RenderOverrides& o, const std::string& v) { o.threads = to_int("threads", v); }},
     {"frame", [](RenderOverrides& o, const std::string& v) { o.frame = to_int("frame", v); }},
-    {"colorspace", [](RenderOverrides& o, const std::string& v) { o.colorspace = one_of("colorspace", v, {"srgb", "linear"}); }},
-    {"tonemap", [](RenderOverrides& o, const std::string& v) { o.tonemap = one_of("tonemap", v, {"clamp", "reinhard"}); }},
+    {"colorspace", [](RenderOverrides& o, const std::string& v) { o.colorspace = one_of("colorspace", v, kColorSpaceNames); }},
+    {"tonemap", [](RenderOverrides& o, const std::string& v) { o.tonemap = one_of("tonemap", v, kTonemapNames); }},
     {"exposure", [](RenderOverrides& o, const std::string& v) { o.exposure = to_double("exposure", v); }},
+    {"shade", [](RenderOverrides& o, const std::string& v) { o.shade = one_of("shade", v, kShadeModeNames); }},
 };
+
+// The token's spelling of each kind of field.
+std::string token_value(int v) { return std::to_string(v); }
+std::string token_value(double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+}
+std::string token_value(SamplePattern v) { return std::string(name_of(kSamplePatternNames, v)); }
+std::string token_value(Calibration v) { return std::string(name_of(kCalibrationNames, v)); }
+std::string token_value(ColorSpace v) { return std::string(name_of(kColorSpaceNames, v)); }
+std::string token_value(Tonemap v) { return std::string(name_of(kTonemapNames, v)); }
+std::string token_value(ExrPixels v) { return std::string(name_of(kExrPixelsNames, v)); }
+std::string token_value(EngineKind v) { return std::string(name_of(kEngineNames, v)); }
+std::string token_value(Isa v) { return std::string(name_of(kIsaNames, v)); }
+std::string token_value(accel::AccelMode v) { return std::string(name_of(accel::kAccelModeNames, v)); }
+std::string token_value(ShadeMode v) { return std::string(name_of(kShadeModeNames, v)); }
 
 }  // namespace
 
@@ -75,6 +92,21 @@ std::string override_names() {
     std::string s;
     for (const Field& f : kFields) s += (s.empty() ? "" : ", ") + std::string(f.name);
     return s;
+}
+
+std::string settings_token(const PixelSettings& s) {
+    std::string token;
+    s.for_each_field([&](const char* name, const auto& value) {
+        if (!token.empty()) token += ',';
+        token += name;
+        token += '=';
+        // The recursive engine has no kernels: its pixels do not depend on the level.
+        if constexpr (std::is_same_v<std::decay_t<decltype(value)>, Isa>)
+            token += s.engine == EngineKind::Stream ? token_value(value) : "none";
+        else
+            token += token_value(value);
+    });
+    return token;
 }
 
 RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile) {
@@ -119,10 +151,19 @@ RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile) 
         parse_isa(*o.isa, job.options.isa);
         if (!isa_supported(job.options.isa)) throw UsageError("isa " + *o.isa + ": this CPU does not support it");
     }
+    if (o.shade) job.options.shade = *value_named(kShadeModeNames, *o.shade);
     if (profile) {
         job.profile = std::make_unique<StreamProfile>();
         job.options.profile = job.profile.get();
     }
+    PixelSettings& p = job.settings;
+    p.width = s.width, p.height = s.height, p.spp = s.spp, p.depth = s.depth, p.degree = s.degree;
+    p.light_samples = o.light_samples.value_or(0);
+    p.frame = o.frame.value_or(-1);
+    p.cutoff = s.cutoff, p.exposure = s.exposure;
+    p.sampler = s.pattern, p.calibration = s.calibration, p.colorspace = s.colorspace, p.tonemap = s.tonemap;
+    p.exr = s.exr;
+    p.engine = job.engine, p.isa = job.options.isa, p.accel = accel::accel_config().mode, p.shade = job.options.shade;
     return job;
 }
 

@@ -21,23 +21,12 @@ Isa best_isa() {
     return Isa::Sse2;
 }
 
-const char* isa_name(Isa isa) {
-    switch (isa) {
-        case Isa::Sse2: return "sse2";
-        case Isa::Sse42: return "sse4.2";
-        case Isa::Avx2: return "avx2";
-        case Isa::Avx512: return "avx512";
-    }
-    return "?";
-}
+const char* isa_name(Isa isa) { return name_of(kIsaNames, isa).data(); }  // the literals end in NUL
 
 bool parse_isa(const std::string& s, Isa& out) {
-    for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512})
-        if (s == isa_name(isa)) {
-            out = isa;
-            return true;
-        }
-    return false;
+    const auto isa = value_named(kIsaNames, s);
+    if (isa) out = *isa;
+    return isa.has_value();
 }
 
 const KernelTable& kernel_table(Isa isa) {

@@ -4,6 +4,8 @@
 // has. The pipeline calls them through this table, so only these files carry ISA flags.
 #include <cstddef>
 #include <cstdint>
+
+#include "core/enum_names.h"
 #include <string>
 #include <vector>
 
@@ -31,6 +33,8 @@ using AnyCulledFn = void (*)(RayView rays, const ObjectXf* objs, const ObjectBou
 
 enum class Isa : std::uint8_t { Sse2, Sse42, Avx2, Avx512 };
 inline constexpr int kIsaCount = 4;
+inline constexpr EnumName<Isa> kIsaNames[] = {
+    {Isa::Sse2, "sse2"}, {Isa::Sse42, "sse4.2"}, {Isa::Avx2, "avx2"}, {Isa::Avx512, "avx512"}};
 
 struct KernelTable {
     Isa isa;

@@ -33,22 +33,9 @@ void Parser::image(Statement& st, const std::vector<Token>& toks) {
         else if (k == "cutoff") s.cutoff = st.in_closed(a, 0.0, 1.0);
         else if (k == "output") s.output = std::string(a.value);
         else if (k == "frames") frame_range(st, a, s.frames_first, s.frames_last);
-        else if (k == "sampler") {
-            if (a.value == "stratified") s.pattern = SamplePattern::Stratified;
-            else if (a.value == "grid") s.pattern = SamplePattern::Grid;
-            else if (a.value == "random") s.pattern = SamplePattern::Random;
-            else
-                st.fail(a.value_col, "expected stratified, grid or random for 'sampler', got " +
-                                         quote(a.value));
-        } else if (k == "calibration") {
-            if (a.value == "clamp") s.calibration = Calibration::Clamp;
-            else if (a.value == "normalize") s.calibration = Calibration::Normalize;
-            else
-                st.fail(a.value_col,
-                        "expected clamp or normalize for 'calibration', got " + quote(a.value));
-        } else {
-            display_key(st, a, s);
-        }
+        else if (k == "sampler") s.pattern = st.word(a, kSamplePatternNames);
+        else if (k == "calibration") s.calibration = st.word(a, kCalibrationNames);
+        else display_key(st, a, s);
     }
 }
 
@@ -61,17 +48,11 @@ void Parser::display_key(const Statement& st, const Arg& a, RenderSettings& s) {
             st.fail(a.value_col, "'exposure' must be a multiplier > 0, in [1e-6, 1e6], got " + quote(a.value));
         s.exposure = v;
     } else if (k == "colorspace") {
-        if (a.value == "srgb") s.colorspace = ColorSpace::Srgb;
-        else if (a.value == "linear") s.colorspace = ColorSpace::Linear;
-        else st.fail(a.value_col, "expected srgb or linear for 'colorspace', got " + quote(a.value));
+        s.colorspace = st.word(a, kColorSpaceNames);
     } else if (k == "tonemap") {
-        if (a.value == "clamp") s.tonemap = Tonemap::Clamp;
-        else if (a.value == "reinhard") s.tonemap = Tonemap::Reinhard;
-        else st.fail(a.value_col, "expected clamp or reinhard for 'tonemap', got " + quote(a.value));
+        s.tonemap = st.word(a, kTonemapNames);
     } else if (k == "exr") {
-        if (a.value == "half") s.exr = ExrPixels::Half;
-        else if (a.value == "float") s.exr = ExrPixels::Float;
-        else st.fail(a.value_col, "expected half or float for 'exr', got " + quote(a.value));
+        s.exr = st.word(a, kExrPixelsNames);
     }
 }
 
@@ -200,11 +181,7 @@ void Parser::area_light_key(const Statement& st, const Arg& a, Light& l) {
     else if (a.key == "v") l.v = st.vec3(a);
     else if (a.key == "samples") l.samples = st.integer(a, 1, 4096);
     else if (a.key == "soft") l.soft = st.at_least_zero(a);
-    else if (a.key == "falloff") {
-        if (a.value == "none") l.falloff = Falloff::None;
-        else if (a.value == "inverse_square") l.falloff = Falloff::InverseSquare;
-        else st.fail(a.value_col, "expected none or inverse_square for 'falloff', got " + quote(a.value));
-    }
+    else if (a.key == "falloff") l.falloff = st.word(a, kFalloffNames);
 }
 
 void Parser::check_area_light(const Statement& st, const Light& l) {

@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "scene/texture.h"
 #include "core/transform.h"
@@ -83,6 +84,7 @@ struct ObjectLoc {
 enum class LightKind : std::uint8_t { Point, Spot, Directional, Sphere, Rect };
 /// How a light's colour falls with the distance d to it: none (the handout's) or 1 / d^2.
 enum class Falloff : std::uint8_t { None, InverseSquare };
+inline constexpr EnumName<Falloff> kFalloffNames[] = {{Falloff::None, "none"}, {Falloff::InverseSquare, "inverse_square"}};
 
 struct Light {
     LightKind kind = LightKind::Point;
@@ -124,11 +126,18 @@ struct Camera {
 };
 
 enum class Calibration : std::uint8_t { Clamp, Normalize };
+inline constexpr EnumName<Calibration> kCalibrationNames[] = {{Calibration::Clamp, "clamp"},
+                                                              {Calibration::Normalize, "normalize"}};
 enum class SamplePattern : std::uint8_t { Stratified, Grid, Random };
+inline constexpr EnumName<SamplePattern> kSamplePatternNames[] = {
+    {SamplePattern::Stratified, "stratified"}, {SamplePattern::Grid, "grid"}, {SamplePattern::Random, "random"}};
 // Display colour of the 8-bit outputs (docs/scene-format.md, "Output and display colour").
 enum class ColorSpace : std::uint8_t { Srgb, Linear };
+inline constexpr EnumName<ColorSpace> kColorSpaceNames[] = {{ColorSpace::Srgb, "srgb"}, {ColorSpace::Linear, "linear"}};
 enum class Tonemap : std::uint8_t { Clamp, Reinhard };
+inline constexpr EnumName<Tonemap> kTonemapNames[] = {{Tonemap::Clamp, "clamp"}, {Tonemap::Reinhard, "reinhard"}};
 enum class ExrPixels : std::uint8_t { Half, Float };
+inline constexpr EnumName<ExrPixels> kExrPixelsNames[] = {{ExrPixels::Half, "half"}, {ExrPixels::Float, "float"}};
 
 struct RenderSettings {
     int width = 640;

@@ -28,6 +28,8 @@ enum class AccelMode : std::uint8_t {
     Bvh,   ///< always the hierarchy
     Flat,  ///< the handout's loop over every object (per shape kind in the stream engine)
 };
+inline constexpr EnumName<AccelMode> kAccelModeNames[] = {
+    {AccelMode::Auto, "auto"}, {AccelMode::Bvh, "bvh"}, {AccelMode::Flat, "flat"}};
 
 /// Process-wide settings (the command line's --accel, perf/ and the tests set them).
 struct AccelConfig {

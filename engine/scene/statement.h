@@ -249,6 +249,12 @@ class Statement {
             fail(a.value_col, quote(a.key) + " must be a non-zero vector, got " + quote(a.value));
         return d / len;
     }
+    /// One of the enum's names (core/enum_names.h).
+    template <class E, std::size_t N>
+    E word(const Arg& a, const EnumName<E> (&names)[N]) const {
+        if (const auto v = value_named(names, a.value)) return *v;
+        fail(a.value_col, "expected " + names_list(names) + " for " + quote(a.key) + ", got " + quote(a.value));
+    }
     bool boolean(const Arg& a) const {
         if (same(a.value, "true")) return true;
         if (!same(a.value, "false"))

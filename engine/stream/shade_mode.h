@@ -2,6 +2,8 @@
 // How the stream engine's shade stage groups the hits of a generation for its SIMD kernel.
 #include <cstdint>
 
+#include "core/enum_names.h"
+
 namespace streamrt {
 
 enum class ShadeMode : std::uint8_t {
@@ -10,5 +12,7 @@ enum class ShadeMode : std::uint8_t {
     Gathered,  ///< runs of one material and shape kind: each lane's object record gathered
     Scalar,    ///< one ray at a time (kept to measure the difference)
 };
+inline constexpr EnumName<ShadeMode> kShadeModeNames[] = {
+    {ShadeMode::Auto, "simd"}, {ShadeMode::Sorted, "sorted"}, {ShadeMode::Gathered, "gathered"}, {ShadeMode::Scalar, "scalar"}};
 
 }  // namespace streamrt

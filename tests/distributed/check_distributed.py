@@ -4,7 +4,7 @@ for byte (PFM) with the single-process render of the same settings.
 
     check_distributed.py --streamrt BIN [--mpirun MPIRUN] GROUP
 
-GROUP: usage | shard | checkpoint | mpi-usage | mpi-scenes | mpi-ranks | mpi-faults
+GROUP: usage | shard | checkpoint | settings | mpi-usage | mpi-scenes | mpi-ranks | mpi-faults
 Exits 1 with one line per failure; 0 when everything holds.
 """
 import argparse
@@ -151,6 +151,59 @@ def group_shard(args, tmp):
     check(r.returncode == 2 and one_line(r), f"merge with a truncated part: {r.returncode}: {r.stderr.strip()!r}")
 
 
+# Every setting of the settings token (driver/render_job.h, PixelSettings): the flag that
+# changes it and two values, or None for a setting only the scene's files give (covered by
+# the scene's content hash) or that has its own test (frames: the frames group of cli_test).
+SETTING_FLAGS = {
+    "width": ("--width", "64", "80"), "height": ("--height", "48", "32"), "spp": ("--spp", "2", "3"),
+    "depth": ("--depth", "5", "2"), "degree": ("--degree", "5", "4"),
+    "light_samples": ("--light-samples", "1", "2"), "cutoff": ("--cutoff", "0", "0.05"),
+    "exposure": ("--exposure", "1", "2"), "sampler": ("--sampler", "stratified", "grid"),
+    "colorspace": ("--colorspace", "srgb", "linear"), "tonemap": ("--tonemap", "clamp", "reinhard"),
+    "engine": ("--engine", "stream", "recursive"), "isa": ("--isa", "sse2", "sse4.2"),
+    "accel": ("--accel", "auto", "flat"), "shade": ("--shade", "simd", "scalar"),
+    "frame": None, "calibration": None, "exr": None,
+}
+
+
+def settings_of_part(path):
+    """The keys of a part's settings token, read from its header line."""
+    head = path.read_bytes().split(b"\n", 1)[0].decode()
+    token = next(f for f in head.split() if f.startswith("settings="))[len("settings="):]
+    return [item.split("=", 1)[0] for item in token.split(",")]
+
+
+def group_settings(args, tmp):
+    """Shard parts that differ in one setting are never merged (the silent mixed image this
+    token exists to prevent); the list of settings is the token's own, read from a part."""
+    scene = SCENES / "whitted.cfg"
+    defaults = {"--width": "64", "--height": "48", "--spp": "2"}
+
+    def base(but=None):
+        return ["-j1", scene, "-q", *[x for f, v in defaults.items() if f != but for x in (f, v)]]
+
+    probe = tmp / "probe.part"
+    r = run([args.streamrt, *base(), "-o", probe, "--shard", "0/2"])
+    check(r.returncode == 0, f"shard render failed: {r.stderr.strip()}")
+    keys = settings_of_part(probe)
+    check(sorted(keys) == sorted(SETTING_FLAGS), f"the token's settings {sorted(keys)} are not the ones this test "
+                                                 f"knows {sorted(SETTING_FLAGS)}: add a case for the new one")
+    for key, case in SETTING_FLAGS.items():
+        if case is None:
+            continue
+        flag, a, b = case
+        parts = []
+        for k, value in ((0, a), (1, b)):
+            part = tmp / f"{key}_{k}.part"
+            r = run([args.streamrt, *base(flag), flag, value, "-o", part, "--shard", f"{k}/2"])
+            check(r.returncode == 0, f"--shard {k}/2 {flag} {value}: {r.stderr.strip()}")
+            parts.append(part)
+        r = run([args.streamrt, "merge", *parts, "-o", tmp / f"{key}.pfm"])
+        check(r.returncode == 2 and one_line(r), f"parts differing in {flag} ({a} vs {b}) were merged: "
+                                                f"{r.returncode}: {r.stderr.strip()!r}")
+        check(not (tmp / f"{key}.pfm").exists(), f"a refused merge ({flag}) wrote an image")
+
+
 def group_checkpoint(args, tmp):
     scene = SCENES / "whitted.cfg"
     size = ["--width", "640", "--height", "480", "-q"]
@@ -175,7 +228,11 @@ def group_checkpoint(args, tmp):
         data = journal.read_bytes()
         journal.write_bytes(data[: len(data) - 7])
         # Another scene's or other settings' journal is refused, and left alone.
-        for other in (["--spp", "63"], ["--spp", "64", "--sampler", "grid"]):
+        others = [["--spp", "63"], ["--spp", "64", "--sampler", "grid"]]
+        # One setting at a time, each away from the journal's (which has the first values).
+        others += [["--spp", "64", flag, b] for flag, a, b in filter(None, SETTING_FLAGS.values())
+                   if flag not in ("--width", "--height", "--spp")]
+        for other in others:
             r = run([args.streamrt, "-j2", scene, "-o", out, *size, *other, "--checkpoint", journal, "--resume"])
             check(r.returncode == 2 and one_line(r) and "other settings" in r.stderr,
                   f"mismatched journal ({' '.join(other)}): {r.returncode}: {r.stderr.strip()!r}")
@@ -331,7 +388,7 @@ def main():
     ap.add_argument("group")
     args = ap.parse_args()
     args.mpich = args.group.startswith("mpi") and is_mpich(args)
-    groups = {"usage": group_usage, "shard": group_shard, "checkpoint": group_checkpoint,
+    groups = {"usage": group_usage, "shard": group_shard, "checkpoint": group_checkpoint, "settings": group_settings,
               "mpi-usage": group_mpi_usage, "mpi-scenes": group_mpi_scenes, "mpi-ranks": group_mpi_ranks,
               "mpi-faults": group_mpi_faults}
     start = time.time()
