@@ -6,10 +6,13 @@
 // triangle mesh (a 317 x 317 UV sphere with lumps and random vertex jitter: triangles of
 // every size and shape). One view (1280x720, the camera of mesh_bench), primary rays in 4x4
 // pixel tiles; at each primary hit, in the same order, a shadow ray to a point light (any
-// hit), a mirror-reflected ray and a glass-refracted ray (index 1.5) (closest hit). Each
+// hit), a mirror-reflected ray, a glass-refracted ray (index 1.5) and a diffuse ray (uniform
+// over the hemisphere: incoherent) (closest hit). Each
 // stream runs through the level's flat mesh kernel (KernelTable closest/any[Mesh], one
 // thread) with MeshView::single_ray_lanes = each value of --lanes (0: packet walk only; 64:
-// single-ray walk only; between: the hybrid), median of N runs (default 5), in Mrays/s.
+// single-ray walk only; between: the hybrid), median of N runs (default 5), in Mrays/s. Row
+// "scene1": the same streams through the scene hierarchy's single-ray traversal (the mesh one
+// leaf object; its mesh walk is the single-ray walk).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,6 +24,8 @@
 
 #include "kernels/kernel_table.h"
 #include "mesh/mesh.h"
+#include "scene/scene_bvh.h"
+#include "stream/stream_accel.h"
 #include "simd/lanes.h"
 
 using namespace streamrt;
@@ -61,7 +66,7 @@ MeshData irregular_mesh() {
 }
 
 struct Streams {
-    Stream primary, shadow, mirror, glass;
+    Stream primary, shadow, mirror, glass, diffuse;
 };
 
 /// The four ray streams of the view: primary rays traced once (packet walk) for the hits.
@@ -86,6 +91,8 @@ Streams make_streams(const Mesh& mesh, const KernelTable& kt, const ObjectXf& xf
     v.prim = prim.data(), v.bu = bu.data(), v.bv = bv.data();
     kt.closest[int(ShapeKind::Mesh)](v, id.data(), &xf, 1);
     const Vec3f light{3, 5, 4};
+    std::mt19937 rng(3);
+    std::normal_distribution<float> gauss(0.f, 1.f);
     for (std::size_t i = 0; i < s.primary.count; ++i) {
         if (id[i] != 0) continue;
         const Vec3f o{s.primary.ox[i], s.primary.oy[i], s.primary.oz[i]}, d{s.primary.dx[i], s.primary.dy[i],
@@ -101,11 +108,37 @@ Streams make_streams(const Mesh& mesh, const KernelTable& kt, const ObjectXf& xf
         s.mirror.add(out, d - 2.f * dot(d, n) * n, 1e30f);
         const float eta = 1.f / 1.5f, c = -dot(d, n), k = 1.f - eta * eta * (1.f - c * c);
         s.glass.add(in, normalize(eta * d + (eta * c - std::sqrt(k)) * n), 1e30f);
+        Vec3f r{gauss(rng), gauss(rng), gauss(rng)};  // uniform over the outer hemisphere
+        if (dot(r, n) < 0) r = -r;
+        s.diffuse.add(out, normalize(r), 1e30f);
     }
     s.shadow.pad();
     s.mirror.pad();
     s.glass.pad();
+    s.diffuse.pad();
     return s;
+}
+
+/// The stream through the scene hierarchy's single-ray walk (AccelConfig Traversal::Single),
+/// which meets the mesh as a leaf object.
+double scene_single_mrays(const Stream& st, bool any, const KernelTable& kt, const StreamAccel& sa, int reps) {
+    std::vector<double> secs;
+    simd::AlignedVec<float> t(st.t_max.size()), bu(t.size()), bv(t.size());
+    simd::AlignedVec<std::int32_t> id(t.size()), prim(t.size());
+    for (int r = 0; r < reps; ++r) {
+        std::copy(st.t_max.begin(), st.t_max.end(), t.begin());
+        RayView v = st.view(t.data());
+        const double t0 = now();
+        if (any) {
+            sa.any(kt, v);
+        } else {
+            v.prim = prim.data(), v.bu = bu.data(), v.bv = bv.data();
+            sa.closest(kt, v, id.data(), false);
+        }
+        secs.push_back(now() - t0);
+    }
+    std::sort(secs.begin(), secs.end());
+    return double(st.count) / secs[secs.size() / 2] * 1e-6;
 }
 
 double mrays(const Stream& st, bool any, const KernelTable& kt, const ObjectXf& xf, int reps) {
@@ -164,16 +197,31 @@ int main(int argc, char** argv) {
         xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
         xf.mesh = &mesh->view();
         const Streams s = make_streams(*mesh, kt, xf);
-        std::printf("%-6s %10s %10s %10s %10s\n", "lanes", "primary", "shadow", "mirror", "glass");
+        std::printf("%-6s %10s %10s %10s %10s %10s\n", "lanes", "primary", "shadow", "mirror", "glass", "diffuse");
         for (std::uint32_t l : lanes) {
             const auto m = mesh->with_single_ray_lanes(l);
             ObjectXf x = xf;
             x.mesh = &m->view();
-            std::printf("%-6u %10.2f %10.2f %10.2f %10.2f\n", l, mrays(s.primary, false, kt, x, reps),
+            std::printf("%-6u %10.2f %10.2f %10.2f %10.2f %10.2f\n", l, mrays(s.primary, false, kt, x, reps),
                         mrays(s.shadow, true, kt, x, reps), mrays(s.mirror, false, kt, x, reps),
-                        mrays(s.glass, false, kt, x, reps));
+                        mrays(s.glass, false, kt, x, reps), mrays(s.diffuse, false, kt, x, reps));
             std::fflush(stdout);
         }
+        Scene scene;
+        Object o;
+        o.kind = ShapeKind::Mesh;
+        o.mesh = 0;
+        o.md = glm::dmat4x3(glm::dmat4(1.0));
+        scene.meshes.push_back(mesh);
+        scene.add_object(o);
+        accel::accel_config().mode = accel::AccelMode::Bvh;
+        accel::accel_config().primary = accel::accel_config().secondary = accel::accel_config().shadow =
+            accel::Traversal::Single;
+        const StreamAccel sa(scene, accel::SceneBvh::build(scene));
+        std::printf("%-6s %10.2f %10.2f %10.2f %10.2f %10.2f\n", "scene1", scene_single_mrays(s.primary, false, kt, sa, reps),
+                    scene_single_mrays(s.shadow, true, kt, sa, reps), scene_single_mrays(s.mirror, false, kt, sa, reps),
+                    scene_single_mrays(s.glass, false, kt, sa, reps), scene_single_mrays(s.diffuse, false, kt, sa, reps));
+        accel::accel_config() = accel::AccelConfig{};
     }
     return 0;
 }

@@ -15,8 +15,11 @@
 
 namespace streamrt {
 
-/// MeshView::single_ray_lanes of every built mesh (measured: docs/performance.md "### Meshes").
-inline constexpr std::uint32_t kDefaultSingleRayLanes = 2;
+/// MeshView::single_ray_lanes of every built mesh. Measured (docs/performance.md "### Meshes",
+/// perf/mesh_walk_bench): the packet walk alone is fastest for primary, shadow, mirror and
+/// glass rays in the engine's tile order; the hybrid gains only on incoherent (diffuse) rays,
+/// which the renderer does not trace.
+inline constexpr std::uint32_t kDefaultSingleRayLanes = 0;
 
 struct Mesh {
     std::string name;                   ///< the file it came from, for messages

@@ -88,6 +88,23 @@ void fill(RayStream& rs, const Case& c) {
     rs.pad_tail();
 }
 
+/// A closest-hit stream of the case with the mesh-hit arrays attached.
+struct Traced {
+    RayStream rs;
+    AlignedVec<std::int32_t> id, prim;
+    AlignedVec<float> bu, bv;
+    RayView view;
+    explicit Traced(const Case& c) {
+        fill(rs, c);
+        id.assign(rs.capacity(), -1);
+        prim.assign(rs.capacity(), -1);
+        bu.assign(rs.capacity(), 0.f);
+        bv.assign(rs.capacity(), 0.f);
+        view = view_of(rs);
+        view.prim = prim.data(), view.bu = bu.data(), view.bv = bv.data();
+    }
+};
+
 /// Counts disagreements with the oracle of every walk on every level: closest t (relative
 /// 1e-4), triangle (unless the oracle's hit is within 1e-5 of an edge, where either
 /// neighbour is right, or the ray grazes the triangle, where float t is ill-conditioned), and
@@ -140,30 +157,21 @@ void check_against_oracle(const std::shared_ptr<const Mesh>& mesh, const Case& c
             xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
             xf.id = 0;
             xf.mesh = &walk->view();
-            RayStream rs;
-            fill(rs, c);
-            AlignedVec<std::int32_t> id(rs.capacity(), -1), prim(rs.capacity(), -1);
-            AlignedVec<float> bu(rs.capacity()), bv(rs.capacity());
-            RayView view = view_of(rs);
-            view.prim = prim.data(), view.bu = bu.data(), view.bv = bv.data();
-            kt.closest[int(ShapeKind::Mesh)](view, id.data(), &xf, 1);
-            CHECK(count_bad(rs, id.data(), prim.data(), false) == 0);
+            Traced tr(c);
+            kt.closest[int(ShapeKind::Mesh)](tr.view, tr.id.data(), &xf, 1);
+            CHECK(count_bad(tr.rs, tr.id.data(), tr.prim.data(), false) == 0);
             RayStream sh;
             fill(sh, c);
             kt.any[int(ShapeKind::Mesh)](view_of(sh), &xf, 1);
             CHECK(count_bad(sh, nullptr, nullptr, true) == 0);
         }
         // The scene hierarchy's single-ray walk reaches the mesh through a leaf.
-        accel::accel_config().primary = accel::accel_config().shadow = accel::Traversal::Single;
+        accel::accel_config().primary = accel::accel_config().secondary = accel::accel_config().shadow =
+            accel::Traversal::Single;
         StreamAccel sa(scene, accel::SceneBvh::build(scene));
-        RayStream rs;
-        fill(rs, c);
-        AlignedVec<std::int32_t> id(rs.capacity(), -1), prim(rs.capacity(), -1);
-        AlignedVec<float> bu(rs.capacity()), bv(rs.capacity());
-        RayView view = view_of(rs);
-        view.prim = prim.data(), view.bu = bu.data(), view.bv = bv.data();
-        sa.closest(kt, view, id.data(), false);
-        CHECK(count_bad(rs, id.data(), prim.data(), false) == 0);
+        Traced tr(c);
+        sa.closest(kt, tr.view, tr.id.data(), false);
+        CHECK(count_bad(tr.rs, tr.id.data(), tr.prim.data(), false) == 0);
         RayStream sh;
         fill(sh, c);
         sa.any(kt, view_of(sh));
