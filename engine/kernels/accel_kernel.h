@@ -94,35 +94,41 @@ inline void mesh_leaf_closest(const RayView& rays, std::size_t base, const Objec
                         rays.bu ? rays.bu + base : nullptr, rays.bv ? rays.bv + base : nullptr);
 }
 
-/// The same for one ray broadcast into a packet (single-ray traversal): lane 0's result,
-/// written at index i of the mesh-hit arrays.
+/// One ray in a mesh object's canonical space (computed on a broadcast batch, so exactly as
+/// the packet kernels transform the same ray).
+template <class Arch>
+inline void single_to_canonical(const Vec3f& o, const Vec3f& d, const ObjectXf& ob, Vec3f& oc, Vec3f& dc) {
+    using B = xsimd::batch<float, Arch>;
+    const RayPacket<B> r{{B(o.x), B(o.y), B(o.z)}, {B(d.x), B(d.y), B(d.z)}};
+    const RayPacket<B> c = to_canonical<B, float>(r, ob);
+    oc = {c.o.x.get(0), c.o.y.get(0), c.o.z.get(0)};
+    dc = {c.d.x.get(0), c.d.y.get(0), c.d.z.get(0)};
+}
+
+/// A mesh object against one ray (single-ray traversal): the single-ray mesh walk
+/// (kernels/mesh_single_kernel.h); the hit is written at index i of the mesh-hit arrays.
 template <class Arch>
 inline float mesh_single_closest(const RayView& rays, std::size_t i, const Vec3f& o, const Vec3f& d, const ObjectXf& ob,
                                  float t_max) {
-    using B = xsimd::batch<float, Arch>;
-    constexpr std::size_t W = B::size;
-    const RayPacket<B> r{{B(o.x), B(o.y), B(o.z)}, {B(d.x), B(d.y), B(d.z)}};
-    const RayPacket<B> c = to_canonical<B, float>(r, ob);
-    B best(t_max);
-    alignas(64) std::int32_t p[W];
-    alignas(64) float u[W], v[W];
-    mesh_closest_packet(*ob.mesh, c.o, c.d, best, p, u, v);
-    const float t = best.get(0);
+    using Archs = SingleRayArchs<Arch>;
+    Vec3f oc, dc;
+    single_to_canonical<Arch>(o, d, ob, oc, dc);
+    MeshHit h;
+    const float t = mesh_closest_single<typename Archs::node, typename Archs::leaf>(*ob.mesh, oc, dc, t_max, h);
     if (t < t_max && rays.prim) {
-        rays.prim[i] = p[0];
-        rays.bu[i] = u[0];
-        rays.bv[i] = v[0];
+        rays.prim[i] = h.prim;
+        rays.bu[i] = h.u;
+        rays.bv[i] = h.v;
     }
     return t < t_max ? t : kInfF;
 }
 
 template <class Arch>
 inline bool mesh_single_any(const Vec3f& o, const Vec3f& d, const ObjectXf& ob, float t_max) {
-    using B = xsimd::batch<float, Arch>;
-    const RayPacket<B> r{{B(o.x), B(o.y), B(o.z)}, {B(d.x), B(d.y), B(d.z)}};
-    const RayPacket<B> c = to_canonical<B, float>(r, ob);
-    const B tm(t_max);
-    return xsimd::any(mesh_any_packet(*ob.mesh, c.o, c.d, tm, tm > B(0.f)));
+    using Archs = SingleRayArchs<Arch>;
+    Vec3f oc, dc;
+    single_to_canonical<Arch>(o, d, ob, oc, dc);
+    return mesh_any_single<typename Archs::node, typename Archs::leaf>(*ob.mesh, oc, dc, t_max);
 }
 
 /// Nearest hit t in (0, t_max) of the rays at `base` (W lanes, in memory) with one object, in

@@ -2,12 +2,16 @@
 // The SIMD mesh kernels: a packet of rays (already in the mesh's canonical space, as for the
 // canonical shapes) walks the mesh's 8-wide BVH together; leaves run the watertight triangle
 // test (shapes/triangle_math.h) on the whole packet, one broadcast triangle at a time.
+// Hybrid: a stack entry that at most MeshView::single_ray_lanes lanes reached is finished
+// by the single-ray walk (mesh_single_kernel.h), one lane after the other.
 // Included only by kernels/isa_*.cpp through intersect_kernel.h, inside their own namespace.
 #include <xsimd/xsimd.hpp>
 
+#include <bit>
 #include <cstdint>
 #include <limits>
 
+#include "kernels/mesh_single_kernel.h"
 #include "mesh/mesh_view.h"
 #include "shapes/triangle_math.h"
 
@@ -15,12 +19,27 @@ namespace streamrt::STREAMRT_ISA_NAMESPACE {
 
 namespace mesh_detail {
 
-constexpr int kStack = accel::kNodeWidth * 64;
-
-struct Entry {
+struct PacketEntry {
     std::int32_t child;
     std::uint32_t count;
-    float t;
+    float t;             ///< smallest entry distance of the lanes that hit the box
+    std::uint32_t lanes;  ///< bit l: lane l hit the box
+};
+
+/// The packet's canonical rays, lane by lane, for the lanes handed to the single-ray walk.
+template <class B>
+struct PacketLanes {
+    alignas(64) float ox[B::size], oy[B::size], oz[B::size], dx[B::size], dy[B::size], dz[B::size];
+    PacketLanes(const Vec3T<B>& o, const Vec3T<B>& d) {
+        o.x.store_aligned(ox);
+        o.y.store_aligned(oy);
+        o.z.store_aligned(oz);
+        d.x.store_aligned(dx);
+        d.y.store_aligned(dy);
+        d.z.store_aligned(dz);
+    }
+    Vec3f origin(std::size_t l) const { return {ox[l], oy[l], oz[l]}; }
+    Vec3f direction(std::size_t l) const { return {dx[l], dy[l], dz[l]}; }
 };
 
 /// Box test for the mesh walk. Boxes are padded outwards (accel::conservative_box) and the
@@ -30,7 +49,6 @@ struct Entry {
 template <class B>
 inline auto robust_box(const accel::WideNode& n, int j, const Vec3T<B>& o, const Vec3T<B>& inv, const B& t_max,
                        B& t_near) {
-    constexpr float kWiden = 1.f + 2.f * (3.f * 0x1p-24f) / (1.f - 3.f * 0x1p-24f);
     B tn(0.f), tf = t_max;
     const auto slab = [&](float lo, float hi, const B& oc, const B& ic) {
         const B a = (B(lo) - oc) * ic, b = (B(hi) - oc) * ic;
@@ -78,6 +96,7 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
                                 float* u, float* v) {
     using namespace mesh_detail;
     using I = xsimd::batch<std::int32_t, typename B::arch_type>;
+    using Archs = SingleRayArchs<typename B::arch_type>;
     constexpr std::size_t W = B::size;
     if (!m.nodes) return;
     const B start = best;
@@ -87,12 +106,40 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
     const WatertightRay<B> wr = watertight_ray(o, d);
     B bu(0.f), bv(0.f);
     I bprim(-1);
-    Entry stack[kStack];
+    // Lanes handed to the single-ray walk: rays, then the hits as arrays, loaded back after.
+    const PacketLanes<B> lanes(o, d);
+    const auto hand_over = [&](const PacketEntry& e) {
+        alignas(64) float t_l[W], u_l[W], v_l[W];
+        alignas(64) std::int32_t p_l[W];
+        best.store_aligned(t_l);
+        bu.store_aligned(u_l);
+        bv.store_aligned(v_l);
+        bprim.store_aligned(p_l);
+        for (std::size_t l = 0; l < W; ++l) {
+            if (!(e.lanes >> l & 1u) || e.t > t_l[l]) continue;
+            MeshHit h{p_l[l], u_l[l], v_l[l]};
+            t_l[l] = mesh_closest_single<typename Archs::node, typename Archs::leaf>(
+                m, lanes.origin(l), lanes.direction(l), t_l[l], h, {e.child, e.count, 0.f});
+            p_l[l] = h.prim;
+            u_l[l] = h.u;
+            v_l[l] = h.v;
+        }
+        best = B::load_aligned(t_l);
+        bu = B::load_aligned(u_l);
+        bv = B::load_aligned(v_l);
+        bprim = I::load_aligned(p_l);
+    };
+    PacketEntry stack[kStack];
     int sp = 0;
-    stack[sp++] = {0, 0, 0.f};
+    stack[sp++] = {0, 0, 0.f, movemask_bits(best > B(0.f))};
     while (sp > 0) {
-        const Entry e = stack[--sp];
+        const PacketEntry e = stack[--sp];
         if (e.t > best_max) continue;
+        if (std::uint32_t(std::popcount(e.lanes)) <= m.single_ray_lanes) {
+            hand_over(e);
+            best_max = lanes_max(best);
+            continue;
+        }
         if (e.count > 0) {
             for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
                 const TriangleHit<B> h = triangle_hit(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2),
@@ -108,14 +155,15 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
             continue;
         }
         const accel::WideNode& n = m.nodes[e.child];
-        Entry hits[accel::kNodeWidth];
+        PacketEntry hits[accel::kNodeWidth];
         int nh = 0;
         for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
             B tn;
             const auto hit = robust_box(n, j, o, inv, best, tn);
             if (!xsimd::any(hit)) continue;
             // farthest first, so the nearest is popped first
-            const Entry en{n.child[j], n.count[j], lanes_min_where(tn, hit)};
+            const PacketEntry en{n.child[j], n.count[j], lanes_min_where(tn, hit),
+                                 m.single_ray_lanes > 0 ? movemask_bits(hit) : ~0u};
             int k = nh++;
             while (k > 0 && hits[k - 1].t < en.t) {
                 hits[k] = hits[k - 1];
@@ -146,15 +194,36 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
 template <class B, class M>
 inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, const B& t_max, M open) {
     using namespace mesh_detail;
+    using Archs = SingleRayArchs<typename B::arch_type>;
+    constexpr std::size_t W = B::size;
     M blocked = B(0.f) != B(0.f);
     if (!m.nodes || !xsimd::any(open)) return blocked;
     const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
     const WatertightRay<B> wr = watertight_ray(o, d);
-    Entry stack[kStack];
+    const PacketLanes<B> lanes(o, d);
+    // The open lanes of e, finished one by one by the single-ray walk.
+    const auto hand_over = [&](const PacketEntry& e) {
+        alignas(64) float t_l[W], blocked_l[W];
+        t_max.store_aligned(t_l);
+        xsimd::select(blocked, B(1.f), B(0.f)).store_aligned(blocked_l);
+        const std::uint32_t go = e.lanes & movemask_bits(open);
+        for (std::size_t l = 0; l < W; ++l)
+            if ((go >> l & 1u) && mesh_any_single<typename Archs::node, typename Archs::leaf>(
+                                      m, lanes.origin(l), lanes.direction(l), t_l[l], {e.child, e.count, 0.f}))
+                blocked_l[l] = 1.f;
+        blocked = B::load_aligned(blocked_l) != B(0.f);
+        open = open && !blocked;
+    };
+    PacketEntry stack[kStack];
     int sp = 0;
-    stack[sp++] = {0, 0, 0.f};
+    stack[sp++] = {0, 0, 0.f, movemask_bits(open)};
     while (sp > 0) {
-        const Entry e = stack[--sp];
+        const PacketEntry e = stack[--sp];
+        if (m.single_ray_lanes > 0 && std::uint32_t(std::popcount(e.lanes & movemask_bits(open))) <= m.single_ray_lanes) {
+            hand_over(e);
+            if (!xsimd::any(open)) break;
+            continue;
+        }
         if (e.count > 0) {
             for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
                 const TriangleHit<B> h = triangle_hit(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2),
@@ -169,7 +238,9 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
         const accel::WideNode& n = m.nodes[e.child];
         for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
             B tn;
-            if (xsimd::any(robust_box(n, j, o, inv, t_max, tn) && open)) stack[sp++] = {n.child[j], n.count[j], 0.f};
+            const auto hit = robust_box(n, j, o, inv, t_max, tn) && open;
+            if (xsimd::any(hit))
+                stack[sp++] = {n.child[j], n.count[j], 0.f, m.single_ray_lanes > 0 ? movemask_bits(hit) : ~0u};
         }
     }
     return blocked;

@@ -17,7 +17,8 @@
 namespace streamrt {
 
 std::size_t Mesh::memory_bytes() const {
-    return tri.size() * sizeof(float) + index.size() * sizeof(std::uint32_t) +
+    return tri.size() * sizeof(float) + blocks.size() * sizeof(TriangleBlock) +
+           block_of.size() * sizeof(std::uint32_t) + index.size() * sizeof(std::uint32_t) +
            vertex_normals.size() * sizeof(float) + corner_uv.size() * sizeof(float) + bvh.memory_bytes();
 }
 
@@ -126,9 +127,8 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
             m->lo[a] = std::min(m->lo[a], double(m->tri[3 * k + a]));
             m->hi[a] = std::max(m->hi[a], double(m->tri[3 * k + a]));
         }
-    m->kernel_view = {m->bvh.nodes.empty() ? nullptr : m->bvh.nodes.data(), m->tri.data(), m->index.data(),
-                      m->vertex_normals.data(), std::uint32_t(n_tris),
-                      m->corner_uv.empty() ? nullptr : m->corner_uv.data(), m->uv_density};
+    m->build_triangle_blocks();
+    m->set_view(kDefaultSingleRayLanes);
     return m;
 }
 

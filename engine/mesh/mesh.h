@@ -15,6 +15,12 @@
 
 namespace streamrt {
 
+/// MeshView::single_ray_lanes of every built mesh. Measured (docs/performance.md "### Meshes",
+/// perf/mesh_walk_bench): the packet walk alone is fastest for primary, shadow, mirror and
+/// glass rays in the engine's tile order; the hybrid gains only on incoherent (diffuse) rays,
+/// which the renderer does not trace.
+inline constexpr std::uint32_t kDefaultSingleRayLanes = 0;
+
 struct Mesh {
     std::string name;                   ///< the file it came from, for messages
     simd::AlignedVec<float> tri;        ///< 9 per triangle, leaf order
@@ -22,6 +28,8 @@ struct Mesh {
     std::vector<float> vertex_normals;  ///< 3 per vertex
     std::vector<float> corner_uv;       ///< 6 per triangle (MeshView::uv), leaf order; empty: none
     accel::Bvh bvh;                     ///< prim_index is dropped: triangles are stored in leaf order
+    simd::AlignedVec<TriangleBlock> blocks;  ///< MeshView::blocks: the leaves' triangles, 4 to a block
+    std::vector<std::uint32_t> block_of;     ///< MeshView::block_of, one per triangle
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  ///< bounds of the vertices
     std::size_t dropped = 0;            ///< degenerate triangles left out
     float uv_density = 1.f;            ///< MeshView::uv_density
@@ -29,8 +37,15 @@ struct Mesh {
 
     std::size_t triangle_count() const { return index.size() / 3; }
     const MeshView& view() const { return kernel_view; }
-    /// Bytes held by the mesh (triangles, indices, normals, BVH nodes).
+    /// Bytes held by the mesh (triangles, triangle blocks, indices, normals, BVH nodes).
     std::size_t memory_bytes() const;
+    /// A copy whose kernels switch a packet to single rays at `lanes` active lanes or fewer
+    /// (MeshView::single_ray_lanes), for measuring the switch point (perf/mesh_bench.cpp).
+    std::shared_ptr<const Mesh> with_single_ray_lanes(std::uint32_t lanes) const;
+    /// Fills blocks and block_of from tri and the BVH's leaves (mesh_blocks.cpp).
+    void build_triangle_blocks();
+    /// Points kernel_view at this mesh's arrays.
+    void set_view(std::uint32_t single_ray_lanes);
 
     /// Builds a mesh from vertex positions (3 floats each) and triangles (3 vertex numbers
     /// each, counter-clockwise seen from outside). Triangles with a repeated vertex, an

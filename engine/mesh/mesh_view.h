@@ -6,6 +6,19 @@
 
 namespace streamrt {
 
+/// Triangles tested together against one ray by the single-ray mesh walk
+/// (kernels/mesh_single_kernel.h): one SIMD lane each.
+inline constexpr int kBlockTriangles = 4;
+
+/// kBlockTriangles triangles of one leaf as structure-of-arrays: corner[c][axis][lane]. A
+/// leaf of n triangles owns ceil(n / 4) consecutive blocks; unused lanes hold NaN corners,
+/// which the watertight test never accepts (every comparison with NaN is false, so t > 0
+/// fails) and which never trigger its exact fallback (NaN == 0 is false).
+struct alignas(16) TriangleBlock {
+    float corner[3][3][kBlockTriangles];
+};
+static_assert(sizeof(TriangleBlock) == 144);
+
 /// What the kernels and the renderers read of a mesh: raw pointers only (see
 /// kernels/shade_job.h on why the per-ISA files touch no container code). Triangles are in
 /// the BVH's leaf order: a leaf (first, count) holds triangles first .. first + count - 1.
@@ -21,6 +34,14 @@ struct MeshView {
     /// How fast (u, v) changes per canonical unit along the surface (the mesh's total uv
     /// edge length over its total edge length), for the mip level selection.
     float uv_density = 1.f;
+    /// The leaves' triangles as blocks, for the single-ray walk; block_of[first] is the first
+    /// block of the leaf whose first triangle is `first` (other entries unused).
+    const TriangleBlock* blocks = nullptr;
+    const std::uint32_t* block_of = nullptr;
+    /// Hybrid walk: a packet continues as single rays (one walk per lane) from any stack
+    /// entry that at most this many of its lanes reached (0: packet only; the packet width or
+    /// more: single rays from the root). Measured in docs/performance.md "### Meshes".
+    std::uint32_t single_ray_lanes = 0;
 };
 
 }  // namespace streamrt

@@ -107,30 +107,42 @@ inline WatertightRay<V> watertight_ray(const Vec3T<V>& o, const Vec3T<V>& d) {
     return r;
 }
 
-/// Nearest hit in (t_min, t_max) with the triangle (p0, p1, p2), t = +inf on a miss. Both
-/// faces count. t is measured along the direction given to watertight_ray().
+/// The test proper, on the corners relative to the ray's origin and already permuted
+/// (x: axis kx, y: ky, z: kz). triangle_hit() permutes with per-lane selects (a packet's rays
+/// may differ in kz); the single-ray walk, whose one ray fixes the axes, loads the permuted
+/// coordinates of 4 triangles directly (kernels/mesh_single_kernel.h). Same operations in
+/// the same order either way, so both give the same bits.
 template <class V>
-inline TriangleHit<V> triangle_hit(const WatertightRay<V>& r, const Vec3T<V>& p0, const Vec3T<V>& p1,
-                                   const Vec3T<V>& p2, V t_min, V t_max) {
+inline TriangleHit<V> triangle_hit_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
+                                            const Vec3T<V>& c, V t_min, V t_max) {
     using namespace simd;
-    using tri_detail::pick;
-    const Vec3T<V> a = p0 - r.o, b = p1 - r.o, c = p2 - r.o;
-    const V akz = pick(r.kz0, r.kz1, a), bkz = pick(r.kz0, r.kz1, b), ckz = pick(r.kz0, r.kz1, c);
-    const V ax = pick(r.kx0, r.kx1, a) - r.sx * akz, ay = pick(r.ky0, r.ky1, a) - r.sy * akz;
-    const V bx = pick(r.kx0, r.kx1, b) - r.sx * bkz, by = pick(r.ky0, r.ky1, b) - r.sy * bkz;
-    const V cx = pick(r.kx0, r.kx1, c) - r.sx * ckz, cy = pick(r.ky0, r.ky1, c) - r.sy * ckz;
+    const V ax = a.x - r.sx * a.z, ay = a.y - r.sy * a.z;
+    const V bx = b.x - r.sx * b.z, by = b.y - r.sy * b.z;
+    const V cx = c.x - r.sx * c.z, cy = c.y - r.sy * c.z;
     V U = cx * by - cy * bx;
     V Vv = ax * cy - ay * cx;
     V W = bx * ay - by * ax;
     tri_detail::edge_fallback(U, Vv, W, ax, ay, bx, by, cx, cy);
     const auto outside = ((U < V(0)) || (Vv < V(0)) || (W < V(0))) && ((U > V(0)) || (Vv > V(0)) || (W > V(0)));
     const V det = U + Vv + W;
-    const V T = U * (r.sz * akz) + Vv * (r.sz * bkz) + W * (r.sz * ckz);
+    const V T = U * (r.sz * a.z) + Vv * (r.sz * b.z) + W * (r.sz * c.z);
     const auto ok = !outside && (det != V(0));
     const V inv_det = V(1) / select(ok, det, V(1));
     const V t = T * inv_det;
     const auto hit = ok && (t > t_min) && (t < t_max);
     return {select(hit, t, infinity_v<V>()), Vv * inv_det, W * inv_det};
+}
+
+/// Nearest hit in (t_min, t_max) with the triangle (p0, p1, p2), t = +inf on a miss. Both
+/// faces count. t is measured along the direction given to watertight_ray().
+template <class V>
+inline TriangleHit<V> triangle_hit(const WatertightRay<V>& r, const Vec3T<V>& p0, const Vec3T<V>& p1,
+                                   const Vec3T<V>& p2, V t_min, V t_max) {
+    using tri_detail::pick;
+    const auto permuted = [&r](const Vec3T<V>& p) {
+        return Vec3T<V>{pick(r.kx0, r.kx1, p), pick(r.ky0, r.ky1, p), pick(r.kz0, r.kz1, p)};
+    };
+    return triangle_hit_permuted(r, permuted(p0 - r.o), permuted(p1 - r.o), permuted(p2 - r.o), t_min, t_max);
 }
 
 /// Unnormalised geometric normal (p1 - p0) x (p2 - p0): outward for counter-clockwise

@@ -88,26 +88,33 @@ void check_all_hit(const std::shared_ptr<const Mesh>& mesh, const Rays& r, float
         const std::string isa_str = isa_name(isa);
         CAPTURE(isa_str);
         const KernelTable& kt = kernel_table(isa);
-        RayStream rs;
-        fill(rs, r, t_limit);
-        AlignedVec<std::int32_t> id(rs.capacity(), -1), prim(rs.capacity(), -1);
-        AlignedVec<float> bu(rs.capacity()), bv(rs.capacity());
-        RayView view = view_of(rs);
-        view.prim = prim.data(), view.bu = bu.data(), view.bv = bv.data();
-        kt.closest[int(ShapeKind::Mesh)](view, id.data(), &xf, 1);
-        std::size_t misses = 0, bad_prim = 0;
-        for (std::size_t i = 0; i < rs.count; ++i) {
-            misses += id[i] != 0;
-            bad_prim += prim[i] < 0 || std::uint32_t(prim[i]) >= mv.n_tris;
+        // Packet walk only, the hybrid, single-ray walk only (MeshView::single_ray_lanes).
+        for (std::uint32_t lanes : {0u, 2u, 64u}) {
+            CAPTURE(lanes);
+            const auto walk = mesh->with_single_ray_lanes(lanes);
+            xf.mesh = &walk->view();
+            RayStream rs;
+            fill(rs, r, t_limit);
+            AlignedVec<std::int32_t> id(rs.capacity(), -1), prim(rs.capacity(), -1);
+            AlignedVec<float> bu(rs.capacity()), bv(rs.capacity());
+            RayView view = view_of(rs);
+            view.prim = prim.data(), view.bu = bu.data(), view.bv = bv.data();
+            kt.closest[int(ShapeKind::Mesh)](view, id.data(), &xf, 1);
+            std::size_t misses = 0, bad_prim = 0;
+            for (std::size_t i = 0; i < rs.count; ++i) {
+                misses += id[i] != 0;
+                bad_prim += prim[i] < 0 || std::uint32_t(prim[i]) >= mv.n_tris;
+            }
+            CHECK(misses == 0);
+            CHECK(bad_prim == 0);
+            RayStream sh;
+            fill(sh, r, t_limit == kInfF ? 1e30f : t_limit);
+            kt.any[int(ShapeKind::Mesh)](view_of(sh), &xf, 1);
+            std::size_t open = 0;
+            for (std::size_t i = 0; i < sh.count; ++i) open += sh.t_max[i] != 0.f;
+            CHECK(open == 0);
         }
-        CHECK(misses == 0);
-        CHECK(bad_prim == 0);
-        RayStream sh;
-        fill(sh, r, t_limit == kInfF ? 1e30f : t_limit);
-        kt.any[int(ShapeKind::Mesh)](view_of(sh), &xf, 1);
-        std::size_t open = 0;
-        for (std::size_t i = 0; i < sh.count; ++i) open += sh.t_max[i] != 0.f;
-        CHECK(open == 0);
+        xf.mesh = &mv;
         for (accel::Traversal tr : {accel::Traversal::Packet, accel::Traversal::Single}) {
             accel::accel_config().primary = accel::accel_config().shadow = tr;
             StreamAccel sa(s, accel::SceneBvh::build(s));

@@ -1,0 +1,257 @@
+#pragma once
+// The single-ray mesh walk: one ray (in the mesh's canonical space) walks the mesh's 8-wide
+// BVH alone. A node's 8 child boxes are tested in one 8-lane slab test (two 4-lane halves on
+// the SSE levels), a leaf's triangles 4 at a time from their structure-of-arrays blocks
+// (MeshView::blocks), with the watertight test of shapes/triangle_math.h run with triangles
+// in the lanes instead of rays. Incoherent rays (shadow, mirror, glass) gain from it; the
+// packet walk (mesh_kernel.h) hands them over when few lanes of a packet remain.
+// Included only by kernels/isa_*.cpp, inside their own namespace.
+#include <xsimd/xsimd.hpp>
+
+#include <immintrin.h>
+
+#include <bit>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
+
+#include "mesh/mesh_view.h"
+#include "shapes/triangle_math.h"
+
+namespace streamrt::STREAMRT_ISA_NAMESPACE {
+
+namespace mesh_detail {
+
+constexpr int kStack = accel::kNodeWidth * 64;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+/// 1 + 2 gamma(3): a box's far distance is widened by this (Ize 2013, "Robust BVH ray
+/// traversal"), so float rounding in the slabs never drops a box the ray touches.
+constexpr float kWiden = 1.f + 2.f * (3.f * 0x1p-24f) / (1.f - 3.f * 0x1p-24f);
+
+struct Entry {
+    std::int32_t child;
+    std::uint32_t count;
+    float t;  ///< entry distance into the box (the smallest over the lanes for a packet)
+};
+
+}  // namespace mesh_detail
+
+/// The arches of the single-ray walk for a level's packet arch: nodes take 8 lanes (AVX2
+/// registers on the AVX levels, two halves of 4 on SSE), leaves 4 (one per block triangle).
+template <class Arch, bool Wide = (xsimd::batch<float, Arch>::size >= 8)>
+struct SingleRayArchs {
+    using node = Arch;
+    using leaf = Arch;
+};
+template <class Arch>
+struct SingleRayArchs<Arch, true> {
+    using node = xsimd::fma3<xsimd::avx2>;
+    using leaf = xsimd::sse4_2;
+};
+
+/// A mesh hit of one ray: triangle number and barycentrics (TriangleHit's u, v).
+struct MeshHit {
+    std::int32_t prim = -1;
+    float u = 0.f, v = 0.f;
+};
+
+/// One ray set up for the walk: per axis the offset (in floats from the node's start) of the
+/// near and far planes, chosen once from the direction's signs (the slab test then needs no
+/// min/max), and the watertight test's per-ray constants with its axis permutation as
+/// indices (the leaf loads permuted coordinates directly).
+template <class NodeArch, class LeafArch>
+struct SingleRay {
+    using NB = xsimd::batch<float, NodeArch>;
+    using LB = xsimd::batch<float, LeafArch>;
+    static_assert(LB::size == std::size_t(kBlockTriangles), "a leaf block is one triangle per lane");
+    NB ox, oy, oz, ix, iy, iz;
+    int near[3], far[3];
+    int axis[3];  ///< kx, ky, kz of the watertight test
+    LB o_perm[3];  ///< origin's coordinates on those axes
+    WatertightRay<LB> wr;  ///< sx, sy, sz used (the permutation masks are axis[] here)
+
+    SingleRay(const Vec3f& o, const Vec3f& d) : ox(o.x), oy(o.y), oz(o.z), ix(1.f / d.x), iy(1.f / d.y), iz(1.f / d.z) {
+        const float inv[3] = {1.f / d.x, 1.f / d.y, 1.f / d.z};
+        for (int a = 0; a < 3; ++a) {
+            // WideNode: lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, 8 floats each. A negative
+            // direction (-0 included: 1 / -0 = -inf) enters through the high plane.
+            const int lo = a * accel::kNodeWidth, hi = (3 + a) * accel::kNodeWidth;
+            near[a] = inv[a] < 0.f ? hi : lo;
+            far[a] = inv[a] < 0.f ? lo : hi;
+        }
+        const WatertightRay<float> w = watertight_ray(o, d);  // the per-lane setup, once
+        axis[0] = w.kx0 ? 0 : w.kx1 ? 1 : 2;
+        axis[1] = w.ky0 ? 0 : w.ky1 ? 1 : 2;
+        axis[2] = w.kz0 ? 0 : w.kz1 ? 1 : 2;
+        const float oc[3] = {o.x, o.y, o.z};
+        for (int a = 0; a < 3; ++a) o_perm[a] = LB(oc[axis[a]]);
+        wr.sx = LB(w.sx);
+        wr.sy = LB(w.sy);
+        wr.sz = LB(w.sz);
+    }
+};
+
+/// Bit l set where lane l of the mask is true, with the movemask instruction (compress.h's
+/// lane_bits goes through memory).
+template <class A>
+inline std::uint32_t movemask_bits(const xsimd::batch_bool<float, A>& m) {
+    using M = xsimd::batch_bool<float, A>;
+    if constexpr (std::is_integral_v<typename M::register_type>) {  // AVX-512: a mask register
+        return std::uint32_t(typename M::register_type(m));
+    } else if constexpr (M::size == 8) {
+        return std::uint32_t(_mm256_movemask_ps(typename M::register_type(m)));
+    } else {
+        static_assert(M::size == 4);
+        return std::uint32_t(_mm_movemask_ps(typename M::register_type(m)));
+    }
+}
+
+namespace mesh_detail {
+
+/// The children of node n the ray enters with t in [0, t_max] (far distance widened by
+/// kWiden; boxes are conservative, accel::conservative_box): written to hits[] nearest
+/// last, so pushing them in order pops the nearest first. A NaN slab distance (0 * inf: the
+/// ray lies in a slab plane) does not limit the interval, so such a ray is kept.
+template <class NodeArch, class LeafArch>
+inline int single_node_hits(const accel::WideNode& n, const SingleRay<NodeArch, LeafArch>& r, float t_max,
+                            Entry* hits) {
+    using NB = typename SingleRay<NodeArch, LeafArch>::NB;
+    constexpr std::size_t NW = NB::size;
+    const float* base = reinterpret_cast<const float*>(&n);
+    alignas(32) float t_out[accel::kNodeWidth];
+    std::uint32_t hit_bits = 0;
+    for (std::size_t j = 0; j < std::size_t(accel::kNodeWidth); j += NW) {
+        NB tn(0.f), tf(t_max);
+        const auto axis = [&](int a, const NB& oc, const NB& ic) {
+            const NB n_a = (NB::load_aligned(base + r.near[a] + j) - oc) * ic;
+            const NB f_a = (NB::load_aligned(base + r.far[a] + j) - oc) * ic;
+            tn = xsimd::select(n_a > tn, n_a, tn);
+            tf = xsimd::select(f_a < tf, f_a, tf);
+        };
+        axis(0, r.ox, r.ix);
+        axis(1, r.oy, r.iy);
+        axis(2, r.oz, r.iz);
+        tn.store_aligned(t_out + j);
+        hit_bits |= movemask_bits(tn <= tf * NB(kWiden)) << j;
+    }
+    int nh = 0;
+    for (; hit_bits; hit_bits &= hit_bits - 1) {
+        const int j = std::countr_zero(hit_bits);
+        if (n.child[j] < 0) continue;
+        const Entry e{n.child[j], n.count[j], t_out[j]};
+        int k = nh++;
+        while (k > 0 && hits[k - 1].t < e.t) {  // farthest first
+            hits[k] = hits[k - 1];
+            --k;
+        }
+        hits[k] = e;
+    }
+    return nh;
+}
+
+/// Corner c of a block's 4 triangles relative to the ray's origin, on the ray's permuted axes.
+template <class NodeArch, class LeafArch>
+inline auto block_corner(const TriangleBlock& b, int c, const SingleRay<NodeArch, LeafArch>& r) {
+    using LB = typename SingleRay<NodeArch, LeafArch>::LB;
+    return Vec3T<LB>{LB::load_aligned(b.corner[c][r.axis[0]]) - r.o_perm[0],
+                     LB::load_aligned(b.corner[c][r.axis[1]]) - r.o_perm[1],
+                     LB::load_aligned(b.corner[c][r.axis[2]]) - r.o_perm[2]};
+}
+
+template <class NodeArch, class LeafArch>
+inline auto block_hit(const TriangleBlock& b, const SingleRay<NodeArch, LeafArch>& r, float t_max) {
+    using LB = typename SingleRay<NodeArch, LeafArch>::LB;
+    return triangle_hit_permuted(r.wr, block_corner(b, 0, r), block_corner(b, 1, r), block_corner(b, 2, r), LB(0.f),
+                                 LB(t_max));
+}
+
+/// The leaf (first, count) against one ray, 4 triangles per test: shrinks best and records
+/// the hit; true when it found one.
+template <class NodeArch, class LeafArch>
+inline bool single_leaf_closest(const MeshView& m, const SingleRay<NodeArch, LeafArch>& r, std::uint32_t first,
+                                std::uint32_t count, float& best, MeshHit& hit) {
+    using LB = typename SingleRay<NodeArch, LeafArch>::LB;
+    const TriangleBlock* b = m.blocks + m.block_of[first];
+    bool found = false;
+    for (std::uint32_t k = 0; k < count; k += kBlockTriangles, ++b) {
+        const TriangleHit<LB> h = block_hit(*b, r, best);
+        if (!xsimd::any(h.t < LB(best))) continue;
+        alignas(16) float t[kBlockTriangles], u[kBlockTriangles], v[kBlockTriangles];
+        h.t.store_aligned(t);
+        h.u.store_aligned(u);
+        h.v.store_aligned(v);
+        for (int l = 0; l < kBlockTriangles; ++l)
+            if (t[l] < best) {
+                best = t[l];
+                hit = {std::int32_t(first + k + std::uint32_t(l)), u[l], v[l]};
+                found = true;
+            }
+    }
+    return found;
+}
+
+template <class NodeArch, class LeafArch>
+inline bool single_leaf_any(const MeshView& m, const SingleRay<NodeArch, LeafArch>& r, std::uint32_t first,
+                            std::uint32_t count, float t_max) {
+    using LB = typename SingleRay<NodeArch, LeafArch>::LB;
+    const TriangleBlock* b = m.blocks + m.block_of[first];
+    for (std::uint32_t k = 0; k < count; k += kBlockTriangles, ++b) {
+        const TriangleHit<LB> h = block_hit(*b, r, t_max);
+        if (xsimd::any(h.t < LB(t_max))) return true;
+    }
+    return false;
+}
+
+/// The walk itself, front to back from `start`: leaf(first, count) tests a leaf and returns
+/// true to stop; t_max (which the leaf may shrink) bounds the boxes, and a pop entered
+/// beyond it is skipped.
+template <class NodeArch, class LeafArch, class Leaf>
+inline void walk_single(const MeshView& m, const SingleRay<NodeArch, LeafArch>& r, Entry start, const float& t_max,
+                        Leaf&& leaf) {
+    Entry stack[kStack];
+    int sp = 0;
+    stack[sp++] = {start.child, start.count, 0.f};
+    while (sp > 0) {
+        const Entry e = stack[--sp];
+        if (e.t > t_max) continue;
+        if (e.count > 0) {
+            if (leaf(std::uint32_t(e.child), e.count)) return;
+            continue;
+        }
+        sp += single_node_hits(m.nodes[e.child], r, t_max, stack + sp);
+    }
+}
+
+}  // namespace mesh_detail
+
+/// Closest hit of the ray (o, d) with the part of the mesh under `start` (the root: {0, 0,
+/// 0}; a packet's stack entry when it hands a lane over) for t in (0, best): returns the new
+/// best and fills hit when it shrank.
+template <class NodeArch, class LeafArch>
+inline float mesh_closest_single(const MeshView& m, const Vec3f& o, const Vec3f& d, float best, MeshHit& hit,
+                                 mesh_detail::Entry start = {0, 0, 0.f}) {
+    using namespace mesh_detail;
+    if (!m.nodes || !(best > 0.f)) return best;
+    const SingleRay<NodeArch, LeafArch> r(o, d);
+    walk_single(m, r, start, best, [&](std::uint32_t first, std::uint32_t count) {
+        single_leaf_closest(m, r, first, count, best, hit);
+        return false;
+    });
+    return best;
+}
+
+/// Whether the mesh blocks the ray (o, d) for t in (0, t_max), under `start` as above.
+template <class NodeArch, class LeafArch>
+inline bool mesh_any_single(const MeshView& m, const Vec3f& o, const Vec3f& d, float t_max,
+                            mesh_detail::Entry start = {0, 0, 0.f}) {
+    using namespace mesh_detail;
+    if (!m.nodes || !(t_max > 0.f)) return false;
+    const SingleRay<NodeArch, LeafArch> r(o, d);
+    bool blocked = false;
+    walk_single(m, r, start, t_max, [&](std::uint32_t first, std::uint32_t count) {
+        return blocked = single_leaf_any(m, r, first, count, t_max);
+    });
+    return blocked;
+}
+
+}  // namespace streamrt::STREAMRT_ISA_NAMESPACE

@@ -1,0 +1,53 @@
+// The mesh's kernel layout beside the leaf-order triangles: each BVH leaf's triangles as
+// structure-of-arrays blocks (MeshView::blocks), for the single-ray walk's leaf test.
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+#include "mesh/mesh.h"
+#include "parallel/parallelism.h"
+
+namespace streamrt {
+
+void Mesh::build_triangle_blocks() {
+    // Leaves as (first triangle, count), in triangle order, so blocks follow the triangles.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> leaves;
+    for (const accel::WideNode& n : bvh.nodes)
+        for (int j = 0; j < accel::kNodeWidth; ++j)
+            if (n.child[j] >= 0 && n.count[j] > 0) leaves.emplace_back(std::uint32_t(n.child[j]), n.count[j]);
+    std::sort(leaves.begin(), leaves.end());
+    std::vector<std::uint32_t> first_block(leaves.size() + 1, 0);
+    for (std::size_t i = 0; i < leaves.size(); ++i)
+        first_block[i + 1] = first_block[i] + (leaves[i].second + kBlockTriangles - 1) / kBlockTriangles;
+    block_of.assign(triangle_count(), 0);
+    blocks.assign(first_block.back(), TriangleBlock{});
+    parallel_for_index(leaves.size(), 4096, [&](std::size_t i) {
+        const auto [first, count] = leaves[i];
+        block_of[first] = first_block[i];
+        for (std::uint32_t k = 0; k < count; k += kBlockTriangles) {
+            TriangleBlock& b = blocks[first_block[i] + k / kBlockTriangles];
+            for (int lane = 0; lane < kBlockTriangles; ++lane) {
+                const std::uint32_t t = first + k + std::uint32_t(lane);
+                const bool real = k + std::uint32_t(lane) < count;
+                for (int c = 0; c < 3; ++c)
+                    for (int a = 0; a < 3; ++a)
+                        b.corner[c][a][lane] = real ? tri[9 * std::size_t(t) + 3 * c + a]
+                                                    : std::numeric_limits<float>::quiet_NaN();
+            }
+        }
+    });
+}
+
+void Mesh::set_view(std::uint32_t single_ray_lanes) {
+    kernel_view = {bvh.nodes.empty() ? nullptr : bvh.nodes.data(), tri.data(), index.data(), vertex_normals.data(),
+                   std::uint32_t(triangle_count()), corner_uv.empty() ? nullptr : corner_uv.data(), uv_density,
+                   blocks.data(), block_of.data(), single_ray_lanes};
+}
+
+std::shared_ptr<const Mesh> Mesh::with_single_ray_lanes(std::uint32_t lanes) const {
+    auto copy = std::make_shared<Mesh>(*this);
+    copy->set_view(lanes);
+    return copy;
+}
+
+}  // namespace streamrt

@@ -1,0 +1,240 @@
+// The mesh walks (kernels/mesh_kernel.h packet and hybrid, kernels/mesh_single_kernel.h
+// single-ray with triangle blocks, and the scene hierarchy's single-ray walk through a mesh
+// leaf) against a brute-force oracle: every triangle of the mesh in double precision with the
+// Moller-Trumbore test written here (no code shared with the engine). Every SIMD level the
+// CPU has, closest and any hit, leaves of 1 to 4 triangles (the blocks' padding lanes), and
+// the hybrid's hand-over both ways: full coherent packets, and packets with one live lane.
+// Watertightness at shared edges and vertices is in mesh_test.cpp (check_all_hit, which also
+// runs these three walks).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "kernels/kernel_table.h"
+#include "mesh/mesh.h"
+#include "scene/scene_bvh.h"
+#include "stream/stream_accel.h"
+
+using namespace streamrt;
+
+namespace {
+
+struct OracleHit {
+    double t = std::numeric_limits<double>::infinity();
+    int prim = -1;
+    double margin = 0;  ///< smallest barycentric weight (distance from an edge) of the hit
+    double cosine = 1;  ///< |cos| of the angle between ray and triangle normal (small: grazing, t ill-conditioned)
+};
+
+/// Nearest hit over all triangles of the mesh (leaf order: the engine's triangle numbers),
+/// double precision, both faces, t in (0, t_max).
+OracleHit oracle(const Mesh& m, const Vec3f& of, const Vec3f& df, double t_max) {
+    OracleHit best;
+    const double o[3] = {of.x, of.y, of.z}, d[3] = {df.x, df.y, df.z};
+    for (std::size_t k = 0; k < m.triangle_count(); ++k) {
+        const float* p = &m.tri[9 * k];
+        double e1[3], e2[3], s[3];
+        for (int a = 0; a < 3; ++a) {
+            e1[a] = double(p[3 + a]) - p[a];
+            e2[a] = double(p[6 + a]) - p[a];
+            s[a] = o[a] - p[a];
+        }
+        const double q[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
+        const double det = e1[0] * q[0] + e1[1] * q[1] + e1[2] * q[2];
+        if (det == 0) continue;
+        const double u = (s[0] * q[0] + s[1] * q[1] + s[2] * q[2]) / det;
+        const double r[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2], s[0] * e1[1] - s[1] * e1[0]};
+        const double v = (d[0] * r[0] + d[1] * r[1] + d[2] * r[2]) / det;
+        const double t = (e2[0] * r[0] + e2[1] * r[1] + e2[2] * r[2]) / det;
+        if (u < 0 || v < 0 || u + v > 1 || !(t > 0) || !(t < t_max) || !(t < best.t)) continue;
+        const auto norm = [](const double* a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); };
+        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        best = {t, int(k), std::min({u, v, 1 - u - v}), std::abs(det) / (norm(d) * norm(n))};
+    }
+    return best;
+}
+
+/// A soup of random triangles of every size and orientation in [-1, 1]^3, so leaves hold 1
+/// to 4 triangles and overlap; `count` triangles.
+MeshData soup(std::size_t count, std::mt19937& rng) {
+    std::uniform_real_distribution<float> u(-1.f, 1.f), s(0.02f, 0.6f);
+    MeshData d;
+    for (std::size_t k = 0; k < count; ++k) {
+        const float c[3] = {u(rng), u(rng), u(rng)}, size = s(rng);
+        for (int j = 0; j < 3; ++j) {
+            for (int a = 0; a < 3; ++a) d.positions.push_back(c[a] + size * u(rng));
+            d.triangles.push_back(std::uint32_t(3 * k + std::size_t(j)));
+        }
+    }
+    return d;
+}
+
+struct Case {
+    std::vector<Vec3f> o, d;
+    std::vector<float> t_max;  ///< 0: an idle lane
+};
+
+void fill(RayStream& rs, const Case& c) {
+    rs.reserve(c.o.size());
+    for (std::size_t i = 0; i < c.o.size(); ++i) {
+        rs.ox[i] = c.o[i].x, rs.oy[i] = c.o[i].y, rs.oz[i] = c.o[i].z;
+        rs.dx[i] = c.d[i].x, rs.dy[i] = c.d[i].y, rs.dz[i] = c.d[i].z;
+        rs.t_max[i] = c.t_max[i];
+    }
+    rs.count = c.o.size();
+    rs.pad_tail();
+}
+
+/// A closest-hit stream of the case with the mesh-hit arrays attached.
+struct Traced {
+    RayStream rs;
+    AlignedVec<std::int32_t> id, prim;
+    AlignedVec<float> bu, bv;
+    RayView view;
+    explicit Traced(const Case& c) {
+        fill(rs, c);
+        id.assign(rs.capacity(), -1);
+        prim.assign(rs.capacity(), -1);
+        bu.assign(rs.capacity(), 0.f);
+        bv.assign(rs.capacity(), 0.f);
+        view = view_of(rs);
+        view.prim = prim.data(), view.bu = bu.data(), view.bv = bv.data();
+    }
+};
+
+/// Counts disagreements with the oracle of every walk on every level: closest t (relative
+/// 1e-4), triangle (unless the oracle's hit is within 1e-5 of an edge, where either
+/// neighbour is right, or the ray grazes the triangle, where float t is ill-conditioned), and
+/// any hit (unless the hit is that close to t_max or an edge).
+void check_against_oracle(const std::shared_ptr<const Mesh>& mesh, const Case& c) {
+    std::vector<OracleHit> want(c.o.size());
+    for (std::size_t i = 0; i < c.o.size(); ++i) want[i] = oracle(*mesh, c.o[i], c.d[i], c.t_max[i]);
+    const auto count_bad = [&](const RayStream& rs, const std::int32_t* id, const std::int32_t* prim, bool any) {
+        std::size_t bad = 0;
+        for (std::size_t i = 0; i < c.o.size(); ++i) {
+            const OracleHit& w = want[i];
+            const bool edge = w.prim >= 0 && (w.margin < 1e-5 || w.cosine < 1e-3);
+            if (any) {
+                const bool near_limit = w.prim >= 0 && w.t > 0.9999 * c.t_max[i];
+                const bool blocked = rs.t_max[i] == 0.f && c.t_max[i] > 0.f;
+                bad += !edge && !near_limit && blocked != (w.prim >= 0);
+                continue;
+            }
+            if (w.prim < 0) {
+                bad += id[i] >= 0 && !edge;
+                continue;
+            }
+            if (id[i] != 0) {
+                bad += !edge;
+                continue;
+            }
+            bad += !edge && std::abs(double(rs.t_max[i]) - w.t) > 1e-4 * w.t;
+            bad += !edge && prim[i] != w.prim && std::abs(double(rs.t_max[i]) - w.t) > 1e-6 * w.t;
+        }
+        return bad;
+    };
+    Scene scene;
+    {
+        Object o;
+        o.kind = ShapeKind::Mesh;
+        o.mesh = 0;
+        o.md = glm::dmat4x3(glm::dmat4(1.0));
+        scene.meshes.push_back(mesh);
+        scene.add_object(o);
+    }
+    for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
+        if (!isa_supported(isa)) continue;
+        const std::string isa_str = isa_name(isa);
+        CAPTURE(isa_str);
+        const KernelTable& kt = kernel_table(isa);
+        for (std::uint32_t lanes : {0u, 1u, 2u, 64u}) {
+            CAPTURE(lanes);
+            const auto walk = mesh->with_single_ray_lanes(lanes);
+            ObjectXf xf{};
+            xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
+            xf.id = 0;
+            xf.mesh = &walk->view();
+            Traced tr(c);
+            kt.closest[int(ShapeKind::Mesh)](tr.view, tr.id.data(), &xf, 1);
+            CHECK(count_bad(tr.rs, tr.id.data(), tr.prim.data(), false) == 0);
+            RayStream sh;
+            fill(sh, c);
+            kt.any[int(ShapeKind::Mesh)](view_of(sh), &xf, 1);
+            CHECK(count_bad(sh, nullptr, nullptr, true) == 0);
+        }
+        // The scene hierarchy's single-ray walk reaches the mesh through a leaf.
+        accel::accel_config().primary = accel::accel_config().secondary = accel::accel_config().shadow =
+            accel::Traversal::Single;
+        StreamAccel sa(scene, accel::SceneBvh::build(scene));
+        Traced tr(c);
+        sa.closest(kt, tr.view, tr.id.data(), false);
+        CHECK(count_bad(tr.rs, tr.id.data(), tr.prim.data(), false) == 0);
+        RayStream sh;
+        fill(sh, c);
+        sa.any(kt, view_of(sh));
+        CHECK(count_bad(sh, nullptr, nullptr, true) == 0);
+        accel::accel_config() = accel::AccelConfig{};
+    }
+}
+
+Vec3f random_dir(std::mt19937& rng) {
+    std::normal_distribution<float> n(0.f, 1.f);
+    for (;;) {
+        const Vec3f v{n(rng), n(rng), n(rng)};
+        if (length(v) > 1e-3f) return normalize(v);
+    }
+}
+
+}  // namespace
+
+TEST_CASE("mesh walks: random rays through a triangle soup agree with a brute-force double oracle") {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-1.5f, 1.5f), t(0.2f, 4.f);
+    for (std::size_t n : {std::size_t(1), std::size_t(2), std::size_t(3), std::size_t(5), std::size_t(300)}) {
+        CAPTURE(n);
+        const MeshData sd = soup(n, rng);
+        const auto mesh = Mesh::build("soup", sd.positions, sd.triangles);
+        Case c;
+        for (int i = 0; i < 3001; ++i) {  // not a multiple of any packet width: a tail
+            const Vec3f o{u(rng), u(rng), u(rng)};
+            c.o.push_back(o);
+            // Half aimed at a triangle's interior, half anywhere.
+            if (i % 2 && mesh->triangle_count() > 0) {
+                const float* p = &mesh->tri[9 * (std::size_t(rng()) % mesh->triangle_count())];
+                std::uniform_real_distribution<float> w(0.05f, 0.9f);
+                const float a = w(rng), b = (1.f - a) * w(rng);
+                const Vec3f q{p[0] + a * (p[3] - p[0]) + b * (p[6] - p[0]), p[1] + a * (p[4] - p[1]) + b * (p[7] - p[1]),
+                              p[2] + a * (p[5] - p[2]) + b * (p[8] - p[2])};
+                c.d.push_back(q - o);
+            } else {
+                c.d.push_back(random_dir(rng));
+            }
+            c.t_max.push_back(i % 3 ? 1e30f : t(rng));
+        }
+        check_against_oracle(mesh, c);
+    }
+}
+
+TEST_CASE("mesh walks: the hybrid hands packets over both ways (coherent packets, one live lane)") {
+    const MeshData d = uv_sphere(40, 80);
+    const auto mesh = Mesh::build("sphere", d.positions, d.triangles);
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(-0.05f, 0.05f);
+    Case coherent, sparse;
+    for (int i = 0; i < 1024; ++i) {
+        // A pencil of nearly parallel rays: every lane of a packet walks the same nodes, so
+        // the packet walk keeps them (more than 2 lanes at each entry) down to the leaves.
+        const Vec3f o{0.3f + u(rng), 0.2f + u(rng), 3.f};
+        coherent.o.push_back(o), coherent.d.push_back({0, 0, -1}), coherent.t_max.push_back(1e30f);
+        // Random rays with one live lane in 16: every packet goes to single rays at the root.
+        const Vec3f dir = random_dir(rng);
+        sparse.o.push_back(dir * -3.f + Vec3f{u(rng), u(rng), u(rng)});
+        sparse.d.push_back(dir + Vec3f{u(rng), u(rng), u(rng)} * 8.f);
+        sparse.t_max.push_back(i % 16 == 5 ? 1e30f : 0.f);
+    }
+    check_against_oracle(mesh, coherent);
+    check_against_oracle(mesh, sparse);
+}
