@@ -24,6 +24,7 @@
 #include "image/image_compare.h"
 #include "image/image_io.h"
 #include "parallel/parallelism.h"
+#include "mesh/mesh.h"
 #include "scene/parser.h"
 
 namespace py = pybind11;
@@ -34,8 +35,46 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+/// A scene built from Python: statements in the .cfg format (so every value goes through the
+/// scene reader's checks and messages) and meshes from NumPy arrays, held in memory and named
+/// by their statements as file=memory:K.
+struct PyScene {
+    std::vector<std::string> lines;
+    std::vector<std::shared_ptr<const Mesh>> meshes;
+    std::string text() const {
+        std::string t;
+        for (const std::string& l : lines) (t += l) += '\n';
+        return t;
+    }
+};
+
+/// A keyword value in the scene format: tuples and lists as "a,b,c", booleans true/false.
+std::string format_value(const py::handle& v) {
+    if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+    if (py::isinstance<py::tuple>(v) || py::isinstance<py::list>(v) || py::isinstance<py::array>(v)) {
+        std::string s;
+        for (const py::handle& x : v) s += (s.empty() ? "" : ",") + format_value(x);
+        return s;
+    }
+    if (py::isinstance<py::float_>(v)) return py::repr(v).cast<std::string>();
+    return py::str(v).cast<std::string>();
+}
+
+std::string statement(const std::string& word, const py::kwargs& kw) {
+    std::string s = word;
+    for (const auto& [k, v] : kw) s += " " + py::str(k).cast<std::string>() + "=" + format_value(v);
+    return s;
+}
+
+
 /// A scene given as a path to a .cfg file, or as the text of one (anything that is not an
 /// existing file): the text's messages name it "<string>".
+Scene read_scene(const PyScene& scene, int threads) {
+    ReadOptions options;
+    options.jobs = threads;
+    options.memory_meshes = &scene.meshes;
+    return parse_scene(scene.text(), "<scene>", options);
+}
 Scene read_scene(const std::string& scene, int threads) {
     std::error_code ec;
     if (scene.find('\n') == std::string::npos && std::filesystem::is_regular_file(scene, ec))
@@ -152,32 +191,36 @@ RenderOverrides overrides_of(const py::kwargs& kw, bool& profile, py::object& pr
     return o;
 }
 
-Result render(const std::string& scene, const py::kwargs& kw) {
+/// The scene a call names: a Scene built in Python, a .cfg path, or .cfg text.
+Scene read_any(const py::object& scene, int threads) {
+    if (py::isinstance<PyScene>(scene)) {
+        const PyScene& s = scene.cast<const PyScene&>();
+        py::gil_scoped_release release;
+        return read_scene(s, threads);
+    }
+    const std::string text = scene.cast<std::string>();
+    py::gil_scoped_release release;
+    return read_scene(text, threads);
+}
+
+Result render(const py::object& scene, const py::kwargs& kw) {
     bool profile = false;
     py::object progress = py::none();
     const RenderOverrides o = overrides_of(kw, profile, progress);
     const auto start = Clock::now();
-    Scene sc;
-    {
-        py::gil_scoped_release release;
-        sc = read_scene(scene, o.threads.value_or(0));
-    }
+    Scene sc = read_any(scene, o.threads.value_or(0));
     const double read_seconds = since(start);
     RenderJob job = build_render_job(std::move(sc), o, profile);
     RenderResult r = render_watched(job, job.engine, progress);
     return make_result(std::move(r), job, job.engine, read_seconds);
 }
 
-py::dict compare(const std::string& scene, const py::kwargs& kw) {
+py::dict compare(const py::object& scene, const py::kwargs& kw) {
     bool profile = false;
     py::object progress = py::none();
     const RenderOverrides o = overrides_of(kw, profile, progress);
     const auto start = Clock::now();
-    Scene sc;
-    {
-        py::gil_scoped_release release;
-        sc = read_scene(scene, o.threads.value_or(0));
-    }
+    Scene sc = read_any(scene, o.threads.value_or(0));
     const double read_seconds = since(start);
     RenderJob job = build_render_job(std::move(sc), o, profile);
     RenderResult stream = render_watched(job, EngineKind::Stream, progress);
@@ -243,6 +286,45 @@ PYBIND11_MODULE(streamrt, m) {
             return "<streamrt.Result " + r.engine + " " + std::to_string(r.image.shape(1)) + "x" +
                    std::to_string(r.image.shape(0)) + ", " + py::str(r.seconds["render"]).cast<std::string>() + " s>";
         });
+
+    py::class_<PyScene>(m, "Scene",
+                        "A scene built from Python: statements of the .cfg format (docs/scene-format.md) and\n"
+                        "meshes from NumPy arrays. Render it with streamrt.render(scene, ...).")
+        .def(py::init<>())
+        .def("add", [](PyScene& s, const std::string& text) {
+                for (std::size_t b = 0, e; b <= text.size(); b = e + 1) {
+                    e = std::min(text.find('\n', b), text.size());
+                    s.lines.push_back(text.substr(b, e - b));
+                }
+            }, py::arg("text"), "Appends statements (one or more lines of .cfg text).")
+        .def("statement", [](PyScene& s, const std::string& word, const py::kwargs& kw) {
+                s.lines.push_back(statement(word, kw));
+            }, py::arg("word"), "Appends one statement from keywords: statement('sphere', color=(1, 0, 0), translate=(0, 1, 0)).")
+        .def("mesh", [](PyScene& s, py::array_t<float, py::array::c_style | py::array::forcecast> vertices,
+                        py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast> triangles,
+                        const py::kwargs& kw) {
+                if (vertices.ndim() != 2 || vertices.shape(1) != 3)
+                    throw py::value_error("vertices: expected an array of shape (n, 3)");
+                if (triangles.ndim() != 2 || triangles.shape(1) != 3)
+                    throw py::value_error("triangles: expected an array of shape (m, 3) of vertex numbers");
+                const std::vector<float> positions(vertices.data(), vertices.data() + vertices.size());
+                const std::vector<std::uint32_t> tris(triangles.data(), triangles.data() + triangles.size());
+                for (const std::uint32_t v : tris)
+                    if (v >= std::uint32_t(vertices.shape(0)))
+                        throw py::value_error("triangles: vertex number " + std::to_string(v) + " out of range");
+                const std::string name = "memory:" + std::to_string(s.meshes.size());
+                std::shared_ptr<const Mesh> mesh;
+                {
+                    py::gil_scoped_release release;
+                    mesh = Mesh::build(name, positions, tris);
+                }
+                if (mesh->triangle_count() == 0) throw py::value_error("the mesh has no non-degenerate triangle");
+                s.meshes.push_back(std::move(mesh));
+                s.lines.push_back(statement("mesh file=" + name, kw));
+            }, py::arg("vertices"), py::arg("triangles"),
+            "Appends a mesh object from arrays (vertices (n, 3), triangles (m, 3), counter-clockwise seen\n"
+            "from outside) with the mesh statement's other keys: mesh(v, t, smooth=True, color=(1, 0, 0)).")
+        .def_property_readonly("text", &PyScene::text, "The statements as .cfg text (meshes as file=memory:K).");
 
     m.def("render", &render, py::arg("scene"),
           "render(scene, **overrides) -> Result\n\n"

@@ -11,6 +11,19 @@ class SceneError(ValueError):
     column: int
     message: str
 
+class Scene:
+    """A scene built from Python: .cfg statements and meshes from NumPy arrays."""
+    def __init__(self) -> None: ...
+    def add(self, text: str) -> None:
+        """Appends statements (one or more lines of .cfg text)."""
+    def statement(self, word: str, **keys: Any) -> None:
+        """Appends one statement: statement('sphere', color=(1, 0, 0), translate=(0, 1, 0))."""
+    def mesh(self, vertices: npt.ArrayLike, triangles: npt.ArrayLike, **keys: Any) -> None:
+        """Appends a mesh object: vertices (n, 3), triangles (m, 3), and the mesh statement's keys."""
+    @property
+    def text(self) -> str:
+        """The statements as .cfg text (meshes named file=memory:K)."""
+
 class Result:
     """One render."""
     @property
@@ -30,7 +43,7 @@ class Result:
         """'stream' or 'recursive'."""
 
 def render(
-    scene: str,
+    scene: str | Scene,
     *,
     width: Optional[int] = ...,
     height: Optional[int] = ...,
@@ -53,7 +66,7 @@ def render(
 ) -> Result:
     """Renders a scene (a .cfg path or its text) with the command line's overrides."""
 
-def compare(scene: str, **overrides: Any) -> dict[str, Any]:
+def compare(scene: str | Scene, **overrides: Any) -> dict[str, Any]:
     """Both engines: 'stream' and 'recursive' Results, 'speedup', 'rmse', 'psnr', 'max_abs', 'share_over'."""
 
 def save(

@@ -109,6 +109,18 @@ fs::path Parser::target_of(const Statement& st, const Arg& a) {
 }
 
 std::uint32_t Parser::mesh_file(const Statement& st, const Arg& a, bool with_uv) {
+    constexpr std::string_view kMemory = "memory:";
+    if (options_.memory_meshes && a.value.substr(0, kMemory.size()) == kMemory) {
+        // A mesh held by the front end, added to the scene once (its texture coordinates, if
+        // any, are those it was built with).
+        const auto k = to_number(a.value.substr(kMemory.size()));
+        const std::size_t n = options_.memory_meshes->size();
+        if (!k || *k != std::floor(*k) || !(*k >= 0 && *k < double(n)))
+            st.fail(a.value_col, "no in-memory mesh " + quote(a.value) + " (there are " + std::to_string(n) + ")");
+        const auto [it, added] = memory_mesh_index_.try_emplace(std::size_t(*k), std::uint32_t(scene.meshes.size()));
+        if (added) scene.meshes.push_back((*options_.memory_meshes)[std::size_t(*k)]);
+        return it->second;
+    }
     return read_once(
         st, a.value_col, target_of(st, a), "mesh", meshes_, scene.meshes,
         [&](fs::path id) { return std::pair{std::move(id), with_uv}; },

@@ -2,6 +2,7 @@
 // Reads the line-oriented .cfg scene format (docs/scene-format.md). Every mistake throws a
 // SceneError carrying file:line:col; a returned Scene is fully validated.
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,6 +27,9 @@ struct ReadOptions {
     /// When set, receives a copy of every file read (the scene, its includes, its meshes), in
     /// reading order: what another machine needs to read the same scene (engine/distributed).
     std::vector<FileCopy>* copies = nullptr;
+    /// Meshes a front end holds in memory (the Python module's Scene.mesh): a `mesh` statement
+    /// names the K-th as `file=memory:K`. Null: no such name is accepted.
+    const std::vector<std::shared_ptr<const Mesh>>* memory_meshes = nullptr;
 };
 
 /// Loads and validates a scene file, following `include` statements. `jobs` threads read a

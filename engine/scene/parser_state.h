@@ -120,6 +120,7 @@ class Parser {
     // By file identity and whether its texture coordinates are kept: loaded once, shared
     // (index in scene.meshes).
     std::map<std::pair<fs::path, bool>, std::uint32_t> meshes_;
+    std::map<std::size_t, std::uint32_t> memory_mesh_index_;  // ReadOptions::memory_meshes -> scene.meshes
     MaterialList scene_materials_{&scene};  // the one-pass reader's: straight into the scene
     int files_ = 0;
 

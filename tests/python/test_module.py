@@ -126,3 +126,49 @@ def test_compare_and_save_round_trip(tmp_path):
     np.testing.assert_array_equal(read_pfm(tmp_path / "x.pfm"), img)
     with pytest.raises(ValueError):
         streamrt.save(np.zeros((4, 4)), str(tmp_path / "bad.png"))
+
+
+def read_obj(path):
+    """Vertices and triangles of an OBJ file of v and triangle f lines, read here."""
+    vertices, triangles = [], []
+    for line in pathlib.Path(path).read_text().splitlines():
+        parts = line.split()
+        if parts and parts[0] == "v":
+            vertices.append([float(x) for x in parts[1:4]])
+        elif parts and parts[0] == "f":
+            triangles.append([int(p.split("/")[0]) - 1 for p in parts[1:4]])
+    return np.array(vertices, np.float32), np.array(triangles, np.uint32)
+
+
+def test_a_scene_built_from_arrays_renders_like_the_cfg_file():
+    obj = ROOT / "scenes/meshes/icosphere.obj"
+    head = ("image width=48 height=32 spp=2 depth=3\ncamera eye=0,1,5 look=0,0.5,0 fov=40\n"
+            "light point pos=3,6,4\nplane color=0.4,0.4,0.4 checker=0.2,0.2,0.2\n")
+    keys = "smooth=true color=0.9,0.45,0.2 refl=0.3 translate=0,1,0"
+    with tempfile.TemporaryDirectory() as d:
+        cfg = pathlib.Path(d) / "m.cfg"
+        cfg.write_text(head + f"mesh file={obj} {keys}\n")
+        want = streamrt.render(str(cfg)).image
+    scene = streamrt.Scene()
+    scene.add(head.rstrip("\n"))
+    v, t = read_obj(obj)
+    scene.mesh(v, t, smooth=True, color=(0.9, 0.45, 0.2), refl=0.3, translate=(0, 1, 0))
+    assert "mesh file=memory:0 smooth=true color=0.9,0.45,0.2 refl=0.3 translate=0,1,0" in scene.text
+    np.testing.assert_array_equal(streamrt.render(scene).image, want)
+    # Statements from keywords, checked by the scene reader like any file.
+    scene.statement("sphere", color=(0, 0, 1), translate=(2, 1, 0), scale=0.5)
+    assert streamrt.render(scene).image.shape == (32, 48, 3)
+    bad = streamrt.Scene()
+    bad.statement("sphere", colour=(1, 0, 0))
+    with pytest.raises(streamrt.SceneError) as e:
+        streamrt.render(bad)
+    assert (e.value.file, e.value.line, e.value.column) == ("<scene>", 1, 8)
+    held = streamrt.Scene()
+    held.mesh(v, t)
+    held.add("mesh file=memory:3")
+    with pytest.raises(streamrt.SceneError, match="no in-memory mesh 'memory:3' \\(there are 1\\)"):
+        streamrt.render(held)
+    with pytest.raises(streamrt.SceneError, match="cannot open mesh file"):  # text holds no meshes
+        streamrt.render("image width=8 height=8\nmesh file=memory:0\n")
+    with pytest.raises(ValueError, match="out of range"):
+        streamrt.Scene().mesh(v, t + 10000)
