@@ -1,0 +1,144 @@
+#pragma once
+// The streamrt command (docs/scene-format.md; README "Using it"), one concept a file:
+// main.cpp (options, dispatch, exit status), job.cpp (the render job from the options and the
+// checks before rendering), progress.h (the progress bar), picture.cpp (one picture, both
+// engines, frames), tiled.cpp (shards, checkpoints, tile costs, MPI, merge).
+#include <CLI/CLI.hpp>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "scene/scene_bvh.h"
+#include "core/error.h"
+#include "distributed/mpi_render.h"
+#include "distributed/scene_bundle.h"
+#include "distributed/tile_file.h"
+#include "image/image_compare.h"
+#include "image/image_io.h"
+#include "kernels/kernel_table.h"
+#include "parallel/parallelism.h"
+#include "driver/limits.h"
+#include "driver/render.h"
+#include "driver/render_job.h"
+#include "scene/animation.h"
+#include "scene/parser.h"
+
+#ifndef STREAMRT_VERSION
+#define STREAMRT_VERSION "dev"
+#endif
+
+namespace streamrt::cli {
+
+namespace fs = std::filesystem;
+
+/// Set by SIGINT/SIGTERM: the render stops, nothing is written (exit status 130). The one
+/// process-wide flag: a signal handler can only reach a global.
+extern std::atomic<bool> g_cancel;
+struct Interrupted {};
+
+struct Options {
+    std::string scene_path;
+    int jobs = 0;
+    std::string output;
+    std::optional<int> spp, width, height, degree, depth;
+    std::optional<double> cutoff;
+    std::optional<int> light_samples;
+    std::string engine = "stream";
+    std::string accel = "auto";
+    std::string isa;
+    bool profile = false;
+    std::string profile_json;
+    bool compare = false;
+    std::string shade = "simd";
+    std::string sampler;
+    bool quiet = false;
+    bool check_only = false;
+    bool mpi = false;
+    std::string mpi_schedule = "dynamic";
+    std::string shard;
+    int shard_k = -1, shard_n = 0;
+    std::string checkpoint;
+    bool resume = false;
+    std::string tile_costs;
+    // Display colour overrides of the image keys (docs/scene-format.md, "Output and display colour").
+    std::string colorspace, tonemap;
+    std::optional<double> exposure;
+    std::string frames;  ///< --frames A..B (animation)
+    /// Rendered tile by tile (render_tiles) rather than as one image.
+    bool tiled() const { return mpi || shard_n > 0 || !checkpoint.empty() || !tile_costs.empty(); }
+};
+
+/// A render ready to go: the scene with the command line's settings, the engine's options.
+struct Job {
+    Scene scene;
+    PixelSettings settings;  ///< everything the pixels depend on beside the scene's files
+    EngineKind engine = EngineKind::Stream;
+    EngineOptions eo;
+    std::unique_ptr<StreamProfile> profile;  ///< when profiling (eo.profile points to it)
+    double read_seconds = 0;
+    int frame = -1;  ///< the frame being rendered (animation; -1: a still picture)
+};
+
+using Clock = std::chrono::steady_clock;
+inline double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// ---- animation: the frames to render (scene/animation.h) ----
+struct FramePlan {
+    int first = 0, last = 0;
+    bool any = false;   ///< frames asked for (--frames or image frames=)
+    bool many = false;  ///< more than one
+};
+
+// ---- job.cpp ----
+/// Prints the error being handled (one line) and gives its exit status: 2 bad usage or bad
+/// scene, 1 render or I/O failure, 130 interrupted. `quiet`: the status only.
+int report_error(std::exception_ptr error, bool quiet = false);
+/// This process's rank when an MPI launcher started it (0 otherwise).
+int launcher_rank();
+/// Refuses, before rendering, an output in a missing or read-only folder, a folder, or the scene itself.
+void check_writable_path(const std::string& out, const std::string& scene_path);
+void check_output_path(const std::string& out, const std::string& scene_path);
+/// Applies the command line to a loaded scene and checks everything before rendering.
+/// `writes`: this process writes the output (false on MPI ranks other than 0).
+/// `check_isa`: --isa must be supported here (MPI ranks agree on it together instead).
+Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa);
+/// The engine's set-up; the scene's object records are released when the engine renders
+/// from its own tables.
+std::unique_ptr<PreparedRender> prepare(Job& job, EngineKind which, bool keep_objects);
+void report_profile(const Options& opt, const StreamProfile* profile);
+/// The summary line.
+void print_summary(const Options& opt, const Job& job, int jobs, const std::string& how, double seconds,
+                   const RayCounts& counts, double setup_seconds, double write_seconds);
+
+// ---- picture.cpp ----
+/// The output name of frame `frame` (printf-style %d), nullopt without one.
+std::optional<std::string> frame_output_name(const std::string& pattern, int frame);
+FramePlan plan_frames(const Options& opt, const RenderSettings& s);
+int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle,
+                   std::unique_ptr<PreparedRender>& prepared);
+int render_frames(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle, const FramePlan& plan);
+
+// ---- tiled.cpp ----
+int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle, const MpiSession* mpi,
+                 std::unique_ptr<PreparedRender>& prepared);
+int run_mpi(const Options& opt, int argc, char** argv);
+int run_merge(int argc, char** argv);
+
+}  // namespace streamrt::cli

@@ -1,0 +1,160 @@
+// The render job from the command line, and the checks made before anything renders.
+#include "cli/cli.h"
+#include "cli/progress.h"
+
+namespace streamrt::cli {
+
+/// This process's rank when an MPI launcher started it (0 otherwise): messages that every
+/// rank would print alike are printed by rank 0 only.
+int launcher_rank() {
+    for (const char* v : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
+        if (const char* r = std::getenv(v)) return std::atoi(r);
+    return 0;
+}
+
+// A missing folder, a read-only folder or the scene file itself are refused before any
+// rendering starts.
+void check_writable_path(const std::string& out, const std::string& scene_path) {
+    std::error_code ec;
+    const fs::path target = fs::absolute(out, ec);
+    if (fs::exists(scene_path, ec) && fs::exists(target, ec) && fs::equivalent(target, scene_path, ec))
+        throw UsageError("output '" + out + "' is the scene file itself");
+    if (fs::is_directory(target, ec)) throw UsageError("output '" + out + "' is a folder");
+    const fs::path dir = target.parent_path();
+    if (!fs::is_directory(dir, ec)) throw UsageError("output folder '" + dir.string() + "' does not exist");
+    if (::access(dir.c_str(), W_OK) != 0) throw UsageError("output folder '" + dir.string() + "' is not writable");
+    // access() says yes to root everywhere; creating a file is what matters (read-only file
+    // systems, /proc, ...). The probe is an unnamed file (O_TMPFILE): a process killed at any
+    // moment leaves nothing in the folder. File systems without O_TMPFILE get a named probe,
+    // removed at once.
+    int fd = ::open(dir.c_str(), O_TMPFILE | O_WRONLY, 0600);
+    if (fd < 0 && (errno == EOPNOTSUPP || errno == EISDIR || errno == EINVAL)) {
+        const fs::path probe = dir / ("." + target.filename().string() + ".probe" + std::to_string(::getpid()));
+        fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+        if (fd >= 0) ::unlink(probe.c_str());
+    }
+    if (fd < 0)
+        throw UsageError("output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
+    ::close(fd);
+}
+
+void check_output_path(const std::string& out, const std::string& scene_path) {
+    if (!image_format_for(out))
+        throw UsageError("output '" + out + "': unknown image format (expected " + image_format_extensions() + ")");
+    check_writable_path(out, scene_path);
+}
+
+
+/// The command line's overrides of the scene's settings (driver/render_job.h: the Python
+/// module builds its jobs from the same record).
+RenderOverrides overrides_of(const Options& opt) {
+    RenderOverrides o;
+    o.width = opt.width, o.height = opt.height, o.spp = opt.spp, o.depth = opt.depth, o.degree = opt.degree;
+    o.cutoff = opt.cutoff, o.light_samples = opt.light_samples, o.exposure = opt.exposure;
+    const auto text = [](const std::string& v) { return v.empty() ? std::nullopt : std::optional<std::string>(v); };
+    o.sampler = text(opt.sampler), o.colorspace = text(opt.colorspace), o.tonemap = text(opt.tonemap);
+    o.engine = opt.engine, o.accel = opt.accel, o.shade = opt.shade;
+    o.threads = opt.jobs;
+    return o;
+}
+
+/// Applies the command line to a loaded scene and checks everything before rendering.
+/// `writes`: this process writes the output (false on MPI ranks other than 0).
+/// `check_isa`: --isa must be supported here (MPI ranks agree on it together instead).
+Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
+    if (!opt.isa.empty() && opt.engine == "recursive" && !opt.compare)
+        throw UsageError("--isa chooses the stream engine's kernels; the recursive engine has none (scalar, double)");
+    if ((opt.profile || !opt.profile_json.empty()) && opt.engine != "stream" && !opt.compare)
+        throw UsageError("--profile needs the stream engine");
+    RenderOverrides overrides = overrides_of(opt);
+    if (check_isa && !opt.isa.empty()) overrides.isa = opt.isa;  // checked against this CPU there
+    RenderJob built = build_render_job(std::move(scene), overrides, opt.profile || !opt.profile_json.empty());
+    Job job;
+    job.scene = std::move(built.scene);
+    job.settings = built.settings;
+    job.engine = built.engine;
+    job.eo = built.options;
+    job.profile = std::move(built.profile);
+    if (!check_isa && !opt.isa.empty()) parse_isa(opt.isa, job.eo.isa);  // MPI: the ranks agree on it later
+    job.settings.isa = job.eo.isa;
+    RenderSettings& s = job.scene.settings;
+    if (!opt.output.empty()) s.output = opt.output;
+    if (opt.mpi && s.frames_last > s.frames_first)
+        throw UsageError("--mpi renders one picture, the scene's image frames= asks for several (render them as a job "
+                         "array, docs/distributed.md)");
+    if (writes) {
+        // A shard part is a tile file (docs/distributed.md), whatever its name.
+        if (opt.shard_n > 0) check_writable_path(s.output, opt.scene_path);
+        else check_output_path(s.output, opt.scene_path);
+        if (!opt.profile_json.empty()) check_writable_path(opt.profile_json, opt.scene_path);
+        if (!opt.tile_costs.empty()) check_writable_path(opt.tile_costs, opt.scene_path);
+    }
+    // Refuse, before allocating anything big, a render that cannot fit in this machine.
+    const int jobs = opt.jobs > 0 ? opt.jobs : default_jobs();
+    check_render_memory(job.scene, job.engine == EngineKind::Stream || opt.compare, jobs);
+    return job;
+}
+
+/// The engine's set-up; the scene's object records are released when the engine renders
+/// from its own tables (128 bytes each; 128 MB at 1e6 objects).
+std::unique_ptr<PreparedRender> prepare(Job& job, EngineKind which, bool keep_objects) {
+    auto prepared = prepare_render(job.scene, which, job.eo);
+    // An animated scene keeps them: the next frames are set on them (scene/animation.h).
+    if (!prepared->reads_scene_objects() && !keep_objects && !job.scene.animation) {
+        std::vector<Object>().swap(job.scene.objects);
+        std::vector<ObjectLoc>().swap(job.scene.object_locs);
+    }
+    return prepared;
+}
+
+void report_profile(const Options& opt, const StreamProfile* profile) {
+    if (!profile) return;
+    if (opt.profile) std::printf("%s", profile->text().c_str());
+    if (!opt.profile_json.empty()) write_text_file(opt.profile_json, profile->json());
+}
+
+/// The summary line.
+void print_summary(const Options& opt, const Job& job, int jobs, const std::string& how, double seconds,
+                   const RayCounts& counts, double setup_seconds, double write_seconds) {
+    if (opt.quiet) return;
+    const RenderSettings& s = job.scene.settings;
+    const std::string frame = job.frame >= 0 ? ", frame " + std::to_string(job.frame) : "";
+    const double mrays = counts.total() / std::max(seconds, 1e-9) / 1e6;
+    std::printf("%s: %dx%d, spp %d, degree %d, %s engine%s, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s"
+                " (read %.3f s, set-up %.3f s, render %.3f s, write %.3f s)\n",
+                opt.scene_path.c_str(), s.width, s.height, s.spp, s.degree, engine_name(job.engine), (how + frame).c_str(), jobs,
+                seconds, static_cast<unsigned long long>(counts.total()), mrays, setup_seconds, s.output.c_str(),
+                job.read_seconds, setup_seconds, seconds, write_seconds);
+}
+
+
+/// Prints the error being handled (one line) and gives its exit status: 2 bad usage or bad
+/// scene, 1 render or I/O failure, 130 interrupted. `quiet`: the status only.
+int report_error(std::exception_ptr error, bool quiet) {
+    const auto say = [&](const std::string& text) {
+        if (!quiet) std::fprintf(stderr, "streamrt: %s\n", text.c_str());
+    };
+    try {
+        std::rethrow_exception(error);
+    } catch (const Interrupted&) {
+        say("interrupted, no image written");
+        return 130;
+    } catch (const SceneError& e) {
+        say(e.what());
+        return 2;
+    } catch (const UsageError& e) {
+        say(e.what());
+        return 2;
+    } catch (const RenderError& e) {
+        say(e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        say("out of memory");
+        return 1;
+    } catch (const std::exception& e) {
+        say(e.what());
+        return 1;
+    }
+}
+
+}  // namespace streamrt::cli
