@@ -85,13 +85,8 @@ struct Options {
     bool tiled() const { return mpi || shard_n > 0 || !checkpoint.empty() || !tile_costs.empty(); }
 };
 
-/// A render ready to go: the scene with the command line's settings, the engine's options.
-struct Job {
-    Scene scene;
-    PixelSettings settings;  ///< everything the pixels depend on beside the scene's files
-    EngineKind engine = EngineKind::Stream;
-    EngineOptions eo;
-    std::unique_ptr<StreamProfile> profile;  ///< when profiling (eo.profile points to it)
+/// A render ready to go (driver/render_job.h), and what the command line adds to it.
+struct Job : RenderJob {
     double read_seconds = 0;
     int frame = -1;  ///< the frame being rendered (animation; -1: a still picture)
 };

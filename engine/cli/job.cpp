@@ -68,15 +68,10 @@ Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
         throw UsageError("--profile needs the stream engine");
     RenderOverrides overrides = overrides_of(opt);
     if (check_isa && !opt.isa.empty()) overrides.isa = opt.isa;  // checked against this CPU there
-    RenderJob built = build_render_job(std::move(scene), overrides, opt.profile || !opt.profile_json.empty());
     Job job;
-    job.scene = std::move(built.scene);
-    job.settings = built.settings;
-    job.engine = built.engine;
-    job.eo = built.options;
-    job.profile = std::move(built.profile);
-    if (!check_isa && !opt.isa.empty()) parse_isa(opt.isa, job.eo.isa);  // MPI: the ranks agree on it later
-    job.settings.isa = job.eo.isa;
+    static_cast<RenderJob&>(job) = build_render_job(std::move(scene), overrides, opt.profile || !opt.profile_json.empty());
+    if (!check_isa && !opt.isa.empty()) parse_isa(opt.isa, job.options.isa);  // MPI: the ranks agree on it later
+    job.settings.isa = job.options.isa;
     RenderSettings& s = job.scene.settings;
     if (!opt.output.empty()) s.output = opt.output;
     if (opt.mpi && s.frames_last > s.frames_first)
@@ -98,7 +93,7 @@ Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
 /// The engine's set-up; the scene's object records are released when the engine renders
 /// from its own tables (128 bytes each; 128 MB at 1e6 objects).
 std::unique_ptr<PreparedRender> prepare(Job& job, EngineKind which, bool keep_objects) {
-    auto prepared = prepare_render(job.scene, which, job.eo);
+    auto prepared = prepare_render(job.scene, which, job.options);
     // An animated scene keeps them: the next frames are set on them (scene/animation.h).
     if (!prepared->reads_scene_objects() && !keep_objects && !job.scene.animation) {
         std::vector<Object>().swap(job.scene.objects);

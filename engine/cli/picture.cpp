@@ -66,7 +66,7 @@ int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBu
     if (opt.tiled()) return render_tiled(opt, job, par, bundle, nullptr, prepared);
     const RenderSettings& s = job.scene.settings;
     const EngineKind engine = job.engine;
-    EngineOptions& eo = job.eo;
+    EngineOptions& eo = job.options;
     WriteOptions wo;
     wo.par = &par;
     wo.cancel = &g_cancel;

@@ -24,7 +24,7 @@ int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBund
     TileFileHeader header;
     header.scene = bundle.content_hash();
     PixelSettings settings = job.settings;
-    settings.isa = job.eo.isa;  // MPI: the level the ranks agreed on
+    settings.isa = job.options.isa;  // MPI: the level the ranks agreed on
     settings.frame = job.frame;  // parts of one frame only
     header.settings = settings_token(settings);
     header.width = s.width;
@@ -70,7 +70,7 @@ int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBund
     if (job.profile && mpi) job.profile->threads = par.jobs();
     report_profile(opt, job.profile.get());
     if (opt.profile && mpi) std::printf("%s", rank_stats_text(ranks).c_str());
-    std::string how = job.engine == EngineKind::Stream ? std::string(", isa ") + isa_name(job.eo.isa) : "";
+    std::string how = job.engine == EngineKind::Stream ? std::string(", isa ") + isa_name(job.options.isa) : "";
     if (mpi)
         how += ", " + std::to_string(mpi->size()) + (mpi->size() == 1 ? " rank" : " ranks") + " (" +
                opt.mpi_schedule + ")";
@@ -118,12 +118,12 @@ int run_mpi(const Options& opt, int argc, char** argv) {
         // every rank has (float results differ in the last bits between levels).
         if (job->engine == EngineKind::Stream) {
             if (!opt.isa.empty()) {
-                if (mpi.min_over_ranks(isa_supported(job->eo.isa) ? 1 : 0) == 0) {
+                if (mpi.min_over_ranks(isa_supported(job->options.isa) ? 1 : 0) == 0) {
                     if (rank0) std::fprintf(stderr, "streamrt: --isa %s: not every rank's CPU supports it\n", opt.isa.c_str());
                     return 2;
                 }
             } else {
-                job->eo.isa = Isa(mpi.min_over_ranks(int(best_isa())));
+                job->options.isa = Isa(mpi.min_over_ranks(int(best_isa())));
             }
         }
         if (opt.check_only) {
