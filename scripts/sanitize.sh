@@ -111,6 +111,7 @@ tbb_built=$(date +%s)
 # Python module: an instrumented module cannot be loaded into an uninstrumented interpreter.
 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSTREAMRT_SANITIZE="$sanitize" \
   -DSTREAMRT_MPI=OFF -DSTREAMRT_BUILD_PERF=OFF -DSTREAMRT_BUILD_PYTHON=OFF -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g -fno-math-errno" \
+  -DSTREAMRT_TEST_TIMEOUT_SCALE=10 \
   "${extra[@]}" >/dev/null
 ninja -C "$dir" -j"$jobs"
 if [[ $kind == tsan ]]; then
