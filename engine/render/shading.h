@@ -214,6 +214,10 @@ template <class V>
 struct DirectLight {
     ColorT<V> color;  ///< zero where `lit` is false
     MaskOf<V> lit;    ///< the light reaches the side the normal faces
+    /// Where `color` may be non-zero: lit, and for a material without a Lambert term (diff =
+    /// 0: a pure mirror or glass) only where its highlight is above its cut-off. A shadow ray
+    /// elsewhere could only carry zero, so none is cast there (the same pixels, fewer rays).
+    MaskOf<V> contributes;
 };
 
 /// Direct light from one light at degree >= 1, before visibility:
@@ -227,8 +231,11 @@ inline DirectLight<V> direct_light(int degree, const MaterialT<T>& m, const Colo
     const V ndotw = dot(n, s.w);
     const auto lit = s.reaches && (ndotw > zero);
     const V k = select(lit, ndotw, zero);
-    if (degree == 1) return {base * k, lit};
+    if (degree == 1) return {base * k, lit, lit};
     ColorT<V> c = base * (V(m.diff) * k);
+    const bool lambert = m.diff > T(0);  // per material: uniform over a packet
+    auto contributes = lit;
+    if (!lambert) contributes = lit && !lit;  // none but the highlight's lanes, below
     if (m.spec > T(0)) {
         const Vec3T<V> r = n * (V(2) * ndotw) - s.w;  // w mirrored about n
         const V rv = -dot(r, view);
@@ -237,8 +244,9 @@ inline DirectLight<V> direct_light(int degree, const MaterialT<T>& m, const Colo
             const V h = select(shiny, V(m.spec) * simd::pow(select(shiny, rv, V(1)), V(m.shininess)), zero);
             c = c + ColorT<V>{h, h, h};
         }
+        if (!lambert) contributes = shiny;
     }
-    return {mul(c, splat<V>(l.color)), lit};
+    return {mul(c, splat<V>(l.color)), lit, contributes};
 }
 
 /// The part of the colour that needs no light: degree 0 the flat colour, degree 1
@@ -474,7 +482,7 @@ template <bool kShadows, class V, class T, class M, class Sink>
         }
         const ShapedSample<V> s = sample_shaped_light(l, p, u1, u2);
         const DirectLight<V> dl = direct_light(rules.degree, m, base, n, ray.dir, l, s.ls);
-        const auto send = dl.lit && active && (s.scale > V(0));
+        const auto send = dl.contributes && active && (s.scale > V(0));
         if (!any(send)) continue;
         const ColorT<V> c = mul(ray.weight, dl.color) * (s.scale * share);
         if constexpr (kShadows) {
@@ -537,7 +545,7 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
             }
             const LightSample<V> ls = sample_light(l, p);
             const DirectLight<V> dl = direct_light(rules.degree, m, base, n, d, l, ls);
-            const auto send = dl.lit && active;
+            const auto send = dl.contributes && active;
             if (!any(send)) continue;
             const ColorT<V> c = mul(ray.weight, dl.color);
             if constexpr (kShadows) {

@@ -255,6 +255,9 @@ TEST_CASE("pipeline: ray counts of each stage, worked out by hand on a plane see
         {2, "plane refl=0.5 trans=0.5", true, P, 0, 0, 0},
         // no light: no shadow rays even at degree 5
         {5, "plane refl=0.5", false, 2 * P, 0, P, 0},
+        // glass without a Lambert term or highlight: the light could add nothing, so no
+        // shadow ray leaves it (the same pixels: render/shading.h, DirectLight::contributes)
+        {5, "plane trans=0.5 ior=1.5 diff=0 spec=0", true, 2 * P, 0, 0, P},
     };
     for (const Case& c : cases) {
         CAPTURE(c.degree); CAPTURE(c.plane); CAPTURE(c.light);
@@ -276,6 +279,28 @@ TEST_CASE("pipeline: ray counts of each stage, worked out by hand on a plane see
         // Every shadow ray reaches the light: nothing but the plane, which it leaves.
         CHECK(prof.stages[int(Stage::Occlusion)].rays_in == c.shadow);
         CHECK(prof.stages[int(Stage::Occlusion)].rays_out == c.shadow);
-        if (c.shadow == 0) CHECK(prof.stages[int(Stage::Occlusion)].nanoseconds == 0);
+        if (c.shadow == 0 && !std::string(c.plane).empty() && std::string(c.plane).find("diff=0") == std::string::npos)
+            CHECK(prof.stages[int(Stage::Occlusion)].nanoseconds == 0);
+    }
+}
+
+// Proven against: shadow rays sent wherever the light reaches (send = lit, the old rule):
+// every hit of the highlight-only mirror casts one (P instead of a part of P), and the
+// diff=0 spec=0 glass above casts P.
+TEST_CASE("pipeline: a surface without a Lambert term casts shadow rays only where its highlight shows") {
+    // The plane seen from above, a mirror with a narrow highlight (shininess 200) and no
+    // Lambert term: the light straight above shows in the middle of the picture only.
+    constexpr int W = 20, H = 15;
+    constexpr std::uint64_t P = std::uint64_t(W) * H;
+    const std::string text = "image width=20 height=15 depth=1 degree=5\ncamera eye=0,5,0 look=0,0,0 up=0,0,-1 fov=40\n"
+                             "light point pos=0,10,0\nplane refl=0.5 diff=0 spec=1 shininess=200\n";
+    const Scene sc = parse_scene(text, "highlight.cfg");
+    for (EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
+        CAPTURE(engine_name(engine));
+        Parallelism par(1);
+        const RenderResult r = render_scene(sc, engine, par);
+        CHECK(r.counts.primary == P);
+        CHECK(r.counts.shadow > 0);
+        CHECK(r.counts.shadow < P / 2);
     }
 }
