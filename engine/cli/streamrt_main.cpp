@@ -570,7 +570,8 @@ int run(int argc, char** argv) {
     app.add_option("--shade", opt.shade,
                    "Stream shade stage: simd (default: hits regrouped by object up to 8192 objects, by material and "
                    "kind above), sorted, gathered or scalar (for measurement)")
-        ->check(CLI::IsMember({"simd", "sorted", "gathered", "scalar"}));
+        ->check(CLI::IsMember({"simd", "sorted", "gathered", "scalar"}))
+        ->group("");  // a measuring switch (docs/performance.md), not in the user's --help
     app.add_option("--colorspace", opt.colorspace, "8-bit output encoding: srgb (default) or linear (the handout's)")
         ->check(CLI::IsMember({"srgb", "linear"}));
     app.add_option("--tonemap", opt.tonemap, "Tone curve before calibration: clamp (default) or reinhard")
