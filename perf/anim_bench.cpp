@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
     const int frames = argc > 3 ? std::atoi(argv[3]) : 10;
     Parallelism par(argc > 4 ? std::atoi(argv[4]) : 0);
     const std::string text = make_scene(n, keyed);
-    accel::accel_config().mode = accel::AccelMode::Bvh;
+    EngineOptions options;
+    options.accel.mode = accel::AccelMode::Bvh;
     std::printf("%d spheres, %d keyed, frames 1..%d, %d threads; per-frame set-up, median (ms)\n", n, keyed, frames,
                 par.jobs());
     std::printf("| engine | refit (first frame: links built) | rebuild | new set-up per frame | render, refitted | render, rebuilt |\n"
@@ -63,9 +64,9 @@ int main(int argc, char** argv) {
         for (const EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
             double ms[3], first_refit = 0, render_ms[2] = {0, 0};
             for (int how = 0; how < 3; ++how) {
-                accel::accel_config().refit_max_share = how == 0 ? 1e18 : 0.0;  // always refit / always rebuild
+                options.accel.refit_max_share = how == 0 ? 1e18 : 0.0;  // always refit / always rebuild
                 Scene scene = parse_scene(text, "anim_bench");
-                auto prepared = prepare_render(scene, engine);
+                auto prepared = prepare_render(scene, engine, options);
                 std::vector<double> t;
                 for (int f = 1; f <= frames; ++f) {
                     const FrameChange change = set_frame(scene, f);
@@ -74,7 +75,7 @@ int main(int argc, char** argv) {
                         t.push_back(prepared->setup_seconds);
                     } else {
                         prepared.reset();
-                        prepared = prepare_render(scene, engine);
+                        prepared = prepare_render(scene, engine, options);
                         t.push_back(prepared->setup_seconds);
                     }
                 }

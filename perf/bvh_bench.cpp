@@ -89,9 +89,22 @@ int arg_jobs(int& argc, char** argv) {
     return jobs;
 }
 
-double render_seconds(const Scene& s, EngineKind e, Parallelism& par, int reps = 3) {
+/// The hierarchy settings of the renders measured here: `mode`, and the build's cost model
+/// from the environment (BVH_TRAVERSAL_COST, BVH_MAX_LEAF) when set, for tuning runs.
+accel::AccelConfig bench_accel(accel::AccelMode mode = accel::AccelMode::Auto) {
+    accel::AccelConfig config;
+    config.mode = mode;
+    if (const char* c = std::getenv("BVH_TRAVERSAL_COST")) config.build.traversal_cost = float(std::atof(c));
+    if (const char* c = std::getenv("BVH_MAX_LEAF")) config.build.max_leaf = std::atoi(c);
+    return config;
+}
+
+double render_seconds(const Scene& s, EngineKind e, Parallelism& par, int reps = 3,
+                      accel::AccelMode mode = accel::AccelMode::Auto) {
+    EngineOptions options;
+    options.accel = bench_accel(mode);
     double best = 1e30;
-    for (int r = 0; r < reps; ++r) best = std::min(best, render_scene(s, e, par).seconds);
+    for (int r = 0; r < reps; ++r) best = std::min(best, render_scene(s, e, par, nullptr, options).seconds);
     return best;
 }
 
@@ -107,7 +120,7 @@ int cmd_build(std::size_t n, int jobs) {
                     n, jobs, t1 - t0, b->bvh.stats.seconds, b->bvh.stats.wide_nodes, b->bvh.stats.leaves,
                     double(b->bvh.memory_bytes()) / double(n));
     }
-    StreamAccel sa(s, accel::SceneBvh::build(s));
+    StreamAccel sa(s, accel::SceneBvh::build(s), accel::AccelConfig{});
     std::printf("stream engine hierarchy (nodes + index + leaf objects): %.1f bytes/object\n",
                 double(sa.memory_bytes()) / double(n));
     return 0;
@@ -120,7 +133,7 @@ int cmd_scaling(std::vector<std::size_t> ns, int jobs) {
     for (std::size_t n : ns) {
         const Scene s = random_spheres(n);
         const double t0 = now();
-        StreamRenderer renderer(s, best_isa());  // builds the stream scene and its hierarchy
+        StreamRenderer renderer(s, best_isa(), ShadeMode::Auto, 0, bench_accel());  // builds the stream scene and its hierarchy
         const double tb = now() - t0;
         double t = 1e30;
         RenderProgress progress;
@@ -153,7 +166,7 @@ int cmd_traversal(std::size_t n) {
     const Isa isa = best_isa();
     const KernelTable& kt = kernel_table(isa);
     const AccelKernelTable& at = accel_kernel_table(isa);
-    StreamAccel sa(s, accel::SceneBvh::build(s));
+    StreamAccel sa(s, accel::SceneBvh::build(s), accel::AccelConfig{});
     // Build the leaf objects view the same way StreamAccel does, by asking it to trace.
     const int W = s.settings.width, H = s.settings.height;
     constexpr std::size_t kChunk = 4096;  // as the stream engine's chunks (16x16 tiles x 16)
@@ -279,13 +292,10 @@ int cmd_threshold(int jobs) {
         double t[4];
         int k = 0;
         for (EngineKind e : {EngineKind::Stream, EngineKind::Recursive})
-            for (accel::AccelMode m : {accel::AccelMode::Flat, accel::AccelMode::Bvh}) {
-                accel::accel_config().mode = m;
-                t[k++] = render_seconds(s, e, par, e == EngineKind::Stream ? 5 : 2);
-            }
+            for (accel::AccelMode m : {accel::AccelMode::Flat, accel::AccelMode::Bvh})
+                t[k++] = render_seconds(s, e, par, e == EngineKind::Stream ? 5 : 2, m);
         std::printf("%3zu  %.4f  %.4f   %.4f  %.4f\n", n, t[0], t[1], t[2], t[3]);
     }
-    accel::accel_config().mode = accel::AccelMode::Auto;
     return 0;
 }
 
@@ -293,8 +303,6 @@ int cmd_threshold(int jobs) {
 
 int main(int argc, char** argv) {
     const int jobs = arg_jobs(argc, argv);
-    if (const char* c = std::getenv("BVH_TRAVERSAL_COST")) accel::accel_config().build.traversal_cost = float(std::atof(c));
-    if (const char* c = std::getenv("BVH_MAX_LEAF")) accel::accel_config().build.max_leaf = std::atoi(c);
     const std::string cmd = argc > 1 ? argv[1] : "";
     if (cmd == "build" && argc > 2) return cmd_build(std::size_t(std::atof(argv[2])), jobs);
     if (cmd == "scaling") {

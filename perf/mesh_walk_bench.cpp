@@ -214,14 +214,13 @@ int main(int argc, char** argv) {
         o.md = glm::dmat4x3(glm::dmat4(1.0));
         scene.meshes.push_back(mesh);
         scene.add_object(o);
-        accel::accel_config().mode = accel::AccelMode::Bvh;
-        accel::accel_config().primary = accel::accel_config().secondary = accel::accel_config().shadow =
-            accel::Traversal::Single;
-        const StreamAccel sa(scene, accel::SceneBvh::build(scene));
+        accel::AccelConfig single;
+        single.mode = accel::AccelMode::Bvh;
+        single.primary = single.secondary = single.shadow = accel::Traversal::Single;
+        const StreamAccel sa(scene, accel::SceneBvh::build(scene), single);
         std::printf("%-6s %10.2f %10.2f %10.2f %10.2f %10.2f\n", "scene1", scene_single_mrays(s.primary, false, kt, sa, reps),
                     scene_single_mrays(s.shadow, true, kt, sa, reps), scene_single_mrays(s.mirror, false, kt, sa, reps),
                     scene_single_mrays(s.glass, false, kt, sa, reps), scene_single_mrays(s.diffuse, false, kt, sa, reps));
-        accel::accel_config() = accel::AccelConfig{};
     }
     return 0;
 }

@@ -38,8 +38,8 @@ struct RecursiveSink {
 };
 }  // namespace
 
-RecursiveRenderer::RecursiveRenderer(const Scene& scene)
-    : scene_(scene), bvh_(accel::SceneBvh::build_for(scene)), camera_(CameraRays<double>::from(scene)) {
+RecursiveRenderer::RecursiveRenderer(const Scene& scene, const accel::AccelConfig& accel)
+    : scene_(scene), accel_config_(accel), bvh_(accel::SceneBvh::build_for(scene, accel_config_)), camera_(CameraRays<double>::from(scene)) {
     objects_.resize(scene.objects.size());
     parallel_for_index(scene.objects.size(), 4096, [&](std::size_t i) {
         const Object& o = scene.objects[i];
@@ -230,8 +230,9 @@ void RecursiveRenderer::update(const FrameChange& change) {
     }
     if (change.camera) camera_ = CameraRays<double>::from(scene_);
     if (bvh_ && !change.objects.empty()) {
-        if (bvh_->refit_pays(change.objects.size())) bvh_->refit(scene_, change.objects, bvh_->bvh.prim_index);
-        else bvh_ = accel::SceneBvh::build(scene_, accel::accel_config().build);
+        if (bvh_->refit_pays(change.objects.size(), accel_config_))
+            bvh_->refit(scene_, change.objects, bvh_->bvh.prim_index);
+        else bvh_ = accel::SceneBvh::build(scene_, accel_config_.build);
     }
 }
 

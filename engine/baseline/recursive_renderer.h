@@ -40,7 +40,8 @@ struct HitD {
 
 class RecursiveRenderer {
   public:
-    explicit RecursiveRenderer(const Scene& scene);
+    /// accel: whether and how the object hierarchy is used (EngineOptions::accel).
+    explicit RecursiveRenderer(const Scene& scene, const accel::AccelConfig& accel = {});
 
     /// Renders the whole image; tiles in parallel, each pixel independent of -j.
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr) const;
@@ -84,6 +85,7 @@ class RecursiveRenderer {
     /// Tests object i in its canonical space; shrinks t_max and records it on a closer hit.
     bool test_object(std::size_t i, const RayD& ray, double t_min, double& t_max, Candidate& c) const;
     const Scene& scene_;
+    accel::AccelConfig accel_config_;
     std::unique_ptr<accel::SceneBvh> bvh_;  ///< null: the handout's loop over all objects
     CameraRays<double> camera_;
     std::vector<PreparedObject> objects_;

@@ -28,28 +28,29 @@ int run(int argc, char** argv) {
                    "Shadow rays per shaded point of every area light (overrides the lights' samples=)")
         ->check(CLI::Range(1, 4096));
     app.add_option("--engine", opt.engine, "Renderer: stream (SIMD ray streams) or recursive (the handout's baseline)")
-        ->check(CLI::IsMember({"stream", "recursive"}));
+        ->check(CLI::IsMember(names_vector(kEngineNames)));
     app.add_option("--isa", opt.isa, "Force the stream kernels' level: sse2, sse4.2, avx2 or avx512 (default: best the CPU has)")
-        ->check(CLI::IsMember({"sse2", "sse4.2", "avx2", "avx512"}));
+        ->check(CLI::IsMember(names_vector(kIsaNames)));
     app.add_option("--accel", opt.accel,
                    "Object hierarchy: auto (the BVH above a measured object count), bvh (always) or flat (the "
                    "handout's loop over all objects)")
-        ->check(CLI::IsMember({"auto", "bvh", "flat"}));
+        ->check(CLI::IsMember(names_vector(accel::kAccelModeNames)));
     app.add_flag("--profile", opt.profile, "Print per-stage throughput of the stream engine");
     app.add_option("--profile-json", opt.profile_json, "Write the profile as JSON to FILE (also: --profile=json FILE)");
     app.add_option("--shade", opt.shade,
                    "Stream shade stage: simd (default: hits regrouped by object up to 8192 objects, by material and "
                    "kind above), sorted, gathered or scalar (for measurement)")
-        ->check(CLI::IsMember({"simd", "sorted", "gathered", "scalar"}));
+        ->check(CLI::IsMember(names_vector(kShadeModeNames)))
+        ->group("");  // a measuring switch (docs/performance.md), not in the user's --help
     app.add_option("--colorspace", opt.colorspace, "8-bit output encoding: srgb (default) or linear (the handout's)")
-        ->check(CLI::IsMember({"srgb", "linear"}));
+        ->check(CLI::IsMember(names_vector(kColorSpaceNames)));
     app.add_option("--tonemap", opt.tonemap, "Tone curve before calibration: clamp (default) or reinhard")
-        ->check(CLI::IsMember({"clamp", "reinhard"}));
+        ->check(CLI::IsMember(names_vector(kTonemapNames)));
     app.add_option("--exposure", opt.exposure, "Multiplier of the linear values before the tone curve")
         ->check(CLI::Range(1e-6, 1e6));
     app.add_flag("--compare", opt.compare, "Render with both engines and report times, speedup and image difference");
     app.add_option("--sampler", opt.sampler, "Pixel sampling: stratified, grid or random")
-        ->check(CLI::IsMember({"stratified", "grid", "random"}));
+        ->check(CLI::IsMember(names_vector(kSamplePatternNames)));
     app.add_flag("-q,--quiet", opt.quiet, "No progress bar and no summary line");
     app.add_flag("--check", opt.check_only, "Validate the scene and the output path, render nothing");
     app.add_flag("--mpi", opt.mpi, "Render with the ranks of an MPI job: mpirun -np N streamrt --mpi ...");

@@ -18,7 +18,7 @@ double seconds_since(Clock::time_point t) { return std::chrono::duration<double>
 
 class PreparedRecursive final : public PreparedRender {
   public:
-    explicit PreparedRecursive(const Scene& scene) : renderer_(scene) {}
+    PreparedRecursive(const Scene& scene, const EngineOptions& options) : renderer_(scene, options.accel) {}
     Framebuffer render(Parallelism& par, RenderProgress* progress) override { return renderer_.render(par, progress); }
     bool reads_scene_objects() const override { return true; }
     void update_engine(const Scene&, const FrameChange& change) override { renderer_.update(change); }
@@ -41,7 +41,7 @@ class PreparedRecursive final : public PreparedRender {
 class PreparedStream final : public PreparedRender {
   public:
     PreparedStream(const Scene& scene, const EngineOptions& options)
-        : renderer_(scene, options.isa, options.shade, options.slice_rays), profile_(options.profile) {}
+        : renderer_(scene, options.isa, options.shade, options.slice_rays, options.accel), profile_(options.profile) {}
     Framebuffer render(Parallelism& par, RenderProgress* progress) override {
         return renderer_.render(par, progress, profile_);
     }
@@ -74,7 +74,7 @@ std::unique_ptr<PreparedRender> prepare_render(const Scene& scene, EngineKind en
     // that rays/s speaks of the rendering alone.
     const auto start = Clock::now();
     std::unique_ptr<PreparedRender> p;
-    if (engine == EngineKind::Recursive) p = std::make_unique<PreparedRecursive>(scene);
+    if (engine == EngineKind::Recursive) p = std::make_unique<PreparedRecursive>(scene, options);
     else p = std::make_unique<PreparedStream>(scene, options);
     p->setup_seconds = seconds_since(start);
     p->width = scene.settings.width;

@@ -14,6 +14,7 @@
 #include "render/render_stats.h"
 #include "scene/animation.h"
 #include "scene/scene.h"
+#include "scene/scene_bvh.h"
 
 namespace streamrt {
 
@@ -33,6 +34,7 @@ struct EngineOptions {
     StreamProfile* profile = nullptr;   ///< stream engine: per-stage figures, when wanted
     ShadeMode shade = ShadeMode::Auto;  ///< stream engine: how the shade stage groups hits
     std::size_t slice_rays = 0;         ///< stream engine: most rays traced at once (0: default; tests)
+    accel::AccelConfig accel;           ///< both engines: whether and how the object hierarchy is used
 };
 
 /// An engine with its set-up done (tables, hierarchy), ready to render.

@@ -144,9 +144,7 @@ RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile) 
     }
     job.engine = o.engine && *o.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
     job.threads = o.threads.value_or(0);
-    accel::accel_config().mode = !o.accel || *o.accel == "auto" ? accel::AccelMode::Auto
-                                 : *o.accel == "bvh"            ? accel::AccelMode::Bvh
-                                                                : accel::AccelMode::Flat;
+    if (o.accel) job.options.accel.mode = *value_named(accel::kAccelModeNames, *o.accel);
     if (o.isa) {
         parse_isa(*o.isa, job.options.isa);
         if (!isa_supported(job.options.isa)) throw UsageError("isa " + *o.isa + ": this CPU does not support it");
@@ -163,7 +161,7 @@ RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile) 
     p.cutoff = s.cutoff, p.exposure = s.exposure;
     p.sampler = s.pattern, p.calibration = s.calibration, p.colorspace = s.colorspace, p.tonemap = s.tonemap;
     p.exr = s.exr;
-    p.engine = job.engine, p.isa = job.options.isa, p.accel = accel::accel_config().mode, p.shade = job.options.shade;
+    p.engine = job.engine, p.isa = job.options.isa, p.accel = job.options.accel.mode, p.shade = job.options.shade;
     return job;
 }
 

@@ -22,7 +22,9 @@ namespace streamrt {
 
 class Parallelism;
 
-/// The PNG writer's knobs (perf/image_bench.cpp measures them; the defaults are the choice).
+/// The PNG writer's knobs. The product always writes with the defaults (the measured choice,
+/// docs/performance.md "Image output"); the fields stay settable because perf/image_bench.cpp
+/// sets all three to measure the alternatives against them.
 enum class PngFilter : unsigned char { None = 0, Sub = 1, Up = 2 };
 struct PngOptions {
     int level = 1;            ///< zlib level

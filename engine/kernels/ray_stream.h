@@ -59,19 +59,6 @@ struct RayStream {
     void pad_tail() { make_tail_inert(*this); }
 };
 
-/// Closest hit per ray: t (t_max where nothing was hit) and the scene object index (-1).
-struct HitStream {
-    AlignedVec<float> t;
-    AlignedVec<std::int32_t> object;
-    void reserve(std::size_t n) {
-        const std::size_t cap = simd::round_up_lanes(n);
-        if (t.size() < cap) {
-            t.resize(cap);
-            object.resize(cap);
-        }
-    }
-};
-
 /// Shadow rays: a segment towards a light and the colour it brings if nothing blocks it.
 struct ShadowStream {
     std::size_t count = 0;

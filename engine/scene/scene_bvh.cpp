@@ -9,11 +9,6 @@
 
 namespace streamrt::accel {
 
-AccelConfig& accel_config() {
-    static AccelConfig config;
-    return config;
-}
-
 bool object_world_bounds(const Object& o, const Mesh* mesh, double lo[3], double hi[3]) {
     const glm::dmat4x3& m = o.md;
     // The canonical box: the shape's own bounds (shapes/shapes.h), or the mesh's.

@@ -31,7 +31,8 @@ enum class AccelMode : std::uint8_t {
 inline constexpr EnumName<AccelMode> kAccelModeNames[] = {
     {AccelMode::Auto, "auto"}, {AccelMode::Bvh, "bvh"}, {AccelMode::Flat, "flat"}};
 
-/// Process-wide settings (the command line's --accel, perf/ and the tests set them).
+/// How a render uses the hierarchy: a value carried by EngineOptions::accel to both engines
+/// (the command line's --accel, perf/ and the tests set it there; no process-wide copy).
 struct AccelConfig {
     AccelMode mode = AccelMode::Auto;
     /// Measured (docs/performance.md, "## BVH"): below this many bounded objects the flat
@@ -46,7 +47,6 @@ struct AccelConfig {
     /// it otherwise (docs/performance.md, "## Animation"). 0: always rebuild.
     double refit_max_share = 0.25;
 };
-AccelConfig& accel_config();
 
 /// The hierarchy over the bounded objects of a scene plus the list of the others.
 struct SceneBvh {
@@ -57,7 +57,7 @@ struct SceneBvh {
     /// nullptr when the configuration says this scene is traced flat.
     /// shift: the hierarchy is built for the scene translated by -shift (the stream engine
     /// renders relative to the eye, stream/stream_scene.cpp) without copying the scene.
-    static std::unique_ptr<SceneBvh> build_for(const Scene& scene, const AccelConfig& config = accel_config(),
+    static std::unique_ptr<SceneBvh> build_for(const Scene& scene, const AccelConfig& config,
                                                const glm::dvec3& shift = glm::dvec3(0.0));
     /// The hierarchy regardless of the mode.
     static std::unique_ptr<SceneBvh> build(const Scene& scene, const BuildOptions& options = {},
@@ -67,7 +67,7 @@ struct SceneBvh {
     /// Whether moving `moved` more of the hierarchy's objects is refitted (true) or rebuilt:
     /// refitted while all the objects moved since the build, these included, are at most
     /// config.refit_max_share of the hierarchy's.
-    bool refit_pays(std::size_t moved, const AccelConfig& config = accel_config()) const;
+    bool refit_pays(std::size_t moved, const AccelConfig& config) const;
     /// Refits the boxes of the scene objects `moved` (scene indices; unbounded ones are
     /// skipped) at their current Md. `order` maps a leaf position to its scene index
     /// (bvh.prim_index, or the stream engine's copy of it); shift as in build().

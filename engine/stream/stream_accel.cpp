@@ -22,18 +22,16 @@ KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t i
     return k;
 }
 
-std::shared_ptr<StreamAccel> StreamAccel::build_for(const Scene& scene, const glm::dvec3& shift) {
-    auto bvh = accel::SceneBvh::build_for(scene, accel::accel_config(), shift);
+std::shared_ptr<StreamAccel> StreamAccel::build_for(const Scene& scene, const accel::AccelConfig& config,
+                                                    const glm::dvec3& shift) {
+    auto bvh = accel::SceneBvh::build_for(scene, config, shift);
     if (!bvh) return nullptr;
-    return std::make_shared<StreamAccel>(scene, std::move(bvh), shift);
+    return std::make_shared<StreamAccel>(scene, std::move(bvh), config, shift);
 }
 
-StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh, const glm::dvec3& shift)
-    : bvh_(std::move(bvh)) {
-    const accel::AccelConfig& c = accel::accel_config();
-    primary_ = c.primary;
-    secondary_ = c.secondary;
-    shadow_ = c.shadow;
+StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh, const accel::AccelConfig& config,
+                         const glm::dvec3& shift)
+    : bvh_(std::move(bvh)), config_(config) {
     // Leaf order: the leaves' ranges [child, child + count) index objects_ directly, so the
     // hierarchy's own map to scene indices moves here (id -> scene index).
     order_ = std::move(bvh_->bvh.prim_index);
@@ -58,7 +56,7 @@ void StreamAccel::closest(const KernelTable& kt, RayView rays, std::int32_t* obj
     if (bvh_->bvh.empty()) return;
     const AccelKernelTable& at = accel_kernel_table(kt.isa);
     const AccelView view{bvh_->bvh.nodes.data(), objects_.data()};
-    const accel::Traversal tr = coherent ? primary_ : secondary_;
+    const accel::Traversal tr = coherent ? config_.primary : config_.secondary;
     (tr == accel::Traversal::Packet ? at.closest_packet : at.closest_single)(view, rays, object);
 }
 
@@ -68,12 +66,12 @@ void StreamAccel::any(const KernelTable& kt, RayView rays) const {
     if (bvh_->bvh.empty()) return;
     const AccelKernelTable& at = accel_kernel_table(kt.isa);
     const AccelView view{bvh_->bvh.nodes.data(), objects_.data()};
-    (shadow_ == accel::Traversal::Packet ? at.any_packet : at.any_single)(view, rays);
+    (config_.shadow == accel::Traversal::Packet ? at.any_packet : at.any_single)(view, rays);
 }
 
 // ---- animation: per-frame update ----
 bool StreamAccel::update(const Scene& scene, std::span<const std::uint32_t> moved, const glm::dvec3& shift, bool all) {
-    if (!all && !bvh_->refit_pays(moved.size())) return false;
+    if (!all && !bvh_->refit_pays(moved.size(), config_)) return false;
     if (id_of_.empty()) {
         id_of_.assign(scene.objects.size(), -1);
         for (std::size_t id = 0; id < order_.size(); ++id) id_of_[order_[id]] = std::int32_t(id);

@@ -24,10 +24,12 @@ KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t i
 
 class StreamAccel {
   public:
-    /// nullptr when the scene is traced without the hierarchy (accel_config()).
+    /// nullptr when `config` says the scene is traced without the hierarchy.
     /// For the scene translated by -shift (the stream engine renders relative to the eye).
-    static std::shared_ptr<StreamAccel> build_for(const Scene& scene, const glm::dvec3& shift = glm::dvec3(0.0));
-    StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh, const glm::dvec3& shift = glm::dvec3(0.0));
+    static std::shared_ptr<StreamAccel> build_for(const Scene& scene, const accel::AccelConfig& config,
+                                                  const glm::dvec3& shift = glm::dvec3(0.0));
+    StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bvh, const accel::AccelConfig& config,
+                const glm::dvec3& shift = glm::dvec3(0.0));
 
     /// Closest hit of every ray (see ClosestHitFn); `coherent` picks the configured traversal
     /// for primary rays, otherwise for secondary rays. Ids index objects().
@@ -57,7 +59,7 @@ class StreamAccel {
     FillLaterVec<KernelObject> objects_;                ///< by id: leaf order, then unbounded
     std::vector<std::uint32_t> order_;                  ///< id -> scene index
     std::vector<ObjectXf> unbounded_[kShapeKindCount];  ///< per kind, outside the hierarchy
-    accel::Traversal primary_, secondary_, shadow_;
+    accel::AccelConfig config_;  ///< traversal per ray class, refit or rebuild
     std::vector<std::int32_t> id_of_;  ///< scene index -> id; built on the first update
 };
 

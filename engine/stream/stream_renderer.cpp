@@ -10,8 +10,9 @@
 
 namespace streamrt {
 
-StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade, std::size_t slice_rays)
-    : scene_(scene),
+StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade, std::size_t slice_rays,
+                               const accel::AccelConfig& accel)
+    : scene_(scene, accel),
       kernels_(kernel_table(isa)),
       tile_fn_(nullptr),
       shade_mode_(resolve_shade_mode(scene_, shade)),

@@ -21,7 +21,9 @@ class StreamRenderer {
     /// picks by object count, the others are kept for measurement and tests).
     /// slice_rays: the most rays of one generation traced at once per thread (0: the default,
     /// max(kSliceRays, spp)); smaller values are for tests.
-    StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade = ShadeMode::Auto, std::size_t slice_rays = 0);
+    /// accel: whether and how the object hierarchy is used (EngineOptions::accel).
+    StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade = ShadeMode::Auto, std::size_t slice_rays = 0,
+                   const accel::AccelConfig& accel = {});
 
     /// Renders the image. With a profile, every stage is timed and counted into it.
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr, StreamProfile* profile = nullptr) const;

@@ -45,7 +45,8 @@ glm::vec3 cell_offset(const Material& m, const glm::dvec3& eye) {
 
 }  // namespace
 
-StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
+StreamScene::StreamScene(const Scene& scene, const accel::AccelConfig& accel_config)
+    : settings(scene.settings), accel_config_(accel_config) {
     // Objects are moved as they are converted (no copy of the scene: at 1e6 objects that copy
     // doubled the memory and the set-up time).
     glm::dvec3 eye;
@@ -57,7 +58,7 @@ StreamScene::StreamScene(const Scene& scene) : settings(scene.settings) {
     textures = scene.textures;
     has_meshes = !meshes.empty();
 
-    accel = StreamAccel::build_for(scene, eye);
+    accel = StreamAccel::build_for(scene, accel_config_, eye);
     const std::size_t n = scene.objects.size();
     std::fill(std::begin(group_bounded), std::end(group_bounded), true);
     if (accel) {
@@ -166,7 +167,7 @@ void StreamScene::update(const Scene& scene, const FrameChange& change) {
     if (!accel) {
         convert_flat(scene);  // O(N): few objects, unless --accel flat forces the flat loops
     } else if (!accel->update(scene, change.objects, eye, shifted)) {
-        accel = StreamAccel::build_for(scene, eye);
+        accel = StreamAccel::build_for(scene, accel_config_, eye);
         objects = accel->objects().data();
         fill_surfaces(scene);  // ids follow the new leaf order
     }

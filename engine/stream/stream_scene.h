@@ -61,7 +61,8 @@ struct StreamScene {
     /// The images the materials' textures point into (kept alive here).
     std::vector<std::shared_ptr<const Texture>> textures;
 
-    explicit StreamScene(const Scene& scene);
+    /// accel: whether and how the object hierarchy is used (EngineOptions::accel).
+    explicit StreamScene(const Scene& scene, const accel::AccelConfig& accel = {});
 
     /// Animation (scene/animation.h): `scene` was put at another frame; brings the tables up
     /// to it, converting only what `change` names (all objects when the eye moved).
@@ -71,6 +72,7 @@ struct StreamScene {
 
   private:
     std::vector<KernelObject> flat_objects_;  ///< `objects` without a hierarchy
+    accel::AccelConfig accel_config_;          ///< kept for rebuilding the hierarchy in update()
     glm::dvec3 eye_{0.0};                     ///< the world position of the engine's origin
     void convert_flat(const Scene& scene);    ///< fills flat_objects_, groups and their bounds
     void convert_lights(const Scene& scene);

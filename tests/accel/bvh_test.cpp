@@ -139,7 +139,7 @@ TEST_CASE("BVH: SIMD packet and single-ray kernels agree with the flat kernels, 
         const Scene s = random_scene(n, 100 + std::uint32_t(n));
         const double side = 3.0 * std::cbrt(double(n));
         const Rays r = random_rays(1000, side, 3 + std::uint32_t(n));
-        StreamAccel sa(s, accel::SceneBvh::build(s));
+        StreamAccel sa(s, accel::SceneBvh::build(s), accel::AccelConfig{});
         for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
             if (!isa_supported(isa)) continue;
             const KernelTable& kt = kernel_table(isa);
@@ -163,8 +163,9 @@ TEST_CASE("BVH: SIMD packet and single-ray kernels agree with the flat kernels, 
             for (int k = 0; k < kShapeKindCount; ++k)
                 if (!groups[k].empty()) kt.closest[k](view_of(flat), flat_id.data(), groups[k].data(), groups[k].size());
             for (accel::Traversal tr : {accel::Traversal::Packet, accel::Traversal::Single}) {
-                accel::accel_config().primary = tr;
-                StreamAccel sa2(s, accel::SceneBvh::build(s));
+                accel::AccelConfig config;
+                config.primary = config.shadow = tr;
+                StreamAccel sa2(s, accel::SceneBvh::build(s), config);
                 RayStream rs;
                 make(rs, std::numeric_limits<float>::infinity());
                 AlignedVec<std::int32_t> id(rs.capacity(), -1);
@@ -180,8 +181,7 @@ TEST_CASE("BVH: SIMD packet and single-ray kernels agree with the flat kernels, 
                 // (must not be blocked). The 0.1 % margin is ~1e4 float ulps of t: far above
                 // the kernels' rounding of t (the closest-hit check above asks for equality).
                 for (float f : {0.5f, 0.999f, 1.001f}) {
-                    accel::accel_config().shadow = tr;
-                    StreamAccel sa3(s, accel::SceneBvh::build(s));
+                    StreamAccel sa3(s, accel::SceneBvh::build(s), config);
                     RayStream sh;
                     make(sh, 0.f);
                     for (std::size_t i = 0; i < sh.count; ++i)
@@ -200,7 +200,6 @@ TEST_CASE("BVH: SIMD packet and single-ray kernels agree with the flat kernels, 
                     else CHECK(long_hits > 0);
                 }
             }
-            accel::accel_config() = accel::AccelConfig{};
         }
     }
 }

@@ -116,8 +116,9 @@ void check_all_hit(const std::shared_ptr<const Mesh>& mesh, const Rays& r, float
         }
         xf.mesh = &mv;
         for (accel::Traversal tr : {accel::Traversal::Packet, accel::Traversal::Single}) {
-            accel::accel_config().primary = accel::accel_config().shadow = tr;
-            StreamAccel sa(s, accel::SceneBvh::build(s));
+            accel::AccelConfig config;
+            config.primary = config.shadow = tr;
+            StreamAccel sa(s, accel::SceneBvh::build(s), config);
             RayStream rs2;
             fill(rs2, r, t_limit);
             AlignedVec<std::int32_t> id2(rs2.capacity(), -1);
@@ -132,7 +133,6 @@ void check_all_hit(const std::shared_ptr<const Mesh>& mesh, const Rays& r, float
             for (std::size_t i = 0; i < sh2.count; ++i) o2 += sh2.t_max[i] != 0.f;
             CHECK(o2 == 0);
         }
-        accel::accel_config() = accel::AccelConfig{};
     }
 }
 
@@ -320,21 +320,21 @@ TEST_CASE("meshes: an OBJ file through the parser, both engines agree, errors ca
     CHECK(s.mesh_of(s.objects[4])->triangle_count() == 2);  // the quad, triangulated
     Parallelism par(2);
     for (accel::AccelMode mode : {accel::AccelMode::Flat, accel::AccelMode::Bvh}) {
-        accel::accel_config().mode = mode;
-        const Framebuffer a = render_scene(s, EngineKind::Stream, par).image;
-        const Framebuffer b = render_scene(s, EngineKind::Recursive, par).image;
+        EngineOptions with_mode;
+        with_mode.accel.mode = mode;
+        const Framebuffer a = render_scene(s, EngineKind::Stream, par, nullptr, with_mode).image;
+        const Framebuffer b = render_scene(s, EngineKind::Recursive, par, nullptr, with_mode).image;
         const ImageDifference d = compare_images(a, b);
         CAPTURE(d.psnr);
         CAPTURE(d.share_over);
         CHECK(d.psnr >= 50.0);
         CHECK(d.share_over <= 0.001);
         // The scalar shade stage gives the same picture as the SIMD one.
-        EngineOptions opt;
+        EngineOptions opt = with_mode;
         opt.shade = ShadeMode::Scalar;
         const ImageDifference ds = compare_images(render_scene(s, EngineKind::Stream, par, nullptr, opt).image, a);
         CHECK(ds.psnr >= 50.0);
     }
-    accel::accel_config() = accel::AccelConfig{};
 
     const auto error_of = [&](const std::string& t) {
         try {

@@ -166,9 +166,9 @@ void check_against_oracle(const std::shared_ptr<const Mesh>& mesh, const Case& c
             CHECK(count_bad(sh, nullptr, nullptr, true) == 0);
         }
         // The scene hierarchy's single-ray walk reaches the mesh through a leaf.
-        accel::accel_config().primary = accel::accel_config().secondary = accel::accel_config().shadow =
-            accel::Traversal::Single;
-        StreamAccel sa(scene, accel::SceneBvh::build(scene));
+        accel::AccelConfig single;
+        single.primary = single.secondary = single.shadow = accel::Traversal::Single;
+        StreamAccel sa(scene, accel::SceneBvh::build(scene), single);
         Traced tr(c);
         sa.closest(kt, tr.view, tr.id.data(), false);
         CHECK(count_bad(tr.rs, tr.id.data(), tr.prim.data(), false) == 0);
@@ -176,7 +176,6 @@ void check_against_oracle(const std::shared_ptr<const Mesh>& mesh, const Case& c
         fill(sh, c);
         sa.any(kt, view_of(sh));
         CHECK(count_bad(sh, nullptr, nullptr, true) == 0);
-        accel::accel_config() = accel::AccelConfig{};
     }
 }
 

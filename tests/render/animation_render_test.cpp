@@ -17,12 +17,6 @@ using namespace streamrt;
 
 namespace {
 
-/// The process-wide hierarchy settings, restored at scope exit.
-struct AccelGuard {
-    accel::AccelConfig saved = accel::accel_config();
-    ~AccelGuard() { accel::accel_config() = saved; }
-};
-
 Framebuffer render(PreparedRender& p) {
     Parallelism par(2);
     return render_prepared(p, par).image;
@@ -90,7 +84,6 @@ TEST_CASE("animation: per-frame update (refit, rebuild, flat) equals a set-up ma
     text += "key s107 frame=2 scale=1\nkey s107 frame=6 scale=2\n";
     text += "key s207 frame=0 translate=0,0,0\nkey s207 frame=8 translate=-20,0,0\n";
 
-    AccelGuard guard;
     struct Mode {
         const char* name;
         accel::AccelMode mode;
@@ -102,14 +95,15 @@ TEST_CASE("animation: per-frame update (refit, rebuild, flat) equals a set-up ma
                          Mode{"bvh, camera moving", accel::AccelMode::Bvh, 0.25, true},
                          Mode{"flat", accel::AccelMode::Flat, 0.25, true}}) {
         CAPTURE(m.name);
-        accel::accel_config().mode = m.mode;
-        accel::accel_config().refit_max_share = m.share;
+        EngineOptions options;
+        options.accel.mode = m.mode;
+        options.accel.refit_max_share = m.share;
         const std::string scene_text = text + "key l frame=0 pos=10,20,10\nkey l frame=8 pos=-10,20,10\n" +
                                        (m.camera ? "key cam frame=0 eye=0,12,30\nkey cam frame=8 eye=12,10,26\n" : "");
         for (const EngineKind engine : {EngineKind::Recursive, EngineKind::Stream}) {
             CAPTURE(std::string(engine_name(engine)));
             Scene animated = parse_scene(scene_text, "t.cfg");
-            const auto updated = prepare_render(animated, engine);
+            const auto updated = prepare_render(animated, engine, options);
             for (const int frame : {1, 4, 7}) {
                 CAPTURE(frame);
                 const FrameChange change = set_frame(animated, frame);
@@ -117,7 +111,7 @@ TEST_CASE("animation: per-frame update (refit, rebuild, flat) equals a set-up ma
                 updated->update(animated, change);
                 Scene fresh = parse_scene(scene_text, "t.cfg");
                 set_frame(fresh, frame);
-                const auto made = prepare_render(fresh, engine);
+                const auto made = prepare_render(fresh, engine, options);
                 CHECK(same_pixels(render(*updated), render(*made)));
             }
         }

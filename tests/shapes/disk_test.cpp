@@ -241,9 +241,9 @@ TEST_CASE("disk: the hierarchy never culls a disk hit (scalar and SIMD traversal
         CHECK(hits > o.size() / 2);
         // SIMD: flat kernels with no boxes = the truth at float precision; the flat kernels
         // with the stream engine's culling boxes and the hierarchy kernels must agree with it.
-        accel::accel_config().mode = accel::AccelMode::Flat;
-        const StreamScene flat_scene(s);
-        accel::accel_config() = accel::AccelConfig{};
+        accel::AccelConfig flat;
+        flat.mode = accel::AccelMode::Flat;
+        const StreamScene flat_scene(s, flat);
         const auto& group = flat_scene.groups[int(ShapeKind::Disk)];
         const auto& boxes = flat_scene.group_bounds[int(ShapeKind::Disk)];
         REQUIRE(group.size() == n);
@@ -261,8 +261,9 @@ TEST_CASE("disk: the hierarchy never culls a disk hit (scalar and SIMD traversal
                 culled_wrong += id_c[i] != id_t[i] || culled.t_max[i] != truth.t_max[i];
             CHECK(culled_wrong == 0);
             for (accel::Traversal tr : {accel::Traversal::Packet, accel::Traversal::Single}) {
-                accel::accel_config().primary = accel::accel_config().shadow = tr;
-                StreamAccel sa(s, accel::SceneBvh::build(s));
+                accel::AccelConfig config;
+                config.primary = config.shadow = tr;
+                StreamAccel sa(s, accel::SceneBvh::build(s), config);
                 RayStream rs;
                 fill(rs, o, d, kInfF);
                 AlignedVec<std::int32_t> id(rs.capacity(), -1);
@@ -278,7 +279,6 @@ TEST_CASE("disk: the hierarchy never culls a disk hit (scalar and SIMD traversal
                     sh.t_max[i] = std::isinf(truth.t_max[i]) ? 1e4f : truth.t_max[i] * 1.001f;
                 sa.any(kt, view_of(sh));
                 for (std::size_t i = 0; i < sh.count; ++i) bvh_wrong += (sh.t_max[i] == 0.f) != (id_t[i] >= 0);
-                accel::accel_config() = accel::AccelConfig{};
             }
             CHECK(bvh_wrong == 0);
         }
@@ -340,8 +340,9 @@ TEST_CASE("disk: engines agree on many-disk scenes, flat and through the hierarc
             CHECK(lit > 0.3 * double(img.rgb.size()) * 0.2);
         };
         for (accel::AccelMode mode : {accel::AccelMode::Flat, accel::AccelMode::Auto}) {
-            accel::accel_config().mode = mode;
-            compare(render_scene(scene, EngineKind::Recursive, par).image);
+            EngineOptions recursive;
+            recursive.accel.mode = mode;
+            compare(render_scene(scene, EngineKind::Recursive, par, nullptr, recursive).image);
             for (Isa isa : supported_isas())
                 for (ShadeMode sm : {ShadeMode::Sorted, ShadeMode::Gathered, ShadeMode::Scalar}) {
                     CAPTURE(isa_name(isa));
@@ -349,9 +350,9 @@ TEST_CASE("disk: engines agree on many-disk scenes, flat and through the hierarc
                     EngineOptions opt;
                     opt.isa = isa;
                     opt.shade = sm;
+                    opt.accel.mode = mode;
                     compare(render_scene(scene, EngineKind::Stream, par, nullptr, opt).image);
                 }
         }
-        accel::accel_config() = accel::AccelConfig{};
     }
 }
