@@ -4,24 +4,42 @@
 # (default 60) in one process on one core, from a corpus seeded with scenes/. Crashing inputs land in
 # build-fuzz/artifacts/; keep each as tests/fuzz/regressions/<name>.cfg once fixed.
 # Usage: scripts/fuzz.sh [SECONDS] [extra libFuzzer flags...]
+#        scripts/fuzz.sh ply [SECONDS] [flags...]: the PLY reader alone on raw bytes
+#        (tests/fuzz/ply_fuzz.cpp, seeds tests/fuzz/ply_corpus), into build-fuzz/ply_fuzz.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+target=scene
+[[ ${1:-} == ply ]] && target=ply && shift
 seconds=${1:-60}
 shift || true
 CXX=${FUZZ_CXX:-clang++-14}
 command -v "$CXX" >/dev/null || CXX=clang++
 out=build-fuzz
+if [[ $target == ply ]]; then
+  mkdir -p "$out/ply_corpus" "$out/artifacts"
+  bin="$out/ply_fuzz"
+  if [[ ! -x $bin || tests/fuzz/ply_fuzz.cpp -nt $bin || engine/mesh/ply_reader.cpp -nt $bin ||
+        engine/mesh/ply_reader.h -nt $bin ]]; then
+    echo "fuzz.sh: building $bin with $CXX"
+    "$CXX" -std=c++20 -O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined \
+      -fno-sanitize-recover=undefined -Iengine tests/fuzz/ply_fuzz.cpp engine/mesh/ply_reader.cpp \
+      engine/mesh/mesh.cpp engine/accel/bvh.cpp -ltinyobjloader -ltbb -o "$bin"
+  fi
+  cp -n tests/fuzz/ply_corpus/* "$out/ply_corpus/" 2>/dev/null || true
+  exec "$bin" "$out/ply_corpus" -max_total_time="$seconds" -max_len=4096 -timeout=10 -rss_limit_mb=2048 \
+    -malloc_limit_mb=64 -print_final_stats=1 -artifact_prefix="$out/artifacts/ply-" "$@"
+fi
 mkdir -p "$out/corpus" "$out/artifacts"
 # parser.cpp reads large texts in parallel (TBB) and `mesh` statements with engine/mesh/mesh.cpp, which builds each mesh's
 # triangle hierarchy (engine/accel/bvh.cpp, in parallel with TBB) and reads OBJ files with
-# tinyobjloader; the memory estimate (limits.cpp) asks the image writer (image/*_format.cpp through image_io.cpp, zlib,
+# tinyobjloader and PLY files with engine/mesh/ply_reader.cpp; the memory estimate (limits.cpp) asks the image writer (image/*_format.cpp through image_io.cpp, zlib,
 # stb, OpenEXR) for its buffer size; `key` statements use engine/scene/animation.cpp and
 # `texture=` keys read images with engine/scene/texture.cpp (stb_image).
 sources=(tests/fuzz/scene_fuzz.cpp engine/scene/parser.cpp engine/scene/parse_statements.cpp
          engine/scene/parse_shapes.cpp engine/scene/parse_animation.cpp engine/scene/scene.cpp
          engine/scene/animation.cpp engine/scene/texture.cpp
          engine/core/transform.cpp engine/driver/limits.cpp engine/mesh/mesh.cpp
-         engine/accel/bvh.cpp engine/image/image_io.cpp engine/image/exr_io.cpp
+         engine/mesh/ply_reader.cpp engine/accel/bvh.cpp engine/image/image_io.cpp engine/image/exr_io.cpp
          engine/image/image_formats.cpp engine/image/display.cpp engine/image/atomic_file.cpp
          engine/image/ppm_format.cpp engine/image/png_format.cpp engine/image/pfm_format.cpp
          engine/image/hdr_format.cpp)

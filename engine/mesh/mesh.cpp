@@ -25,7 +25,8 @@ std::size_t Mesh::memory_bytes() const {
 std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<float>& positions,
                                         const std::vector<std::uint32_t>& triangles,
                                         const accel::BuildOptions& options,
-                                        const std::vector<float>& corner_uv) {
+                                        const std::vector<float>& corner_uv,
+                                        const std::vector<float>& normals) {
     auto m = std::make_shared<Mesh>();
     m->name = std::move(name);
     const std::size_t n_verts = positions.size() / 3;
@@ -65,8 +66,13 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
         }
     }
     m->vertex_normals.resize(3 * n_verts);
+    const bool given = normals.size() == 3 * n_verts;
     for (std::size_t v = 0; v < n_verts; ++v) {
         Vec3d n{acc[3 * v], acc[3 * v + 1], acc[3 * v + 2]};
+        if (given) {
+            const Vec3d g{normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]};
+            if (const double g_len = length(g); g_len > 0.0 && std::isfinite(g_len)) n = g;
+        }
         const double len = length(n);
         n = len > 0.0 ? n * (1.0 / len) : Vec3d{0, 0, 1};
         m->vertex_normals[3 * v] = float(n.x);

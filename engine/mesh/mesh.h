@@ -51,11 +51,14 @@ struct Mesh {
     /// each, counter-clockwise seen from outside). Triangles with a repeated vertex, an
     /// out-of-range vertex or zero area are dropped. May return a mesh with no triangles.
     /// `corner_uv`, when not empty, holds 6 floats per triangle of `triangles` (its corners'
-    /// texture coordinates), kept with the triangles.
+    /// texture coordinates), kept with the triangles. `normals`, when it holds 3 floats per
+    /// vertex (a PLY file's nx ny nz), gives the vertex normals (normalised; a zero or
+    /// non-finite one is replaced by the computed one); otherwise they are area-weighted.
     static std::shared_ptr<const Mesh> build(std::string name, const std::vector<float>& positions,
                                              const std::vector<std::uint32_t>& triangles,
                                              const accel::BuildOptions& options = {},
-                                             const std::vector<float>& corner_uv = {});
+                                             const std::vector<float>& corner_uv = {},
+                                             const std::vector<float>& normals = {});
 };
 
 /// Reads a Wavefront OBJ file (tinyobjloader; polygons are triangulated, materials and

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "mesh/ply_reader.h"
 #include "scene/parser_state.h"
 
 namespace streamrt::scene_reader {
@@ -74,6 +75,9 @@ std::optional<Arg> Parser::shape(Statement& st, const std::vector<Token>& toks, 
         }
     }
     if (file_arg && obj_materials) {
+        if (is_ply_path(std::string(file_arg->value)))
+            st.fail(file_arg->value_col, "materials=obj needs an OBJ file (a PLY file has no material library), got " +
+                                             quote(file_arg->value));
         if (singular(f.md))
             st.fail_here(std::string(st.word()) + ": the composed transform is singular (or not finite)");
         // One object per part (usemtl group), each with its part's material over the
@@ -95,7 +99,7 @@ std::optional<Arg> Parser::shape(Statement& st, const std::vector<Token>& toks, 
         return std::nullopt;
     }
     if (file_arg) f.mesh = mesh_file(st, *file_arg, f.look.m.texture >= 0);
-    if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ file)");
+    if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ or PLY file)");
     if (singular(f.md))
         st.fail_here(std::string(st.word()) +
                      ": the composed transform is singular (or not finite)");
@@ -124,7 +128,7 @@ std::uint32_t Parser::mesh_file(const Statement& st, const Arg& a, bool with_uv)
     return read_once(
         st, a.value_col, target_of(st, a), "mesh", meshes_, scene.meshes,
         [&](fs::path id) { return std::pair{std::move(id), with_uv}; },
-        [&](const std::string& path) { return load_obj_mesh(path, with_uv); });
+        [&](const std::string& path) { return load_mesh_file(path, with_uv); });
 }
 
 std::int32_t Parser::texture_file(const Statement& st, int col, const fs::path& target) {

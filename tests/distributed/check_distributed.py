@@ -358,7 +358,8 @@ def group_mpi_faults(args, tmp):
         stdout, err = p.communicate(timeout=30 * SCALE)
     except subprocess.TimeoutExpired:
         p.kill()
-        check(False, "the job did not end after a rank was killed")
+        stdout, err = p.communicate()
+        check(False, f"the job did not end after a rank was killed (killed {victims[-1]} of {victims}): {err.strip()[-2000:]!r}")
         return
     took = time.time() - start
     check(p.returncode != 0, f"a killed rank: exit {p.returncode}")

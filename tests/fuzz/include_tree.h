@@ -27,6 +27,12 @@ inline void make_include_tree(const std::filesystem::path& dir) {
     write_file(dir / "twice.cfg", "include empty.cfg\ninclude empty.cfg\ninclude twice.cfg\n");
     // A tiny OBJ (two triangles, one quad) for `mesh file=tri.obj`.
     write_file(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0.5\nf 1 2 3\nf 2 4 3\nf 1 2 4 3\n");
+    // The same in ASCII PLY, with normals and a property to skip, for `mesh file=tri.ply`.
+    write_file(dir / "tri.ply",
+               "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+               "property float nx\nproperty float ny\nproperty float nz\nproperty uchar red\nelement face 3\n"
+               "property list uchar int vertex_indices\nend_header\n0 0 0 0 0 1 9\n1 0 0 0 0 1 9\n0 1 0 0 0 1 9\n"
+               "1 1 0.5 0 0 1 9\n3 0 1 2\n3 1 3 2\n4 0 1 3 2\n");
 }
 
 }  // namespace streamrt_fuzz

@@ -1,0 +1,459 @@
+#include "mesh/ply_reader.h"
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "mesh/mesh.h"
+
+namespace streamrt {
+
+namespace {
+
+/// A scalar type of the PLY header.
+struct PlyType {
+    int size = 0;  ///< bytes in a binary body
+    bool is_float = false;
+    bool is_signed = false;
+    const char* name = "";
+};
+
+/// The PLY type named `word` (the classic names and their sized aliases); size 0: unknown.
+PlyType ply_type(std::string_view word) {
+    static constexpr struct {
+        const char* classic;
+        const char* sized;
+        PlyType type;
+    } kTypes[] = {
+        {"char", "int8", {1, false, true, "char"}},      {"uchar", "uint8", {1, false, false, "uchar"}},
+        {"short", "int16", {2, false, true, "short"}},   {"ushort", "uint16", {2, false, false, "ushort"}},
+        {"int", "int32", {4, false, true, "int"}},       {"uint", "uint32", {4, false, false, "uint"}},
+        {"float", "float32", {4, true, true, "float"}},  {"double", "float64", {8, true, true, "double"}},
+    };
+    for (const auto& t : kTypes)
+        if (word == t.classic || word == t.sized) return t.type;
+    return {};
+}
+
+struct PlyProperty {
+    std::string name;
+    bool is_list = false;
+    PlyType count_type;  ///< lists only
+    PlyType type;        ///< the value type (a list's items)
+};
+
+struct PlyElement {
+    std::string name;
+    std::uint64_t count = 0;
+    std::vector<PlyProperty> props;
+    int line = 0, col = 0;              ///< of the `element` keyword (missing properties)
+    int count_line = 0, count_col = 0;  ///< of the count (too many items)
+};
+
+enum class PlyFormat { Ascii, BinaryLittle, BinaryBig };
+
+struct PlyHeader {
+    PlyFormat format = PlyFormat::Ascii;
+    std::vector<PlyElement> elements;
+    std::size_t body = 0;  ///< offset of the body's first byte
+    int body_line = 0;     ///< line of the body's first byte (ASCII messages)
+};
+
+[[noreturn]] void fail_at(const std::string& name, int line, int col, const std::string& message) {
+    throw std::runtime_error(name + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " + message);
+}
+
+std::string quoted(std::string_view s) {
+    std::string q(1, '\'');
+    q.append(s);
+    q.push_back('\'');
+    return q;
+}
+
+/// The fewest body bytes one item of `e` can take: its exact size in binary without lists,
+/// two characters per value in ASCII (a digit and a separator); a face's index list has at
+/// least 3 entries.
+std::uint64_t min_item_bytes(const PlyElement& e, bool ascii) {
+    std::uint64_t n = 0;
+    for (const PlyProperty& p : e.props) {
+        const bool face_list = e.name == "face" && p.is_list;
+        const std::uint64_t items = face_list ? 3 : 0;
+        if (ascii) n += 2 * (1 + (p.is_list ? items : 0));
+        else n += p.is_list ? std::uint64_t(p.count_type.size) + items * std::uint64_t(p.type.size)
+                            : std::uint64_t(p.type.size);
+    }
+    return n;
+}
+
+PlyHeader parse_header(std::string_view bytes, const std::string& name) {
+    PlyHeader h;
+    std::size_t pos = 0;
+    bool have_format = false;
+    for (int line = 1;; ++line) {
+        if (pos >= bytes.size()) fail_at(name, line, 1, "file ends before 'end_header'");
+        std::size_t end = bytes.find('\n', pos);
+        const std::size_t next = end == std::string_view::npos ? bytes.size() : end + 1;
+        if (end == std::string_view::npos) end = bytes.size();
+        std::string_view text = bytes.substr(pos, end - pos);
+        if (!text.empty() && text.back() == '\r') text.remove_suffix(1);
+        struct Word {
+            std::string_view text;
+            int col;
+        };
+        std::vector<Word> words;
+        for (std::size_t i = 0; i < text.size();) {
+            if (text[i] == ' ' || text[i] == '\t') {
+                ++i;
+                continue;
+            }
+            std::size_t j = i;
+            while (j < text.size() && text[j] != ' ' && text[j] != '\t') ++j;
+            words.push_back({text.substr(i, j - i), int(i + 1)});
+            i = j;
+        }
+        pos = next;
+        const auto fail = [&](std::size_t w, const std::string& message) {
+            fail_at(name, line, w < words.size() ? words[w].col : int(text.size() + 1), message);
+        };
+        const auto expect_words = [&](std::size_t n, const char* form) {
+            if (words.size() < n) fail(words.size(), std::string("expected ") + form);
+            if (words.size() > n) fail(n, "unexpected " + quoted(words[n].text) + " after " + form);
+        };
+        if (line == 1) {
+            if (words.size() != 1 || words[0].text != "ply") fail(0, "not a PLY file (the first line must be 'ply')");
+            continue;
+        }
+        if (words.empty()) continue;
+        const std::string_view key = words[0].text;
+        if (key == "comment" || key == "obj_info") continue;
+        if (key == "format") {
+            expect_words(3, "'format <ascii|binary_little_endian|binary_big_endian> 1.0'");
+            if (have_format) fail(0, "a second 'format' line");
+            if (words[1].text == "ascii") h.format = PlyFormat::Ascii;
+            else if (words[1].text == "binary_little_endian") h.format = PlyFormat::BinaryLittle;
+            else if (words[1].text == "binary_big_endian") h.format = PlyFormat::BinaryBig;
+            else fail(1, "unknown PLY format " + quoted(words[1].text));
+            if (words[2].text != "1.0") fail(2, "unsupported PLY version " + quoted(words[2].text) + " (1.0 is read)");
+            have_format = true;
+            continue;
+        }
+        if (!have_format) fail(0, "expected 'format' before " + quoted(key));
+        if (key == "element") {
+            expect_words(3, "'element <name> <count>'");
+            PlyElement e;
+            e.name = std::string(words[1].text);
+            const std::string_view c = words[2].text;
+            const auto [ptr, ec] = std::from_chars(c.data(), c.data() + c.size(), e.count);
+            if (ec != std::errc() || ptr != c.data() + c.size())
+                fail(2, "expected a count of items (0 or more), got " + quoted(c));
+            for (const PlyElement& o : h.elements)
+                if (o.name == e.name) fail(1, "a second element " + quoted(e.name));
+            e.line = line, e.col = words[0].col;
+            e.count_line = line, e.count_col = words[2].col;
+            h.elements.push_back(std::move(e));
+            continue;
+        }
+        if (key == "property") {
+            if (h.elements.empty()) fail(0, "'property' before any 'element'");
+            PlyProperty p;
+            std::size_t w = 1;
+            if (words.size() > 1 && words[1].text == "list") {
+                expect_words(5, "'property list <count type> <item type> <name>'");
+                p.is_list = true;
+                p.count_type = ply_type(words[2].text);
+                if (p.count_type.size == 0) fail(2, "unknown property type " + quoted(words[2].text));
+                if (p.count_type.is_float) fail(2, "a list's count type must be an integer type, got " + quoted(words[2].text));
+                w = 3;
+            } else {
+                expect_words(3, "'property <type> <name>'");
+            }
+            p.type = ply_type(words[w].text);
+            if (p.type.size == 0) fail(w, "unknown property type " + quoted(words[w].text));
+            p.name = std::string(words[w + 1].text);
+            PlyElement& e = h.elements.back();
+            for (const PlyProperty& o : e.props)
+                if (o.name == p.name) fail(w + 1, "a second property " + quoted(p.name) + " in element " + quoted(e.name));
+            const bool position = e.name == "vertex" && (p.name == "x" || p.name == "y" || p.name == "z");
+            if (position && p.is_list) fail(w + 1, "vertex property " + quoted(p.name) + " must be a number, not a list");
+            const bool indices = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
+            if (indices && !p.is_list) fail(w + 1, quoted(p.name) + " must be a list ('property list uchar int " + p.name + "')");
+            if (indices && p.type.is_float) fail(w, "vertex indices must have an integer type, got " + quoted(words[w].text));
+            e.props.push_back(std::move(p));
+            continue;
+        }
+        if (key == "end_header") {
+            expect_words(1, "'end_header'");
+            h.body = pos;
+            h.body_line = line + 1;
+            break;
+        }
+        fail(0, "unexpected " + quoted(key) + " in the PLY header");
+    }
+    const auto has = [](const PlyElement& e, std::initializer_list<const char*> names) {
+        for (const PlyProperty& p : e.props)
+            for (const char* n : names)
+                if (p.name == n) return true;
+        return false;
+    };
+    const bool ascii = h.format == PlyFormat::Ascii;
+    const std::uint64_t body_bytes = bytes.size() - h.body;
+    std::uint64_t needed = 0;  // the fewest body bytes of all the elements so far
+    bool vertex = false, face = false;
+    for (const PlyElement& e : h.elements) {
+        if (e.name == "vertex") {
+            vertex = true;
+            for (const char* axis : {"x", "y", "z"})
+                if (!has(e, {axis})) fail_at(name, e.line, e.col, "element 'vertex' has no property '" + std::string(axis) + "'");
+            if (e.count > std::numeric_limits<std::uint32_t>::max())
+                fail_at(name, e.count_line, e.count_col, "more vertices than 32-bit vertex numbers can address");
+        }
+        if (e.name == "face") {
+            face = true;
+            if (!has(e, {"vertex_indices", "vertex_index"}))
+                fail_at(name, e.line, e.col, "element 'face' has no property list 'vertex_indices'");
+        }
+        // Refused before anything is allocated: a hostile count must not reserve memory.
+        const std::uint64_t item = min_item_bytes(e, ascii);
+        const std::uint64_t room = ascii ? body_bytes + 1 : body_bytes;  // the last ASCII value needs no separator
+        if (item > 0 && (e.count > (room - std::min(room, needed)) / item))
+            fail_at(name, e.count_line, e.count_col,
+                    "element " + quoted(e.name) + " declares " + std::to_string(e.count) + " items, more than the " +
+                        std::to_string(body_bytes) + " bytes after the header can hold");
+        needed += e.count * item;
+    }
+    if (!vertex) fail_at(name, h.body_line - 1, 1, "the header declares no element 'vertex'");
+    if (!face) fail_at(name, h.body_line - 1, 1, "the header declares no element 'face'");
+    return h;
+}
+
+/// Values of an ASCII body, one whitespace-separated word at a time.
+class AsciiBody {
+public:
+    AsciiBody(std::string_view bytes, const PlyHeader& h, const std::string& name)
+        : bytes_(bytes), pos_(h.body), line_start_(h.body), line_(h.body_line), name_(name) {}
+
+    void begin_item(const std::string& element, std::uint64_t k) { element_ = &element, item_ = k; }
+
+    std::int64_t read_int(const PlyType& t) {
+        const std::string_view w = word();
+        std::int64_t v = 0;
+        const auto [ptr, ec] = std::from_chars(w.data(), w.data() + w.size(), v);
+        if (ec != std::errc() || ptr != w.data() + w.size())
+            fail("expected an integer (" + std::string(t.name) + "), got " + quoted(w));
+        const std::int64_t lo = t.is_signed ? -(std::int64_t(1) << (8 * t.size - 1)) : 0;
+        const std::int64_t hi = t.is_signed ? (std::int64_t(1) << (8 * t.size - 1)) - 1 : (std::int64_t(1) << (8 * t.size)) - 1;
+        if (v < lo || v > hi) fail(quoted(w) + " is out of range for " + t.name);
+        return v;
+    }
+    double read_number(const PlyType& t) {
+        if (!t.is_float) return double(read_int(t));
+        const std::string_view w = word();
+        double v = 0;
+        const auto [ptr, ec] = std::from_chars(w.data(), w.data() + w.size(), v);
+        if (ec != std::errc() || ptr != w.data() + w.size()) fail("expected a number (" + std::string(t.name) + "), got " + quoted(w));
+        return v;
+    }
+    void skip(const PlyType& t) { read_number(t); }
+    void skip_list(std::uint64_t n, const PlyType& t) {
+        for (std::uint64_t i = 0; i < n; ++i) skip(t);
+    }
+    [[noreturn]] void fail(const std::string& message) const { fail_at(name_, word_line_, word_col_, message); }
+
+private:
+    static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+    std::string_view word() {
+        while (pos_ < bytes_.size() && is_space(bytes_[pos_])) {
+            if (bytes_[pos_] == '\n') line_start_ = pos_ + 1, ++line_;
+            ++pos_;
+        }
+        word_line_ = line_, word_col_ = int(pos_ - line_start_ + 1);
+        if (pos_ >= bytes_.size())
+            fail("file ends inside element " + quoted(*element_) + " item " + std::to_string(item_));
+        const std::size_t start = pos_;
+        while (pos_ < bytes_.size() && !is_space(bytes_[pos_])) ++pos_;
+        return bytes_.substr(start, pos_ - start);
+    }
+
+    std::string_view bytes_;
+    std::size_t pos_, line_start_;
+    int line_;
+    int word_line_ = 0, word_col_ = 0;
+    const std::string& name_;
+    const std::string* element_ = nullptr;
+    std::uint64_t item_ = 0;
+};
+
+/// Values of a binary body in the file's byte order.
+class BinaryBody {
+public:
+    BinaryBody(std::string_view bytes, const PlyHeader& h, const std::string& name)
+        : bytes_(bytes), pos_(h.body), value_at_(h.body), swap_((h.format == PlyFormat::BinaryBig) != (std::endian::native == std::endian::big)),
+          name_(name) {}
+
+    void begin_item(const std::string& element, std::uint64_t k) { element_ = &element, item_ = k; }
+
+    std::int64_t read_int(const PlyType& t) {
+        const double v = read_number(t);
+        return std::int64_t(v);  // integer types of at most 32 bits: exact in a double
+    }
+    double read_number(const PlyType& t) {
+        unsigned char b[8];
+        take(b, std::size_t(t.size));
+        if (swap_) std::reverse(b, b + t.size);
+        const auto as = [&](auto v) {
+            std::memcpy(&v, b, sizeof v);
+            return double(v);
+        };
+        switch (t.size) {
+        case 1: return t.is_signed ? as(std::int8_t()) : as(std::uint8_t());
+        case 2: return t.is_signed ? as(std::int16_t()) : as(std::uint16_t());
+        case 4: return t.is_float ? as(float()) : t.is_signed ? as(std::int32_t()) : as(std::uint32_t());
+        default: return as(double());
+        }
+    }
+    void skip(const PlyType& t) { skip_list(1, t); }
+    void skip_list(std::uint64_t n, const PlyType& t) {
+        value_at_ = pos_;
+        if (n > (bytes_.size() - pos_) / std::uint64_t(t.size)) ends(n * std::uint64_t(t.size));
+        pos_ += std::size_t(n) * std::size_t(t.size);
+    }
+    [[noreturn]] void fail(const std::string& message) const {
+        throw std::runtime_error(name_ + ": element " + *element_ + " " + std::to_string(item_) + " (byte offset " +
+                                 std::to_string(value_at_) + "): " + message);
+    }
+
+private:
+    void take(unsigned char* out, std::size_t n) {
+        value_at_ = pos_;
+        if (bytes_.size() - pos_ < n) ends(n);
+        std::memcpy(out, bytes_.data() + pos_, n);
+        pos_ += n;
+    }
+    [[noreturn]] void ends(std::uint64_t n) const {
+        fail("file ends inside the item (" + std::to_string(n) + " more bytes needed, " +
+             std::to_string(bytes_.size() - pos_) + " left)");
+    }
+
+    std::string_view bytes_;
+    std::size_t pos_, value_at_;
+    bool swap_;
+    const std::string& name_;
+    const std::string* element_ = nullptr;
+    std::uint64_t item_ = 0;
+};
+
+/// Reads the body's elements in header order into `out`.
+template <class Body>
+void read_body(Body& body, const PlyHeader& h, PlyData& out) {
+    std::uint64_t vertex_count = 0;
+    for (const PlyElement& e : h.elements)
+        if (e.name == "vertex") vertex_count = e.count;
+    for (const PlyElement& e : h.elements) {
+        const bool vertex = e.name == "vertex", face = e.name == "face";
+        // Per property: where a vertex keeps it (0-2 position, 3-5 normal, -1 skipped).
+        std::vector<int> slot(e.props.size(), -1);
+        bool normals = true;
+        if (vertex) {
+            static const char* kSlots[] = {"x", "y", "z", "nx", "ny", "nz"};
+            for (std::size_t p = 0; p < e.props.size(); ++p)
+                for (int s = 0; s < 6; ++s)
+                    if (!e.props[p].is_list && e.props[p].name == kSlots[s]) slot[p] = s;
+            for (int s = 3; s < 6; ++s) normals = normals && std::count(slot.begin(), slot.end(), s) == 1;
+            out.positions.reserve(3 * std::size_t(e.count));  // bounded by the file's length (parse_header)
+            if (normals) out.normals.reserve(3 * std::size_t(e.count));
+        }
+        const PlyProperty* indices = nullptr;  // the first index list of a face
+        for (const PlyProperty& p : e.props)
+            if (face && !indices && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) indices = &p;
+        if (face) out.triangles.reserve(3 * std::size_t(e.count));
+        for (std::uint64_t k = 0; k < e.count; ++k) {
+            body.begin_item(e.name, k);
+            double v[6] = {0, 0, 0, 0, 0, 0};
+            for (std::size_t p = 0; p < e.props.size(); ++p) {
+                const PlyProperty& prop = e.props[p];
+                if (!prop.is_list) {
+                    if (slot[p] >= 0) v[slot[p]] = body.read_number(prop.type);
+                    else body.skip(prop.type);
+                    continue;
+                }
+                const std::int64_t n = body.read_int(prop.count_type);
+                if (n < 0) body.fail("a list of " + std::to_string(n) + " items");
+                if (&prop != indices) {
+                    body.skip_list(std::uint64_t(n), prop.type);
+                    continue;
+                }
+                if (n < 3) body.fail("a face needs at least 3 vertices, got " + std::to_string(n));
+                // Fan triangulation: (first, previous, current) for every corner after the second.
+                std::uint32_t first = 0, previous = 0;
+                for (std::int64_t j = 0; j < n; ++j) {
+                    const std::int64_t index = body.read_int(prop.type);
+                    if (index < 0 || std::uint64_t(index) >= vertex_count)
+                        body.fail("vertex index " + std::to_string(index) + " is not one of the " +
+                                  std::to_string(vertex_count) + " vertices");
+                    const auto current = std::uint32_t(index);
+                    if (j == 0) first = current;
+                    else if (j >= 2) out.triangles.insert(out.triangles.end(), {first, previous, current});
+                    previous = current;
+                }
+            }
+            if (!vertex) continue;
+            for (int a = 0; a < 3; ++a)
+                if (!std::isfinite(float(v[a]))) body.fail("vertex position is not finite");
+            out.positions.insert(out.positions.end(), {float(v[0]), float(v[1]), float(v[2])});
+            if (normals) out.normals.insert(out.normals.end(), {float(v[3]), float(v[4]), float(v[5])});
+        }
+    }
+}
+
+}  // namespace
+
+PlyData parse_ply(std::string_view bytes, const std::string& name) {
+    const PlyHeader h = parse_header(bytes, name);
+    PlyData out;
+    if (h.format == PlyFormat::Ascii) {
+        AsciiBody body(bytes, h, name);
+        read_body(body, h, out);
+    } else {
+        BinaryBody body(bytes, h, name);
+        read_body(body, h, out);
+    }
+    return out;
+}
+
+std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot open mesh file");
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (in.bad()) throw std::runtime_error("cannot read mesh file");
+    const PlyData data = parse_ply(bytes, path);
+    const std::size_t faces = data.triangles.size() / 3;
+    auto mesh = Mesh::build(path, data.positions, data.triangles, {}, {}, data.normals);
+    if (mesh->triangle_count() == 0)
+        throw std::runtime_error(faces == 0 ? "PLY file has no faces"
+                                            : "PLY file has no triangles of non-zero area (" + std::to_string(faces) +
+                                                  " degenerate)");
+    return mesh;
+}
+
+bool is_ply_path(const std::string& path) {
+    if (path.size() < 4) return false;
+    std::string ext = path.substr(path.size() - 4);
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".ply";
+}
+
+std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv) {
+    if (!is_ply_path(path)) return load_obj_mesh(path, with_uv);
+    if (with_uv)
+        throw std::runtime_error("a texture needs texture coordinates, which PLY meshes are not read with (use an OBJ file)");
+    return load_ply_mesh(path);
+}
+
+}  // namespace streamrt

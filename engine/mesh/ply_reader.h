@@ -1,0 +1,41 @@
+#pragma once
+// Stanford PLY meshes (ASCII, binary little and big endian): the `vertex` element's x y z
+// (and nx ny nz when all three are present) and the `face` element's vertex index lists,
+// polygons fan-triangulated; every other element and property is skipped by its size.
+// Debian ships no maintained PLY library, hence this reader. Every count and size in the
+// header is checked against the file's length before anything is allocated.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace streamrt {
+
+struct Mesh;
+
+/// What a PLY file holds for a mesh.
+struct PlyData {
+    std::vector<float> positions;          ///< 3 per vertex
+    std::vector<float> normals;            ///< 3 per vertex, or empty (no nx ny nz)
+    std::vector<std::uint32_t> triangles;  ///< 3 vertex numbers per triangle
+};
+
+/// Parses the bytes of a PLY file named `name` (for messages). Throws std::runtime_error
+/// with one line: `name:line:col: message` for the header and an ASCII body,
+/// `name: element E K (byte offset B): message` for a binary body (element E's K-th item,
+/// counted from 0).
+PlyData parse_ply(std::string_view bytes, const std::string& name);
+
+/// Reads a PLY file into a mesh (its normals, when present, are the mesh's vertex normals).
+/// Throws std::runtime_error like parse_ply, and for a file with no triangle of non-zero area.
+std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path);
+
+/// The mesh of a file by its extension: `.ply` (any case) with load_ply_mesh, anything else
+/// as a Wavefront OBJ file (load_obj_mesh). `with_uv` (a textured object) is refused for PLY.
+std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv);
+
+/// True when `path` names a PLY file (extension `.ply`, any case).
+bool is_ply_path(const std::string& path);
+
+}  // namespace streamrt

@@ -1,0 +1,26 @@
+// libFuzzer target for the PLY reader alone: parse_ply() on arbitrary bytes must either
+// return data whose triangles address its vertices or throw std::runtime_error with one
+// line; never crash, read out of bounds or allocate beyond the input's size (ASan's
+// -rss_limit_mb and -malloc_limit_mb catch that). Built and run by scripts/fuzz.sh ply.
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "mesh/ply_reader.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    try {
+        const streamrt::PlyData d = streamrt::parse_ply(std::string_view(reinterpret_cast<const char*>(data), size), "f.ply");
+        const std::size_t vertices = d.positions.size() / 3;
+        if (d.positions.size() % 3 || d.triangles.size() % 3 || (!d.normals.empty() && d.normals.size() != d.positions.size()))
+            std::abort();
+        for (std::uint32_t v : d.triangles)
+            if (v >= vertices) std::abort();
+    } catch (const std::runtime_error& e) {
+        if (std::string_view(e.what()).find('\n') != std::string_view::npos) std::abort();
+    }
+    return 0;
+}

@@ -1,0 +1,273 @@
+// The PLY reader: files written here byte by byte (ASCII, binary little and big endian, with
+// and without normals, a quad to fan, elements and properties to skip) against the triangles
+// and positions written; every header error at its line and column, body errors at their
+// line/column or item and byte offset; absurd counts refused from the header alone; a scene
+// with a PLY mesh renders the very picture of the same mesh read from OBJ.
+#include <doctest/doctest.h>
+
+#include <bit>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "driver/render.h"
+#include "mesh/mesh.h"
+#include "mesh/ply_reader.h"
+#include "parallel/parallelism.h"
+#include "scene/parser.h"
+
+using namespace streamrt;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Bytes of a binary body in one byte order.
+struct Body {
+    bool big = false;
+    std::string bytes;
+    template <class T>
+    Body& put(T v) {
+        char b[sizeof(T)];
+        std::memcpy(b, &v, sizeof(T));
+        if (big != (std::endian::native == std::endian::big)) std::reverse(b, b + sizeof(T));
+        bytes.append(b, sizeof(T));
+        return *this;
+    }
+};
+
+// Vertices: float x, double y, short z, uchar red (skipped), then optionally float nx ny nz;
+// an element `edge` (list + int, skipped); faces: list uchar int vertex_indices, int material.
+constexpr float kX[4] = {0.f, 1.5f, 1.5f, 0.f};
+constexpr double kY[4] = {0.0, 0.0, 2.0, 2.0};
+constexpr short kZ[4] = {0, 0, 0, -3};
+
+std::string binary_ply(bool big, bool normals) {
+    std::string h = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+                    " 1.0\ncomment written by the test\nelement vertex 4\nproperty float x\nproperty float64 y\n"
+                    "property int16 z\nproperty uchar red\n";
+    if (normals) h += "property float nx\nproperty float ny\nproperty float nz\n";
+    h += "element edge 1\nproperty list uint8 int32 ends\nproperty int weight\n"
+         "element face 2\nproperty list uchar int vertex_indices\nproperty int material\nend_header\n";
+    Body b{big, {}};
+    for (int v = 0; v < 4; ++v) {
+        b.put(kX[v]).put(kY[v]).put(std::int16_t(kZ[v])).put(std::uint8_t(200));
+        if (normals) b.put(0.f).put(0.f).put(v == 3 ? 2.f : 1.f);  // (0,0,2): normalised to (0,0,1)
+    }
+    b.put(std::uint8_t(2)).put(std::int32_t(7)).put(std::int32_t(8)).put(std::int32_t(-1));
+    b.put(std::uint8_t(4)).put(std::int32_t(0)).put(std::int32_t(1)).put(std::int32_t(2)).put(std::int32_t(3));
+    b.put(std::int32_t(5));
+    b.put(std::uint8_t(3)).put(std::int32_t(2)).put(std::int32_t(1)).put(std::int32_t(0));
+    b.put(std::int32_t(6));
+    return h + b.bytes;
+}
+
+const std::string kAscii =
+    "ply\n"
+    "format ascii 1.0\n"
+    "element vertex 4\n"
+    "property float x\n"
+    "property double y\n"
+    "property short z\n"
+    "property uchar red\n"
+    "element edge 1\n"
+    "property list uint8 int32 ends\n"
+    "property int weight\n"
+    "element face 2\n"
+    "property list uchar int vertex_indices\n"
+    "property int material\n"
+    "end_header\n"
+    "0 0 0 200\n"
+    "1.5 0 0 200\n"
+    "1.5 2 0 200\n"
+    "0 2 -3 200\n"
+    "2 7 8 -1\n"
+    "4 0 1 2 3 5\n"
+    "3 2 1 0 6\n";
+
+/// The fan of the quad 0 1 2 3 and the triangle 2 1 0.
+const std::vector<std::uint32_t> kTriangles = {0, 1, 2, 0, 2, 3, 2, 1, 0};
+
+void check_data(const PlyData& d, bool normals) {
+    REQUIRE(d.positions.size() == 12);
+    for (int v = 0; v < 4; ++v) {
+        CHECK(d.positions[3 * v] == kX[v]);
+        CHECK(d.positions[3 * v + 1] == float(kY[v]));
+        CHECK(d.positions[3 * v + 2] == float(kZ[v]));
+    }
+    CHECK(d.triangles == kTriangles);
+    if (!normals) {
+        CHECK(d.normals.empty());
+        return;
+    }
+    REQUIRE(d.normals.size() == 12);
+    CHECK(d.normals[11] == 2.f);
+    CHECK(d.normals[2] == 1.f);
+    CHECK(d.normals[0] == 0.f);
+}
+
+std::string error_of(const std::string& bytes) {
+    try {
+        parse_ply(bytes, "t.ply");
+    } catch (const std::runtime_error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+    return s.replace(s.find(from), from.size(), to);
+}
+
+const std::string kHeadAscii = "ply\nformat ascii 1.0\n";
+const std::string kGoodElements =
+    "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+}  // namespace
+
+TEST_CASE("ply: ASCII, binary little and big endian, with and without normals, read the values written") {
+    check_data(parse_ply(kAscii, "a.ply"), false);
+    for (bool big : {false, true})
+        for (bool normals : {false, true}) {
+            CAPTURE(big);
+            CAPTURE(normals);
+            check_data(parse_ply(binary_ply(big, normals), "b.ply"), normals);
+        }
+    // CRLF header lines and extra blanks between ASCII values.
+    std::string crlf = kAscii;
+    for (std::size_t p = 0; (p = crlf.find('\n', p)) != std::string::npos; p += 2) crlf.replace(p, 1, "\r\n");
+    check_data(parse_ply(crlf, "c.ply"), false);
+}
+
+TEST_CASE("ply: header errors carry the line and column of the bad word") {
+    CHECK(error_of("plx\n") == "t.ply:1:1: not a PLY file (the first line must be 'ply')");
+    CHECK(error_of("ply\nformat ascii 2.0\n") == "t.ply:2:14: unsupported PLY version '2.0' (1.0 is read)");
+    CHECK(error_of("ply\nformat utf8 1.0\n") == "t.ply:2:8: unknown PLY format 'utf8'");
+    CHECK(error_of("ply\nelement vertex 3\n") == "t.ply:2:1: expected 'format' before 'element'");
+    CHECK(error_of(kHeadAscii) == "t.ply:3:1: file ends before 'end_header'");
+    CHECK(error_of(kHeadAscii + "element vertex x3\n") == "t.ply:3:16: expected a count of items (0 or more), got 'x3'");
+    CHECK(error_of(kHeadAscii + "element vertex -3\n") == "t.ply:3:16: expected a count of items (0 or more), got '-3'");
+    CHECK(error_of(kHeadAscii + "element vertex\n") == "t.ply:3:15: expected 'element <name> <count>'");
+    CHECK(error_of(kHeadAscii + "element vertex 3\nproperty flot x\n") == "t.ply:4:10: unknown property type 'flot'");
+    CHECK(error_of(kHeadAscii + "element face 1\nproperty list float int vertex_indices\n") ==
+          "t.ply:4:15: a list's count type must be an integer type, got 'float'");
+    CHECK(error_of(kHeadAscii + "element face 1\nproperty list uchar float vertex_indices\n") ==
+          "t.ply:4:21: vertex indices must have an integer type, got 'float'");
+    CHECK(error_of(kHeadAscii + "element face 1\nproperty int vertex_indices\n") ==
+          "t.ply:4:14: 'vertex_indices' must be a list ('property list uchar int vertex_indices')");
+    CHECK(error_of(kHeadAscii + "property float x\n") == "t.ply:3:1: 'property' before any 'element'");
+    CHECK(error_of(kHeadAscii + "elemnt vertex 3\n") == "t.ply:3:1: unexpected 'elemnt' in the PLY header");
+    CHECK(error_of(kHeadAscii + "element vertex 1\nproperty float x\nproperty float y\nelement face 0\n"
+                                "property list uchar int vertex_indices\nend_header\n0 0\n") ==
+          "t.ply:3:1: element 'vertex' has no property 'z'");
+    CHECK(error_of(kHeadAscii + "element vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n") ==
+          "t.ply:7:1: the header declares no element 'face'");
+    CHECK(error_of(kHeadAscii + "element face 0\nproperty list uchar int vertex_index\nend_header\n") ==
+          "t.ply:5:1: the header declares no element 'vertex'");
+    CHECK(error_of(kHeadAscii + "element vertex 0\nproperty float x\nproperty float x\n") ==
+          "t.ply:5:16: a second property 'x' in element 'vertex'");
+}
+
+TEST_CASE("ply: absurd counts are refused from the header, before anything is allocated") {
+    // 4e9 vertices of 3 floats would be 48 GB: the 6 body bytes cannot hold them.
+    CHECK(error_of(kHeadAscii + "element vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\n"
+                                "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n") ==
+          "t.ply:3:16: element 'vertex' declares 4000000000 items, more than the 6 bytes after the header can hold");
+    CHECK(error_of("ply\nformat binary_little_endian 1.0\n" + replaced(kGoodElements, "vertex 3", "vertex 5000000000")) ==
+          "t.ply:3:16: more vertices than 32-bit vertex numbers can address");
+    // Faces need at least 1 + 3 * 4 bytes each in binary: 2 faces do not fit in 36 + 20 bytes.
+    std::string body(36 + 20, '\0');
+    CHECK(error_of("ply\nformat binary_little_endian 1.0\n" + replaced(kGoodElements, "face 1", "face 2") + body) ==
+          "t.ply:7:14: element 'face' declares 2 items, more than the 56 bytes after the header can hold");
+    // A skipped element's count is checked too.
+    CHECK(error_of(kHeadAscii + "element junk 99999999\nproperty uchar a\n" + kGoodElements + "0 0 0\n") ==
+          "t.ply:3:14: element 'junk' declares 99999999 items, more than the 6 bytes after the header can hold");
+}
+
+TEST_CASE("ply: body errors carry their line and column (ASCII) or item and byte offset (binary)") {
+    const std::string head = kHeadAscii + kGoodElements;  // the body starts on line 10
+    CHECK(error_of(head + "0 0 0\n1 0 0\n0 zz 0\n3 0 1 2\n") == "t.ply:12:3: expected a number (float), got 'zz'");
+    CHECK(error_of(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n") == "t.ply:13:7: vertex index 3 is not one of the 3 vertices");
+    CHECK(error_of(head + "0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n") == "t.ply:13:5: vertex index -1 is not one of the 3 vertices");
+    CHECK(error_of(head + "0 0 0\n1 0 0\n0 1 0\n2 0 1     \n") == "t.ply:13:1: a face needs at least 3 vertices, got 2");
+    CHECK(error_of(head + "0 0 0\n1 0 0\n0 1 0\n256 0 1 2\n") == "t.ply:13:1: '256' is out of range for uchar");
+    CHECK(error_of(head + "0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n") == "t.ply:14:1: file ends inside element 'face' item 0");
+    CHECK(error_of(head + "0 0 0\n1 0 0\n0 inf 0\n3 0 1 2\n") == "t.ply:12:7: vertex position is not finite");
+
+    // Binary: 3 vertices of 12 bytes from offset B, then the face.
+    const std::string bin = "ply\nformat binary_big_endian 1.0\n" + kGoodElements;
+    const std::size_t b = bin.size();
+    Body v{true, {}};
+    for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) v.put(x);
+    Body f = v;
+    f.put(std::uint8_t(4)).put(std::int32_t(0)).put(std::int32_t(1)).put(std::int32_t(2));  // 4 announced, 3 given
+    CHECK(error_of(bin + f.bytes) == "t.ply: element face 0 (byte offset " + std::to_string(b + 49) +
+                                         "): file ends inside the item (4 more bytes needed, 0 left)");
+    Body g = v;
+    g.put(std::uint8_t(3)).put(std::int32_t(0)).put(std::int32_t(7)).put(std::int32_t(2));
+    CHECK(error_of(bin + g.bytes) == "t.ply: element face 0 (byte offset " + std::to_string(b + 41) +
+                                         "): vertex index 7 is not one of the 3 vertices");
+    // Truncated in the vertices (fixed-size items): the header's count check refuses it.
+    CHECK(error_of(bin + v.bytes.substr(0, 30)) ==
+          "t.ply:3:16: element 'vertex' declares 3 items, more than the 30 bytes after the header can hold");
+}
+
+TEST_CASE("ply: a mesh keeps the file's normals; a scene renders a PLY mesh as the same OBJ mesh") {
+    const fs::path dir = fs::temp_directory_path() / ("streamrt_ply_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    std::ofstream(dir / "quad.ply", std::ios::binary) << binary_ply(false, true);
+    const auto quad = load_ply_mesh((dir / "quad.ply").string());
+    REQUIRE(quad->vertex_normals.size() == 12);
+    for (int v = 0; v < 4; ++v) {
+        CHECK(quad->vertex_normals[3 * v] == 0.f);
+        CHECK(quad->vertex_normals[3 * v + 2] == 1.f);  // (0,0,2) normalised; not the face normals
+    }
+
+    // The same icosphere as OBJ and as binary PLY: identical triangles, identical picture.
+    const MeshData ball = icosphere(2);
+    REQUIRE(write_obj((dir / "ball.obj").string(), ball));
+    {
+        Body b{false, {}};
+        for (float p : ball.positions) b.put(p);
+        for (std::size_t k = 0; k < ball.triangles.size(); k += 3)
+            b.put(std::uint8_t(3)).put(ball.triangles[k]).put(ball.triangles[k + 1]).put(ball.triangles[k + 2]);
+        std::ofstream(dir / "ball.ply", std::ios::binary)
+            << "ply\nformat binary_little_endian 1.0\nelement vertex " << ball.positions.size() / 3
+            << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << ball.triangles.size() / 3
+            << "\nproperty list uchar uint vertex_indices\nend_header\n"
+            << b.bytes;
+    }
+    const auto scene_with = [&](const std::string& file) {
+        const std::string text = "image width=64 height=48 spp=1 depth=3\ncamera eye=0,1,5 look=0,0.5,0\n"
+                                 "light point pos=3,6,4\nplane color=0.5,0.5,0.5\n"
+                                 "mesh file=" + file + " smooth=true color=1,0.5,0.2 spec=0.5 translate=0,1,0\n";
+        return parse_scene(text, (dir / "scene.cfg").string());
+    };
+    const Scene from_obj = scene_with("ball.obj"), from_ply = scene_with("ball.ply");
+    REQUIRE(from_ply.meshes.size() == 1);
+    CHECK(from_ply.meshes[0]->triangle_count() == 320);
+    Parallelism par(2);
+    for (EngineKind e : {EngineKind::Stream, EngineKind::Recursive}) {
+        const Framebuffer a = render_scene(from_obj, e, par).image;
+        const Framebuffer b = render_scene(from_ply, e, par).image;
+        CHECK(std::equal(a.rgb.begin(), a.rgb.end(), b.rgb.begin(), b.rgb.end()));
+    }
+
+    const auto scene_error = [&](const std::string& line) {
+        try {
+            parse_scene(line, (dir / "scene.cfg").string());
+        } catch (const SceneError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    const std::string where = (dir / "scene.cfg").string() + ":1:";
+    CHECK(scene_error("mesh file=ball.ply materials=obj\n") ==
+          where + "11: materials=obj needs an OBJ file (a PLY file has no material library), got 'ball.ply'");
+    std::ofstream(dir / "bad.ply", std::ios::binary) << "ply\nformat ascii 1.0\nelement vertex x\n";
+    CHECK(scene_error("mesh file=bad.ply\n").find("bad.ply:3:16: expected a count of items") != std::string::npos);
+    CHECK(scene_error("mesh file=bad.ply\n").rfind(where + "11: ", 0) == 0);
+    fs::remove_all(dir);
+}
