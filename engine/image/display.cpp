@@ -13,16 +13,6 @@ namespace streamrt {
 
 using image_detail::for_each;
 
-Display display_of(const RenderSettings& s) {
-    Display d;
-    d.calibration = s.calibration;
-    d.colorspace = s.colorspace;
-    d.tonemap = s.tonemap;
-    d.exposure = float(s.exposure);
-    d.exr = s.exr;
-    return d;
-}
-
 double srgb_oetf(double c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055; }
 
 Framebuffer calibrate(const Framebuffer& fb, Calibration how) {

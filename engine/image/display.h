@@ -3,37 +3,11 @@
 // colour"): how the linear framebuffer becomes the bytes of a PNG or PPM, one row at a time,
 // with no converted copy of the image.
 #include "image/framebuffer.h"
-#include "scene/scene.h"
+#include "image/display_settings.h"
 
 namespace streamrt {
 
 class Parallelism;
-
-/// How the linear framebuffer becomes 8-bit values (PNG, PPM), in this order:
-///   x = v * exposure -> tone curve T(x) (clamp: none; reinhard: x / (1 + x) per channel, x >= 0)
-///   -> calibration (clamp: min(T, 1); normalize: T / max over the image of T, the maximum
-///      taken after the tone curve) -> sRGB OETF (IEC 61966-2-1, exact piecewise) or linear
-///   -> round(255 c). NaN and infinities become 0.
-/// With tonemap=clamp and calibration=normalize the exposure cancels out (v * e / max(v * e)).
-/// The linear formats (PFM, EXR, HDR) hold the framebuffer's values untouched.
-struct Display {
-    Calibration calibration = Calibration::Clamp;
-    ColorSpace colorspace = ColorSpace::Srgb;
-    Tonemap tonemap = Tonemap::Clamp;
-    float exposure = 1.f;
-    ExrPixels exr = ExrPixels::Half;
-
-    /// The handout's output: clamped or normalised values stored linearly, no tone curve.
-    static Display raw(Calibration how) {
-        Display d;
-        d.calibration = how;
-        d.colorspace = ColorSpace::Linear;
-        return d;
-    }
-};
-
-/// The scene's `image` keys that make its Display.
-Display display_of(const RenderSettings& s);
 
 /// The sRGB OETF of IEC 61966-2-1 for c in [0, 1] (in double): 12.92 c up to 0.0031308,
 /// 1.055 c^(1/2.4) - 0.055 above.

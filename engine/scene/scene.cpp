@@ -7,6 +7,17 @@
 
 namespace streamrt {
 
+Display display_of(const RenderSettings& s) {
+    Display d;
+    d.calibration = s.calibration;
+    d.colorspace = s.colorspace;
+    d.tonemap = s.tonemap;
+    d.exposure = float(s.exposure);
+    d.exr = s.exr;
+    return d;
+}
+
+
 glm::dmat4 Camera::world_from_canonical(int width, int height) const {
     if (!look_at) return md;
     // Homothety (rx, ry, df) with df = 1: the screen's half-height is tan(fov/2) at unit

@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "scene/texture.h"
 #include "core/transform.h"
+#include "image/display_settings.h"
 #include "shapes/shape_kind.h"
 
 namespace streamrt {
@@ -125,19 +126,9 @@ struct Camera {
     double focus_distance(const glm::dmat4& md) const;
 };
 
-enum class Calibration : std::uint8_t { Clamp, Normalize };
-inline constexpr EnumName<Calibration> kCalibrationNames[] = {{Calibration::Clamp, "clamp"},
-                                                              {Calibration::Normalize, "normalize"}};
 enum class SamplePattern : std::uint8_t { Stratified, Grid, Random };
 inline constexpr EnumName<SamplePattern> kSamplePatternNames[] = {
     {SamplePattern::Stratified, "stratified"}, {SamplePattern::Grid, "grid"}, {SamplePattern::Random, "random"}};
-// Display colour of the 8-bit outputs (docs/scene-format.md, "Output and display colour").
-enum class ColorSpace : std::uint8_t { Srgb, Linear };
-inline constexpr EnumName<ColorSpace> kColorSpaceNames[] = {{ColorSpace::Srgb, "srgb"}, {ColorSpace::Linear, "linear"}};
-enum class Tonemap : std::uint8_t { Clamp, Reinhard };
-inline constexpr EnumName<Tonemap> kTonemapNames[] = {{Tonemap::Clamp, "clamp"}, {Tonemap::Reinhard, "reinhard"}};
-enum class ExrPixels : std::uint8_t { Half, Float };
-inline constexpr EnumName<ExrPixels> kExrPixelsNames[] = {{ExrPixels::Half, "half"}, {ExrPixels::Float, "float"}};
 
 struct RenderSettings {
     int width = 640;
@@ -166,6 +157,9 @@ struct RenderSettings {
     int frames_first = 0, frames_last = -1;
     bool has_frames() const { return frames_last >= frames_first; }
 };
+
+/// The `image` keys' display colour chain (image/display_settings.h).
+Display display_of(const RenderSettings& s);
 
 struct Scene {
     std::string path;  ///< the file it was read from

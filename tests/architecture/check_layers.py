@@ -13,11 +13,11 @@ import sys
 LAYERS = [
     ["simd"],
     ["core", "parallel"],
-    ["shapes"],
+    ["image", "shapes"],
     ["accel"],
     ["mesh"],
     ["scene"],
-    ["image", "render"],
+    ["render"],
     ["kernels"],
     ["stream", "baseline"],
     ["driver"],
