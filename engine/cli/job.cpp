@@ -62,18 +62,19 @@ RenderOverrides overrides_of(const Options& opt) {
 /// `writes`: this process writes the output (false on MPI ranks other than 0).
 /// `check_isa`: --isa must be supported here (MPI ranks agree on it together instead).
 Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa) {
-    if (!opt.isa.empty() && opt.engine == "recursive" && !opt.compare)
+    const EngineKind engine = value_named(kEngineNames, opt.engine).value_or(EngineKind::Stream);
+    if (!opt.isa.empty() && engine == EngineKind::Recursive && !opt.compare)
         throw UsageError("--isa chooses the stream engine's kernels; the recursive engine has none (scalar, double)");
-    if ((opt.profile || !opt.profile_json.empty()) && opt.engine != "stream" && !opt.compare)
+    if ((opt.profile || !opt.profile_json.empty()) && engine != EngineKind::Stream && !opt.compare)
         throw UsageError("--profile needs the stream engine");
     RenderOverrides overrides = overrides_of(opt);
     if (check_isa && !opt.isa.empty()) overrides.isa = opt.isa;  // checked against this CPU there
+    if (!opt.output.empty()) overrides.output = opt.output;
     Job job;
     static_cast<RenderJob&>(job) = build_render_job(std::move(scene), overrides, opt.profile || !opt.profile_json.empty());
     if (!check_isa && !opt.isa.empty()) parse_isa(opt.isa, job.options.isa);  // MPI: the ranks agree on it later
     job.settings.isa = job.options.isa;
-    RenderSettings& s = job.scene.settings;
-    if (!opt.output.empty()) s.output = opt.output;
+    const RenderSettings& s = job.scene.settings;
     if (opt.mpi && s.frames_last > s.frames_first)
         throw UsageError("--mpi renders one picture, the scene's image frames= asks for several (render them as a job "
                          "array, docs/distributed.md)");

@@ -30,10 +30,16 @@ double to_double(const std::string& name, const std::string& v) {
     }
     throw UsageError(name + ": expected a number, got '" + v + "'");
 }
+/// The value named v in the table, or a UsageError naming the choices.
+template <class E, std::size_t N>
+E named(const std::string& name, const std::string& v, const EnumName<E> (&names)[N]) {
+    if (const std::optional<E> e = value_named(names, v)) return *e;
+    throw UsageError(name + ": expected " + names_list(names) + ", got '" + v + "'");
+}
 template <class E, std::size_t N>
 std::string one_of(const std::string& name, const std::string& v, const EnumName<E> (&names)[N]) {
-    if (value_named(names, v)) return v;
-    throw UsageError(name + ": expected " + names_list(names) + ", got '" + v + "'");
+    named(name, v, names);
+    return v;
 }
 
 struct Field {
@@ -131,25 +137,23 @@ RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile) 
     if (o.light_samples)
         for (Light& l : job.scene.lights)
             if (l.is_area()) l.samples = in("light_samples", *o.light_samples, 1, 4096);
-    if (o.sampler)
-        s.pattern = *o.sampler == "grid" ? SamplePattern::Grid
-                    : *o.sampler == "random" ? SamplePattern::Random
-                                             : SamplePattern::Stratified;
-    if (o.colorspace) s.colorspace = *o.colorspace == "linear" ? ColorSpace::Linear : ColorSpace::Srgb;
-    if (o.tonemap) s.tonemap = *o.tonemap == "reinhard" ? Tonemap::Reinhard : Tonemap::Clamp;
+    if (o.sampler) s.pattern = named("sampler", *o.sampler, kSamplePatternNames);
+    if (o.colorspace) s.colorspace = named("colorspace", *o.colorspace, kColorSpaceNames);
+    if (o.tonemap) s.tonemap = named("tonemap", *o.tonemap, kTonemapNames);
+    if (o.output) s.output = *o.output;
     if (o.exposure) s.exposure = *o.exposure;
     if (o.frame) {
         if (*o.frame < 0) throw UsageError("frame must be >= 0");
         if (job.scene.animation) set_frame(job.scene, *o.frame);
     }
-    job.engine = o.engine && *o.engine == "recursive" ? EngineKind::Recursive : EngineKind::Stream;
+    job.engine = o.engine ? named("engine", *o.engine, kEngineNames) : EngineKind::Stream;
     job.threads = o.threads.value_or(0);
-    if (o.accel) job.options.accel.mode = *value_named(accel::kAccelModeNames, *o.accel);
+    if (o.accel) job.options.accel.mode = named("accel", *o.accel, accel::kAccelModeNames);
     if (o.isa) {
         parse_isa(*o.isa, job.options.isa);
         if (!isa_supported(job.options.isa)) throw UsageError("isa " + *o.isa + ": this CPU does not support it");
     }
-    if (o.shade) job.options.shade = *value_named(kShadeModeNames, *o.shade);
+    if (o.shade) job.options.shade = named("shade", *o.shade, kShadeModeNames);
     if (profile) {
         job.profile = std::make_unique<StreamProfile>();
         job.options.profile = job.profile.get();

@@ -19,6 +19,7 @@ struct RenderOverrides {
     std::optional<int> width, height, spp, depth, degree, light_samples, threads, frame;
     std::optional<double> cutoff, exposure;
     std::optional<std::string> sampler, engine, isa, accel, colorspace, tonemap, shade;
+    std::optional<std::string> output;  ///< the file written (the scene's `image output=` otherwise)
 };
 
 /// Everything beside the scene's files that changes the pixels, or the file written, of a

@@ -244,10 +244,11 @@ void save(py::array_t<float, py::array::c_style | py::array::forcecast> image, c
     Framebuffer fb = Framebuffer::uninitialized(int(image.shape(1)), int(image.shape(0)));
     std::copy(image.data(), image.data() + fb.rgb.size(), fb.rgb.begin());
     Display d;
-    if (colorspace == "linear") d.colorspace = ColorSpace::Linear;
-    else if (colorspace != "srgb") throw py::value_error("colorspace: expected 'srgb' or 'linear'");
-    if (tonemap == "reinhard") d.tonemap = Tonemap::Reinhard;
-    else if (tonemap != "clamp") throw py::value_error("tonemap: expected 'clamp' or 'reinhard'");
+    const auto cs = value_named(kColorSpaceNames, colorspace);
+    if (!cs) throw py::value_error("colorspace: expected " + names_list(kColorSpaceNames));
+    const auto tm = value_named(kTonemapNames, tonemap);
+    if (!tm) throw py::value_error("tonemap: expected " + names_list(kTonemapNames));
+    d.colorspace = *cs, d.tonemap = *tm;
     d.exposure = float(exposure);
     py::gil_scoped_release release;
     write_image(path, fb, d);

@@ -336,18 +336,20 @@ def group_mpi_ranks(args, tmp):
 
 def group_mpi_faults(args, tmp):
     scene = SCENES / "whitted.cfg"
-    out = tmp / "killed.pfm"
+    out, journal = tmp / "killed.pfm", tmp / "killed.journal"
     cmd = mpirun(args, 3) + ["--mpi", "-j1", scene, "-o", out, "--width", "1280", "--height", "720", "--spp", "128",
-                             "-q"]
+                             "--checkpoint", journal, "-q"]
     e = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     p = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=e)
-    # Once the 3 ranks run, kill the last one (whether it is still setting up or rendering,
-    # the job must end with an error; polling, no time limit but the hang catcher's).
+    # Kill the last rank once the render runs: rank 0 creates the journal after MPI_Init, which
+    # every rank passes together. (A rank killed inside MPI_Init can leave Open MPI's launcher
+    # waiting on its wire-up forever: the launcher's matter, not the renderer's.) Polled, no
+    # time limit but the hang catcher's.
     victims = []
     deadline = time.time() + 60 * SCALE
     while time.time() < deadline and p.poll() is None:
         victims = rank_pids(p.pid)
-        if len(victims) == 3:
+        if len(victims) == 3 and journal.exists():
             break
         time.sleep(0.01)
     check(len(victims) == 3, f"expected 3 rank processes under mpirun, found {victims}")
