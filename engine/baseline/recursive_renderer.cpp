@@ -163,7 +163,8 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     if (!closest_hit(ray, 0.0, kInf, hit)) return {s.background.x, s.background.y, s.background.z};
 
     const Object& object = scene_.objects[std::size_t(hit.object)];
-    const ShadeRules<double> rules{s.degree, s.ambient, depth < s.depth, s.cutoff, camera_.spread};
+    const ShadeRules<double> rules{
+        .degree = s.degree, .ambient = s.ambient, .spawn = depth < s.depth, .cutoff = s.cutoff, .spread = camera_.spread};
     // Weight 1: the caller multiplies what this ray brings back by its weight.
     const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
     const MaterialT<double>& material = materials_[object.material];

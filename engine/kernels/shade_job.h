@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "kernels/kernel_object.h"
+#include "kernels/ray_stream.h"
 #include "mesh/mesh_view.h"
 #include "render/camera_rays.h"
 #include "render/shading.h"
@@ -29,6 +30,18 @@ struct ShadowAppend {
     std::int32_t* pixel;
     std::size_t* count;
 };
+
+/// The append views of a stream's arrays (without the keys: a stage that carries them sets them).
+inline RayAppend append_view(RayStream& r) {
+    return {.ox = r.ox.data(), .oy = r.oy.data(), .oz = r.oz.data(), .dx = r.dx.data(), .dy = r.dy.data(),
+            .dz = r.dz.data(), .t_max = r.t_max.data(), .wr = r.wr.data(), .wg = r.wg.data(), .wb = r.wb.data(),
+            .cone = r.cone.data(), .pixel = r.pixel.data(), .kind = r.kind.data(), .count = &r.count};
+}
+inline ShadowAppend append_view(ShadowStream& s) {
+    return {.ox = s.ox.data(), .oy = s.oy.data(), .oz = s.oz.data(), .dx = s.dx.data(), .dy = s.dy.data(),
+            .dz = s.dz.data(), .t_max = s.t_max.data(), .cr = s.cr.data(), .cg = s.cg.data(), .cb = s.cb.data(),
+            .pixel = s.pixel.data(), .count = &s.count};
+}
 
 struct ShadeJob {
     // Rays [begin, end) of the sorted arrays; readable up to end + kMaxLanes (padding).

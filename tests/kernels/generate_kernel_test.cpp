@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "kernels/append_view.h"
+#include "kernels/shade_job.h"
 #include "kernels/kernel_table.h"
 #include "render/camera_rays.h"
 #include "render/sampling.h"
@@ -50,7 +50,7 @@ TEST_CASE("generate kernel: same sample positions and directions as the scalar f
                 rays.reserve(n);
                 GenerateJob job{n, a_px.data(), a_py.data(), a_cx.data(), a_cy.data(), a_kp.data(), a_ks.data(),
                                 int(scene.settings.pattern), spp > 1, float(cols), float(spp / cols),
-                                &cam, 1.f / float(spp), test::append_view(rays)};
+                                &cam, 1.f / float(spp), append_view(rays)};
                 kernel_table(isa).generate(job);
                 for (std::size_t i = 0; i < n; ++i) {
                     const PixelSample ps = pixel_sample(scene.settings.pattern, spp, kp[i], int(ks[i]));

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "driver/render.h"
-#include "kernels/append_view.h"
+#include "kernels/shade_job.h"
 #include "kernels/kernel_table.h"
 #include "render/camera_rays.h"
 #include "render/sampling.h"
@@ -165,7 +165,7 @@ TEST_CASE("thin lens: the generate(lens) kernel traces the scalar formulas' rays
         rays.reserve(n);
         GenerateJob job{n, a_px.data(), a_py.data(), a_cx.data(), a_cy.data(), a_kp.data(), a_ks.data(),
                         int(scene.settings.pattern), true, float(cols), float(spp / cols), &cam, 1.f / float(spp),
-                        test::append_view(rays), a_lx.data(), a_ly.data()};
+                        append_view(rays), a_lx.data(), a_ly.data()};
         kernel_table(isa).generate_lens(job);
         for (std::size_t i = 0; i < n; ++i) {
             const PixelSample ps = pixel_sample(scene.settings.pattern, spp, kp[i], int(ks[i]));

@@ -1,0 +1,338 @@
+#pragma once
+// The shade stage of the stream pipeline: hits become local colour, shadow rays and child
+// rays, one ray at a time (scalar, shade_hit in render/shading.h) or regrouped into runs that
+// share an object, or a material and shape kind, for the SIMD shade kernels.
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "kernels/kernel_table.h"
+#include "kernels/shade_job.h"
+#include "mesh/mesh_trace.h"
+#include "render/render_stats.h"
+#include "render/texture.h"
+#include "shapes/shapes.h"
+#include "stream/shade_mode.h"
+#include "stream/stream_scene.h"
+#include "stream/workspace.h"
+
+namespace streamrt {
+
+/// Scenes with more objects than this shade without sorting: the counting sort walks every
+/// object's bucket per chunk and the runs get too short for whole packets. Measured
+/// (docs/performance.md, "Design choices"): sorted SIMD shading is 3.2x faster at 1e3 spheres,
+/// 2x at 4e3, even at 1e4, 8x slower at 1e5.
+inline constexpr std::size_t kSortedShadeMaxObjects = 8192;
+/// Above it, hits are regrouped by (material, shape kind) instead, whose count stays small
+/// when objects share materials, and each lane gathers its own object's record; scenes with
+/// meshes, or with more than this many (material, kind) pairs, shade one ray at a time.
+inline constexpr std::size_t kGatheredShadeMaxKeys = 65536;
+
+/// The shade mode a scene gets: `asked` resolved against what the scene allows.
+inline ShadeMode resolve_shade_mode(const StreamScene& sc, ShadeMode asked) {
+    const bool gather_ok = !sc.has_meshes && sc.materials.size() * kShapeKindCount <= kGatheredShadeMaxKeys;
+    switch (asked) {
+        case ShadeMode::Scalar: return ShadeMode::Scalar;
+        case ShadeMode::Sorted: return ShadeMode::Sorted;
+        case ShadeMode::Gathered: return gather_ok ? ShadeMode::Gathered : ShadeMode::Sorted;
+        case ShadeMode::Auto: break;
+    }
+    if (sc.object_count <= kSortedShadeMaxObjects) return ShadeMode::Sorted;
+    return gather_ok ? ShadeMode::Gathered : ShadeMode::Scalar;
+}
+
+namespace stage_detail {
+
+inline void add(float* accum, std::int32_t pixel, const ColorT<float>& c) {
+    accum[pixel * 3 + 0] += c.x;
+    accum[pixel * 3 + 1] += c.y;
+    accum[pixel * 3 + 2] += c.z;
+}
+inline std::uint64_t lanes_for(std::size_t n, int width) {
+    return (std::uint64_t(n) + std::uint64_t(width) - 1) / std::uint64_t(width) * std::uint64_t(width);
+}
+
+}  // namespace stage_detail
+
+/// The shade stage for a scene's features (the same flags as PipelineStages).
+template <bool kLighting, bool kShadows, bool kReflect, bool kRefract>
+struct ShadeStage {
+    static constexpr bool kSecondary = kReflect || kRefract;
+
+    /// The shading rules for rays of generation `depth`. The stream's weights carry the
+    /// sample's 1/spp, so the cut-off (defined on the refl / trans product alone, as in the
+    /// recursive engine) is scaled by it.
+    static ShadeRules<float> shade_rules(const StreamScene& sc, int depth) {
+        const RenderSettings& s = sc.settings;
+        return {.degree = s.degree,
+                .ambient = float(s.ambient),
+                .spawn = kSecondary && depth < s.depth,
+                .cutoff = float(s.cutoff / s.spp),
+                .spread = sc.camera.spread};
+    }
+
+    /// Where shade_hit's results go on the scalar path: the local colour into the tile,
+    /// shadow and child rays appended to their streams.
+    struct ScalarSink {
+        static constexpr bool kTestsShadowsNow = false;
+        float* accum;
+        std::int32_t px;
+        RayStream& next;
+        ShadowStream& shadows;
+        RayCounts& counts;
+        const std::uint32_t* keys;  ///< area lights only (else unread): the rays' keys
+        std::size_t i;              ///< the ray shaded
+
+        std::uint32_t light_key() const { return keys[i]; }
+
+        void local(const ColorT<float>& c) { stage_detail::add(accum, px, c); }
+        void shadow(bool send, const Vec3f& from, const Vec3f& to, float t_max, const ColorT<float>& c) {
+            if (!send) return;
+            const std::size_t j = shadows.count++;
+            shadows.ox[j] = from.x;
+            shadows.oy[j] = from.y;
+            shadows.oz[j] = from.z;
+            shadows.dx[j] = to.x;
+            shadows.dy[j] = to.y;
+            shadows.dz[j] = to.z;
+            shadows.t_max[j] = t_max;
+            shadows.cr[j] = c.x;
+            shadows.cg[j] = c.y;
+            shadows.cb[j] = c.z;
+            shadows.pixel[j] = px;
+        }
+        void child(bool send, const Vec3f& from, const Vec3f& dir, const ColorT<float>& weight, const ColorT<float>&,
+                   float cone, RayKind kind) {
+            if (!send) return;
+            if (keys) next.key[next.count] = keys[i];  // area lights: the child inherits the key
+            push(next, next.count++, from, dir, weight, cone, px, kind);
+            ++(kind == RayKind::Reflected ? counts.reflected : counts.refracted);
+        }
+    };
+
+    /// shade + spawn, one ray at a time (shade_hit in render/shading.h with V = float):
+    /// local terms into the tile, shadow rays when degree 5 asks for visibility, reflected
+    /// and refracted rays appended to `next` (only surviving rays move on). Misses bring the
+    /// background.
+    static void shade(const StreamScene& sc, const RayStream& rays, const AlignedVec<std::int32_t>& object,
+                      const MeshHits& mesh_hits, int depth, RayStream& next, ShadowStream& shadows, float* accum,
+                      RayCounts& counts) {
+        using namespace stage_detail;
+        const ShadeRules<float> rules = shade_rules(sc, depth);
+        // This path serves scenes with many objects, where each hit's records are likely
+        // cache misses: fetch them a few rays ahead (in leaf order, neighbouring rays mostly
+        // hit objects close in memory).
+        constexpr std::size_t kPrefetchDistance = 8;
+        const std::uint32_t* keys = sc.features.area_lights ? rays.key.data() : nullptr;
+        for (std::size_t i = 0; i < rays.count; ++i) {
+            if (i + kPrefetchDistance < rays.count && object[i + kPrefetchDistance] >= 0) {
+                const std::size_t ahead = std::size_t(object[i + kPrefetchDistance]);
+                __builtin_prefetch(&sc.objects[ahead]);
+                __builtin_prefetch(reinterpret_cast<const char*>(&sc.objects[ahead]) + 64);
+                __builtin_prefetch(&sc.surfaces[ahead]);
+            }
+            const ColorT<float> w{rays.wr[i], rays.wg[i], rays.wb[i]};
+            const std::int32_t px = rays.pixel[i];
+            const std::int32_t id = object[i];
+            if (id < 0) {
+                add(accum, px, mul(w, sc.background));
+                continue;
+            }
+            const KernelObject& ob = sc.objects[std::size_t(id)];
+            const SurfaceRecord& sf = sc.surfaces[std::size_t(id)];
+            const MaterialT<float>& m = sc.materials[sf.material];
+            const ShapeKind kind = ShapeKind(ob.kind);
+            const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
+            const float t = rays.t_max[i];
+            // The canonical hit point (the kernels keep only t and the object) gives the
+            // normal, brought back with Mn; the world point is the ray's own.
+            const Vec3f pc = apply_point(ob.xf.m, o) + apply_vector(ob.xf.m, d) * t;
+            const Vec3f p = o + d * t;
+            const Vec3f nc =
+                kind == ShapeKind::Mesh
+                    ? mesh_normal<float>(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i], mesh_hits.v[i],
+                                         ob.xf.param != 0.f)
+                    : visit_shape(kind, [&](auto shape) { return shape.template normal<float>(pc, ob.xf.param); });
+            const ArrivingRay<float> arriving{o, d, t, rays.cone[i], w, w};
+            ScalarSink sink{accum, px, next, shadows, counts, keys, i};
+            const Vec3f n_out = apply_normal(ob.xf.m, nc);
+            ColorT<float> color{sf.color[0], sf.color[1], sf.color[2]};
+            if (m.texture) {  // the texture replaces the object's colour (render/texture.h)
+                const float footprint = footprint_width(rays.cone[i], rules.spread, t, dot(d, n_out));
+                const float scale = canonical_per_world<float>(ob.xf.m);
+                color = kind == ShapeKind::Mesh
+                            ? mesh_texture_color(m, *ob.xf.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i],
+                                                 mesh_hits.v[i], scale, footprint)
+                            : texture_color(m, kind, pc, ob.xf.param, scale, footprint);
+            }
+            shade_hit<kLighting, kShadows, kReflect, kRefract>(rules, m, sc.lights.data(), sc.lights.size(), arriving,
+                                                               p, n_out, color, true, sink);
+        }
+    }
+
+    /// shade + spawn, SIMD: misses bring the background; hits are regrouped by object and
+    /// each run goes through the shade kernel; local colours then go into the tile in the
+    /// sorted order (fixed for a given tile, so the picture does not depend on threads).
+    static void shade_sorted(const StreamScene& sc, const KernelTable& kt, const RayStream& rays,
+                             const AlignedVec<std::int32_t>& object, int depth, Workspace& ws, float* accum,
+                             RayCounts& counts, bool gathered) {
+        using namespace stage_detail;
+        SortedHits& h = ws.sorted;
+        // The run key of a hit: its object, or (gathered) its material and shape kind.
+        const auto key_of = [&](std::int32_t id) -> std::size_t {
+            if (!gathered) return std::size_t(id);
+            return std::size_t(sc.surfaces[std::size_t(id)].material) * kShapeKindCount + sc.objects[id].kind;
+        };
+        const std::size_t n_keys = gathered ? sc.materials.size() * kShapeKindCount : sc.object_count;
+        h.run_start.assign(n_keys + 1, 0);
+        std::size_t hits = 0;
+        for (std::size_t i = 0; i < rays.count; ++i) {
+            const std::int32_t id = object[i];
+            if (id < 0) {
+                add(accum, rays.pixel[i], mul(ColorT<float>{rays.wr[i], rays.wg[i], rays.wb[i]}, sc.background));
+                continue;
+            }
+            ++h.run_start[key_of(id) + 1];
+            ++hits;
+        }
+        for (std::size_t k = 1; k <= n_keys; ++k) h.run_start[k] += h.run_start[k - 1];
+        h.reserve(hits);
+        if (sc.features.area_lights) h.reserve_keys();
+        {
+            std::vector<std::uint32_t>& next_slot = ws.slot;
+            next_slot.assign(h.run_start.begin(), h.run_start.end() - 1);
+            for (std::size_t i = 0; i < rays.count; ++i) {
+                const std::int32_t id = object[i];
+                if (id < 0) continue;
+                const std::size_t j = next_slot[key_of(id)]++;
+                h.ox[j] = rays.ox[i];
+                h.oy[j] = rays.oy[i];
+                h.oz[j] = rays.oz[i];
+                h.dx[j] = rays.dx[i];
+                h.dy[j] = rays.dy[i];
+                h.dz[j] = rays.dz[i];
+                h.t[j] = rays.t_max[i];
+                h.wr[j] = rays.wr[i];
+                h.wg[j] = rays.wg[i];
+                h.wb[j] = rays.wb[i];
+                h.cone[j] = rays.cone[i];
+                h.pixel[j] = rays.pixel[i];
+                if (gathered) h.object[j] = id;
+                if (sc.features.area_lights) h.key[j] = rays.key[i];
+                if (sc.has_meshes) {
+                    h.prim[j] = ws.mesh_hits.prim[i];
+                    h.bu[j] = ws.mesh_hits.u[i];
+                    h.bv[j] = ws.mesh_hits.v[i];
+                }
+            }
+            // A gathered packet reads a whole batch of ids past the last hit: valid ones.
+            if (gathered) std::fill_n(h.object.begin() + std::ptrdiff_t(hits), simd::kMaxLanes, 0);
+        }
+        const std::size_t next_before = ws.next.count;
+        RayStream& nx = ws.next;
+        ShadowStream& sh = ws.shadows;
+        ShadeJob job{.ox = h.ox.data(),
+                     .oy = h.oy.data(),
+                     .oz = h.oz.data(),
+                     .dx = h.dx.data(),
+                     .dy = h.dy.data(),
+                     .dz = h.dz.data(),
+                     .t = h.t.data(),
+                     .wr = h.wr.data(),
+                     .wg = h.wg.data(),
+                     .wb = h.wb.data(),
+                     .cone = h.cone.data(),
+                     .pixel = h.pixel.data(),
+                     .begin = 0,
+                     .end = 0,
+                     .object = nullptr,
+                     .color = {},
+                     .material = nullptr,
+                     .lights = sc.lights.data(),
+                     .n_lights = sc.lights.size(),
+                     .rules = shade_rules(sc, depth),
+                     .lr = h.lr.data(),
+                     .lg = h.lg.data(),
+                     .lb = h.lb.data(),
+                     .next = append_view(nx),
+                     .shadows = append_view(sh),
+                     .prim = h.prim.data(),
+                     .bu = h.bu.data(),
+                     .bv = h.bv.data()};
+        if (sc.features.area_lights) job.key = h.key.data(), job.next.key = nx.key.data();
+        const int variant = (kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0);
+        const ShadeFn fn = gathered ? kt.shade_gathered[variant] : kt.shade[variant];
+        if (gathered) {
+            job.ids = h.object.data();
+            job.objects = sc.objects;
+            job.surfaces = sc.surfaces.data();
+        }
+        for (std::size_t k = 0; k < n_keys; ++k) {
+            if (h.run_start[k] == h.run_start[k + 1]) continue;
+            job.begin = h.run_start[k];
+            job.end = h.run_start[k + 1];
+            if (gathered) {
+                job.material = &sc.materials[k / kShapeKindCount];
+                job.kind = ShapeKind(k % kShapeKindCount);
+            } else {
+                const SurfaceRecord& sf = sc.surfaces[k];
+                job.object = &sc.objects[k];
+                job.color = {sf.color[0], sf.color[1], sf.color[2]};
+                job.material = &sc.materials[sf.material];
+            }
+            fn(job);
+        }
+        for (std::size_t j = 0; j < hits; ++j) add(accum, h.pixel[j], {h.lr[j], h.lg[j], h.lb[j]});
+        if constexpr (kSecondary) {
+            for (std::size_t j = next_before; j < nx.count; ++j) {
+                if (nx.kind[j] == std::uint8_t(RayKind::Reflected)) ++counts.reflected;
+                else ++counts.refracted;
+            }
+        }
+    }
+
+    /// Gathered shading emits shadow rays run by run, (material, kind) after (material, kind):
+    /// rays of one packet then start from far apart in the tile, and at 1e6 objects the
+    /// hierarchy walk of such packets cost 1.6x that of rays in pixel order (measured,
+    /// docs/performance.md). A counting sort over the tile's pixels puts them back in pixel
+    /// order (stable: a pixel's rays keep their light order).
+    static void order_shadows_by_pixel(Workspace& ws, std::size_t tile_pixels) {
+        ShadowStream& in = ws.shadows;
+        ShadowStream& out = ws.shadows_in_pixel_order;
+        const std::size_t n = in.count;
+        std::vector<std::uint32_t>& start = ws.slot;
+        start.assign(tile_pixels + 1, 0);
+        for (std::size_t i = 0; i < n; ++i) ++start[std::size_t(in.pixel[i]) + 1];
+        for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
+        out.reserve(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::size_t j = start[std::size_t(in.pixel[i])]++;
+            out.ox[j] = in.ox[i], out.oy[j] = in.oy[i], out.oz[j] = in.oz[i];
+            out.dx[j] = in.dx[i], out.dy[j] = in.dy[i], out.dz[j] = in.dz[i];
+            out.t_max[j] = in.t_max[i];
+            out.cr[j] = in.cr[i], out.cg[j] = in.cg[i], out.cb[j] = in.cb[i];
+            out.pixel[j] = in.pixel[i];
+        }
+        out.count = n;
+        std::swap(in, out);
+    }
+
+    static void push(RayStream& r, std::size_t j, const Vec3f& o, const Vec3f& d, const ColorT<float>& w,
+                     float cone, std::int32_t px, RayKind kind) {
+        r.cone[j] = cone;
+        r.ox[j] = o.x;
+        r.oy[j] = o.y;
+        r.oz[j] = o.z;
+        r.dx[j] = d.x;
+        r.dy[j] = d.y;
+        r.dz[j] = d.z;
+        r.t_max[j] = std::numeric_limits<float>::infinity();
+        r.wr[j] = w.x;
+        r.wg[j] = w.y;
+        r.wb[j] = w.z;
+        r.pixel[j] = px;
+        r.kind[j] = std::uint8_t(kind);
+    }
+};
+
+}  // namespace streamrt
