@@ -10,6 +10,8 @@
 #include <limits>
 
 #include "core/vec3.h"
+#include "core/vec_lanes.h"
+#include "lights/lights.h"
 #include "render/render_stats.h"
 #include "render/sampling.h"
 #include "scene/scene.h"
@@ -17,27 +19,6 @@
 #include "simd/lanes.h"
 
 namespace streamrt {
-
-template <class T>
-using ColorT = Vec3T<T>;
-
-template <class V>
-using MaskOf = decltype(V() < V());
-
-STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
-
-template <class V, class M>
-inline Vec3T<V> select3(const M& m, const Vec3T<V>& a, const Vec3T<V>& b) {
-    using simd::select;
-    return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
-}
-
-template <class V, class T>
-inline Vec3T<V> splat(const Vec3T<T>& a) {
-    return {V(a.x), V(a.y), V(a.z)};
-}
-
-STREAMRT_ISA_END
 
 /// A material in the engine's precision. The object's own colour (Object::color) is passed
 /// beside it wherever a surface colour is needed.
@@ -70,52 +51,6 @@ struct MaterialT {
                 T(m.ambi), T(m.diff), T(m.spec), T(m.shininess), T(m.refl), T(m.trans),
                 T(m.ior), T(1.0 / m.cell), m.checker, T(cutoff), {T(0), T(0), T(0)},
                 fresnel, T(fresnel ? r * r : 0.0)};
-    }
-};
-
-template <class T>
-struct LightT {
-    LightKind kind;
-    Vec3T<T> pos;
-    Vec3T<T> dir;  ///< unit: spot axis or directional travel direction
-    ColorT<T> color;
-    T cos_angle;   ///< spot: cosine of the half-angle
-    // Area lights, falloff and soft edges: a light with `shaped` false (the handout's) takes
-    // shade_hit's original path and reads none of these.
-    bool shaped = false;          ///< Light::shaped(): lit by shade_shaped_light
-    bool inverse_square = false;  ///< falloff=inverse_square
-    bool soft = false;            ///< spot with a soft edge
-    T cos_inner = T(1);           ///< soft spot: cosine of angle - soft (full light inside)
-    T radius = T(0);              ///< sphere
-    Vec3T<T> u{}, v{};            ///< rect: edges from the corner pos
-    Vec3T<T> normal{};            ///< rect: unit u x v, the lit side
-    int samples = 1;              ///< area lights: samples per shaded point
-    int columns = 1;              ///< their stratification lattice: columns x (samples / columns)
-
-    static LightT from(const Light& l) {
-        constexpr double kDeg = 3.14159265358979323846 / 180.0;
-        LightT r{l.kind, {T(l.pos.x), T(l.pos.y), T(l.pos.z)},
-                 {T(l.dir.x), T(l.dir.y), T(l.dir.z)}, {T(l.color.x), T(l.color.y), T(l.color.z)},
-                 T(std::cos(l.angle * kDeg))};
-        r.shaped = l.shaped();
-        r.inverse_square = l.falloff == Falloff::InverseSquare;
-        r.soft = l.kind == LightKind::Spot && l.soft > 0.0;
-        r.cos_inner = T(std::cos((l.angle - l.soft) * kDeg));
-        r.radius = T(l.radius);
-        r.u = {T(l.u.x), T(l.u.y), T(l.u.z)};
-        r.v = {T(l.v.x), T(l.v.y), T(l.v.z)};
-        const glm::dvec3 n = glm::cross(l.u, l.v);
-        const double len = glm::length(n);
-        if (len > 0.0) r.normal = {T(n.x / len), T(n.y / len), T(n.z / len)};
-        r.samples = l.is_area() ? std::max(1, l.samples) : 1;
-        r.columns = l.is_area() ? area_light_columns(r.samples) : 1;
-        return r;
-    }
-    /// Columns of the lattice of n samples: as square as possible, columns dividing n.
-    static int area_light_columns(int n) {
-        int cols = int(std::ceil(std::sqrt(double(n))));
-        while (n % cols != 0) ++cols;
-        return cols;
     }
 };
 
@@ -180,34 +115,6 @@ template <class V>
 inline V footprint_width(const V& cone_at_origin, const V& spread, const V& t, const V& cos_incidence) {
     using namespace simd;
     return (cone_at_origin + spread * t) / max(abs(cos_incidence), V(1e-3));
-}
-
-/// Where a light is seen from p: unit direction w towards it, the shadow-ray segment
-/// (p + t to_light, t in (0, t_max)) and whether p is inside the light's reach (spot cone).
-template <class V>
-struct LightSample {
-    Vec3T<V> w;         ///< unit, towards the light
-    Vec3T<V> to_light;  ///< shadow-ray direction: light - p for lights at a point, w otherwise
-    V t_max;            ///< 1 for lights at a point, +inf for directional
-    MaskOf<V> reaches;  ///< false outside a spot's cone
-};
-
-template <class V, class T>
-inline LightSample<V> sample_light(const LightT<T>& l, const Vec3T<V>& p) {
-    LightSample<V> s;
-    if (l.kind == LightKind::Directional) {
-        s.w = splat<V>(-l.dir);
-        s.to_light = s.w;
-        s.t_max = V(std::numeric_limits<T>::infinity());
-        s.reaches = V(0) == V(0);
-        return s;
-    }
-    s.to_light = splat<V>(l.pos) - p;
-    s.w = normalize(s.to_light);
-    s.t_max = V(1);
-    if (l.kind == LightKind::Point) s.reaches = V(0) == V(0);
-    else s.reaches = dot(-s.w, splat<V>(l.dir)) >= V(l.cos_angle);
-    return s;
 }
 
 template <class V>
@@ -379,77 +286,13 @@ STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h
 // point-light term from each sample point, times `scale` (falloff, soft edge, emitter
 // cosine): a tiny area light is a point light of the same colour.
 
-/// One sample of a shaped light seen from p: the point-light term's direction and reach
-/// (ls), the sample point `at` (lights at a point) and what the term is multiplied by.
-template <class V>
-struct ShapedSample {
-    LightSample<V> ls;
-    Vec3T<V> at;
-    V scale;
-};
-
-
-/// Sample (u1, u2) in [0, 1)^2 of light l seen from p. Sphere: a direction uniform in the
-/// solid angle of the cap of the sphere visible from p (cone sampling: cos theta uniform in
-/// [cos theta_max, 1]), ending on the sphere's near side. Rect: a point uniform on the
-/// parallelogram pos + u1 u + u2 v, weighted by the emitter cosine (zero behind it: one-sided).
-/// Spot with a soft edge: the smoothstep of the cosine from cos(angle) (0) to cos(angle - soft)
-/// (1). falloff=inverse_square: 1 / |p - at|^2 (directional lights, at infinity, have none).
+/// Sample (u1, u2) in [0, 1)^2 of light l seen from p: its kind's sample (lights/), then
+/// falloff=inverse_square, 1 / |p - at|^2 (directional lights, at infinity, have none).
 template <class V, class T>
 inline ShapedSample<V> sample_shaped_light(const LightT<T>& l, const Vec3T<V>& p, const V& u1, const V& u2) {
     using namespace simd;
-    ShapedSample<V> r;
-    r.scale = V(1);
-    if (l.kind == LightKind::Directional) {
-        r.ls = sample_light(l, p);
-        r.at = p + r.ls.w;
-        return r;
-    }
-    if (l.kind == LightKind::Point || l.kind == LightKind::Spot) {
-        r.ls = sample_light(l, p);
-        r.at = splat<V>(l.pos);
-        if (l.soft) {
-            const V c = dot(-r.ls.w, splat<V>(l.dir));
-            const V x = min(max((c - V(l.cos_angle)) / V(l.cos_inner - l.cos_angle), V(0)), V(1));
-            r.scale = x * x * (V(3) - V(2) * x);
-        }
-    } else if (l.kind == LightKind::Sphere) {
-        const Vec3T<V> c = splat<V>(l.pos) - p;
-        const V d2 = dot(c, c);
-        const V r2(l.radius * l.radius);
-        const V dist = sqrt(d2);
-        // At the very centre (dist 0) any axis will do: a = 0 still gives a unit w below.
-        const Vec3T<V> a = c * (V(1) / max(dist, V(std::numeric_limits<T>::min())));
-        const V cos_max = sqrt(V(1) - min(r2 / d2, V(1)));
-        const V cos_t = V(1) - u1 * (V(1) - cos_max);
-        const V sin_t = sqrt(max(V(1) - cos_t * cos_t, V(0)));
-        V cos_phi, sin_phi;
-        simd::cos_sin_of_turn(u2, cos_phi, sin_phi);
-        // An orthonormal basis around a (Duff et al. 2017, branch-free).
-        const V sg = sign_of(a.z);
-        const V k = V(-1) / (sg + a.z);
-        const V b = a.x * a.y * k;
-        const Vec3T<V> b1{V(1) + sg * a.x * a.x * k, sg * b, -sg * a.x};
-        const Vec3T<V> b2{b, sg + a.y * a.y * k, -a.y};
-        const Vec3T<V> w = b1 * (sin_t * cos_phi) + b2 * (sin_t * sin_phi) + a * cos_t;
-        // Along w to the sphere: its near side, or its far side from inside the light.
-        const V h = sqrt(max(r2 - d2 * sin_t * sin_t, V(0)));
-        const V t = select(d2 > r2, dist * cos_t - h, dist * cos_t + h);
-        r.at = p + w * t;
-        r.ls.w = w;
-        r.ls.to_light = w * t;
-        r.ls.t_max = V(1);
-        r.ls.reaches = t > V(0);
-    } else {  // Rect
-        r.at = splat<V>(l.pos) + splat<V>(l.u) * u1 + splat<V>(l.v) * u2;
-        r.ls.to_light = r.at - p;
-        r.ls.w = normalize(r.ls.to_light);
-        r.ls.t_max = V(1);
-        const V emit = -dot(r.ls.w, splat<V>(l.normal));
-        r.ls.reaches = emit > V(0);
-        r.scale = max(emit, V(0));
-    }
-    if (l.inverse_square)
+    ShapedSample<V> r = visit_light(l.kind, [&](auto kind) { return decltype(kind)::template sample<V>(l, p, u1, u2); });
+    if (l.inverse_square && l.kind != LightKind::Directional)
         r.scale = r.scale / max(dot(r.ls.to_light, r.ls.to_light), V(std::numeric_limits<T>::min()));
     return r;
 }
@@ -467,7 +310,7 @@ template <bool kShadows, class V, class T, class M, class Sink>
                                std::uint32_t index, const Vec3T<V>& p, const Vec3T<V>& shadow_origin,
                                const M& active, ColorT<V>& local, Sink& sink) {
     using namespace simd;
-    const bool area = l.kind == LightKind::Sphere || l.kind == LightKind::Rect;
+    const bool area = l.area;
     const V share(T(1) / T(l.samples));
     const int cols = l.columns;
     const V inv_cols(T(1) / T(cols)), inv_rows(T(1) / T(l.samples / cols));

@@ -132,71 +132,46 @@ void Parser::camera(Statement& st, const std::vector<Token>& toks) {
 }
 
 void Parser::light(Statement& st, const std::vector<Token>& toks) {
-    if (toks.size() < 2)
-        st.fail_here("expected a light kind (point, spot, directional, sphere or rect) after 'light'");
+    if (toks.size() < 2) st.fail_here("expected a light kind (" + light_kind_names() + ") after 'light'");
     const Token& kt = toks[1];
+    const std::optional<LightKind> kind = light_kind_named(kt.text);
+    if (!kind) st.fail(kt.column, "expected a light kind (" + light_kind_names() + "), got " + quote(kt.text));
     Light l;
-    const std::vector<std::string_view>* keys = nullptr;
-    if (kt.text == "point") {
-        l.kind = LightKind::Point;
-        keys = &kPointLightKeys;
-    } else if (kt.text == "spot") {
-        l.kind = LightKind::Spot;
-        keys = &kSpotLightKeys;
-    } else if (kt.text == "directional") {
-        l.kind = LightKind::Directional;
-        keys = &kDirectionalLightKeys;
-    } else if (kt.text == "sphere") {
-        l.kind = LightKind::Sphere;
-        keys = &kSphereLightKeys;
-    } else if (kt.text == "rect") {
-        l.kind = LightKind::Rect;
-        keys = &kRectLightKeys;
-    } else {
-        st.fail(kt.column,
-                "expected a light kind (point, spot, directional, sphere or rect), got " + quote(kt.text));
-    }
-    st.read_args(toks, 2, *keys);
-    for (const Arg& a : st.args) {
-        if (a.key == "pos") l.pos = st.vec3(a);
-        else if (a.key == "dir") l.dir = st.direction(a);
-        else if (a.key == "angle") l.angle = st.in_open(a, 0.0, 180.0);
-        else if (a.key == "color") l.color = st.color(a);
-        else area_light_key(st, a, l);
-    }
-    const bool needs_pos = l.kind != LightKind::Directional;
-    const bool needs_dir = l.kind == LightKind::Spot || l.kind == LightKind::Directional;
-    const std::string kind(kt.text);
-    if (needs_pos && !st.find("pos")) st.fail_here("light " + kind + " needs 'pos=x,y,z'");
-    if (needs_dir && !st.find("dir")) st.fail_here("light " + kind + " needs 'dir=x,y,z'");
-    check_area_light(st, l);
+    l.kind = *kind;
+    // The kind's keys, required keys and checks come from its definition (lights/lights.h).
+    visit_light(l.kind, [&](auto def) {
+        using Def = decltype(def);
+        st.read_args(toks, 2, std::vector<std::string_view>(std::begin(Def::keys), std::end(Def::keys)));
+        for (const Arg& a : st.args) light_key(st, a, l);
+        for (std::string_view key : Def::required)
+            if (!st.find(key))
+                st.fail_here("light " + std::string(Def::name) + " needs '" + std::string(key) + "=" +
+                             std::string(key == "radius" ? "r" : "x,y,z") + "'");
+        const LightProblem problem = Def::check(l);
+        if (!problem.key.empty()) {
+            const Arg* at = st.find(problem.key);
+            const std::string msg = problem.message + (problem.with_value && at ? ", got " + quote(at->value) : "");
+            if (at) st.fail(at->value_col, msg);
+            st.fail_here(msg);
+        }
+        return 0;
+    });
     scene.lights.push_back(l);
     if (const Arg* n = st.find("name"))
         name_thing(st.file(), st.line(), *n, Named::Light, std::uint32_t(scene.lights.size() - 1));
 }
 
-void Parser::area_light_key(const Statement& st, const Arg& a, Light& l) {
-    if (a.key == "radius") l.radius = st.positive(a);
+void Parser::light_key(const Statement& st, const Arg& a, Light& l) {
+    if (a.key == "pos") l.pos = st.vec3(a);
+    else if (a.key == "dir") l.dir = st.direction(a);
+    else if (a.key == "angle") l.angle = st.in_open(a, 0.0, 180.0);
+    else if (a.key == "color") l.color = st.color(a);
+    else if (a.key == "radius") l.radius = st.positive(a);
     else if (a.key == "u") l.u = st.vec3(a);
     else if (a.key == "v") l.v = st.vec3(a);
     else if (a.key == "samples") l.samples = st.integer(a, 1, 4096);
     else if (a.key == "soft") l.soft = st.at_least_zero(a);
     else if (a.key == "falloff") l.falloff = st.word(a, kFalloffNames);
-}
-
-void Parser::check_area_light(const Statement& st, const Light& l) {
-    if (l.kind == LightKind::Sphere && !st.find("radius")) st.fail_here("light sphere needs 'radius=r'");
-    if (l.kind == LightKind::Rect) {
-        if (!st.find("u")) st.fail_here("light rect needs 'u=x,y,z'");
-        if (!st.find("v")) st.fail_here("light rect needs 'v=x,y,z'");
-        const double area = glm::length(glm::cross(l.u, l.v));
-        // Relative to the edges' lengths, so the test does not depend on the scene's unit.
-        if (!(area > 1e-12 * glm::length(l.u) * glm::length(l.v)) || !std::isfinite(area))
-            st.fail(st.find("v")->value_col, "light rect: 'u' and 'v' span no area (u x v = 0)");
-    }
-    if (const Arg* s = st.find("soft"); s && !(l.soft < l.angle))
-        st.fail(s->value_col, "'soft' must be below the spot's 'angle' (" + fmt_num(l.angle) + "), got " +
-                                  quote(s->value));
 }
 
 const Appearance& Parser::lookup_material(const Statement& st, const Arg& a) const {

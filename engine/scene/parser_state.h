@@ -159,11 +159,8 @@ class Parser {
 
     void light(Statement& st, const std::vector<Token>& toks);
 
-    /// The keys of area lights, falloff and soft spot edges.
-    static void area_light_key(const Statement& st, const Arg& a, Light& l);
-
-    /// What an area light or a soft edge needs beyond its keys' own ranges.
-    static void check_area_light(const Statement& st, const Light& l);
+    /// One key of a light statement, read into its field (each kind takes some of them).
+    static void light_key(const Statement& st, const Arg& a, Light& l);
 
     /// The material named by `a`, as defined at this statement: the chunked reader has read
     /// every material statement first, so one defined on a later line is refused here.

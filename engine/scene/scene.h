@@ -17,6 +17,7 @@
 #include "scene/texture.h"
 #include "core/transform.h"
 #include "image/display_settings.h"
+#include "lights/lights.h"
 #include "shapes/shape_kind.h"
 
 namespace streamrt {
@@ -79,30 +80,6 @@ static_assert(sizeof(Object) == 128, "Object is meant to stay two cache lines");
 struct ObjectLoc {
     std::uint32_t file = 0;
     std::int32_t line = 0, column = 0;
-};
-
-/// Sphere and Rect are area lights (docs/scene-format.md, "Area lights and soft shadows").
-enum class LightKind : std::uint8_t { Point, Spot, Directional, Sphere, Rect };
-/// How a light's colour falls with the distance d to it: none (the handout's) or 1 / d^2.
-enum class Falloff : std::uint8_t { None, InverseSquare };
-inline constexpr EnumName<Falloff> kFalloffNames[] = {{Falloff::None, "none"}, {Falloff::InverseSquare, "inverse_square"}};
-
-struct Light {
-    LightKind kind = LightKind::Point;
-    glm::dvec3 pos{0.0, 0.0, 0.0};   ///< point, spot, sphere centre, rect corner
-    glm::dvec3 dir{0.0, -1.0, 0.0};  ///< normalised; spot axis or directional travel direction
-    glm::dvec3 color{1.0, 1.0, 1.0};
-    double angle = 30.0;  ///< spot: half-angle of the cone, degrees
-    // Area lights, falloff and soft spot edges (defaults: the handout's lights).
-    double radius = 0.0;                  ///< sphere
-    glm::dvec3 u{0.0, 0.0, 0.0}, v{0.0, 0.0, 0.0};  ///< rect: edges from the corner pos; lights the u x v side
-    int samples = 1;                      ///< area lights: shadow rays per shaded point
-    Falloff falloff = Falloff::None;
-    double soft = 0.0;                    ///< spot: width of the smooth edge inside the cone, degrees
-
-    bool is_area() const { return kind == LightKind::Sphere || kind == LightKind::Rect; }
-    /// Lit by shade_hit's sampled path (render/shading.h): an area light, a falloff or a soft edge.
-    bool shaped() const { return is_area() || falloff != Falloff::None || soft > 0.0; }
 };
 
 /// The handout's canonical camera (eye (0,0,1), screen [-1,1]^2 in z=0) placed by Md.

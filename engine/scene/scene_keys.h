@@ -44,12 +44,6 @@ inline const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExp
 inline const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
 inline const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys, {"name"}});
 inline const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth", "materials"}});
-inline const std::vector<std::string_view> kPointLightKeys = {"pos", "color", "falloff", "name"};
-inline const std::vector<std::string_view> kSpotLightKeys = {"pos", "dir", "angle", "color", "falloff", "soft", "name"};
-inline const std::vector<std::string_view> kDirectionalLightKeys = {"dir", "color", "falloff", "name"};
-// Area lights (docs/scene-format.md, "Area lights and soft shadows").
-inline const std::vector<std::string_view> kSphereLightKeys = {"pos", "radius", "color", "samples", "falloff", "name"};
-inline const std::vector<std::string_view> kRectLightKeys = {"pos", "u", "v", "color", "samples", "falloff", "name"};
 // The `key` statement's keys, by what the name names (animation, scene/animation.h).
 inline const std::vector<std::string_view> kObjectKeyKeys = {"frame", "translate", "rotate", "scale"};
 inline const std::vector<std::string_view> kLightKeyKeys = {"frame", "pos", "color"};

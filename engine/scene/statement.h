@@ -17,6 +17,7 @@
 #include <system_error>
 #include <vector>
 
+#include "core/format_number.h"
 #include "core/error.h"
 #include "core/transform.h"
 #include "scene/scene.h"
@@ -38,12 +39,6 @@ struct Arg {
     std::string_view value;
     int value_col = 0;
 };
-
-inline std::string fmt_num(double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
 
 /// Byte classes for the lexer's inner loops: one table load per byte instead of six tests.
 enum : unsigned char { kSpace = 1, kHash = 2 };

@@ -93,7 +93,7 @@ StreamScene::StreamScene(const Scene& scene, const accel::AccelConfig& accel_con
     features.lens = camera.has_lens();
     for (const LightT<float>& l : lights) {
         shadow_rays_per_hit += std::size_t(l.samples);
-        if (l.kind == LightKind::Sphere || l.kind == LightKind::Rect) features.area_samples += l.samples;
+        if (l.area) features.area_samples += l.samples;
     }
     features.area_lights = features.lighting && features.area_samples > 0;
 }

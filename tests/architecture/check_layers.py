@@ -13,7 +13,7 @@ import sys
 LAYERS = [
     ["simd"],
     ["core", "parallel"],
-    ["image", "shapes"],
+    ["image", "lights", "shapes"],
     ["accel"],
     ["mesh"],
     ["scene"],

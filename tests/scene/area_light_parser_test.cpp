@@ -54,7 +54,24 @@ TEST_CASE("area lights: keys land in the light") {
     CHECK_FALSE(s.lights[3].shaped());
 }
 
+TEST_CASE("area lights: a disk light's keys land in the light") {
+    const Scene s = parse_scene("light disk pos=1,3,0 dir=0,-2,0 radius=0.75 samples=8 color=2,2,2\n", "l.cfg");
+    REQUIRE(s.lights.size() == 1);
+    const Light& d = s.lights[0];
+    CHECK(d.kind == LightKind::Disk);
+    CHECK(d.pos == glm::dvec3(1, 3, 0));
+    CHECK(d.dir == glm::dvec3(0, -1, 0));  // normalised
+    CHECK(d.radius == 0.75);
+    CHECK(d.samples == 8);
+    CHECK(d.is_area());
+    CHECK(d.shaped());
+}
+
 TEST_CASE("area lights: bad values at their line and column") {
+    expect_light_error("light disk pos=0,0,0 dir=0,-1,0\n", 1, 1, "light disk needs 'radius=r'");
+    expect_light_error("light disk pos=0,0,0 radius=1\n", 1, 1, "light disk needs 'dir=x,y,z'");
+    expect_light_error("light disk dir=0,-1,0 radius=1\n", 1, 1, "light disk needs 'pos=x,y,z'");
+    expect_light_error("light disk pos=0,0,0 dir=0,-1,0 radius=1 u=1,0,0\n", 1, 42, "unknown key 'u'");
     expect_light_error("ambient 0.1\nlight sphere pos=0,0,0 radius=-1\n", 2, 31, "'radius' must be > 0");
     expect_light_error("light sphere pos=0,0,0 radius=0\n", 1, 31, "'radius' must be > 0");
     expect_light_error("light sphere pos=0,0,0\n", 1, 1, "needs 'radius=r'");
@@ -68,5 +85,5 @@ TEST_CASE("area lights: bad values at their line and column") {
     expect_light_error("light point pos=0,0,0 falloff=linear\n", 1, 31, "none or inverse_square");
     expect_light_error("light point pos=0,0,0 soft=5\n", 1, 23, "unknown key 'soft'");
     expect_light_error("light sphere pos=0,0,0 radius=1 dir=0,1,0\n", 1, 33, "unknown key 'dir'");
-    expect_light_error("light disc pos=0,0,0\n", 1, 7, "sphere or rect");
+    expect_light_error("light disco pos=0,0,0\n", 1, 7, "(point, spot, directional, sphere, rect or disk), got 'disco'");
 }
