@@ -571,6 +571,26 @@ def ppm_psnr(a_path, b_path):
     return (10 * math.log10(1 / mse) if mse > 0 else float("inf")), close
 
 
+def side_by_side_png(left_ppm, right_ppm, png, gap=4):
+    """The two PPM pictures side by side (a white gap between) as an 8-bit RGB PNG."""
+    import zlib
+    wl, h, a = read_ppm(left_ppm)
+    wr, hr, b = read_ppm(right_ppm)
+    if h != hr:
+        raise ValueError("pictures of different heights")
+    rows = []
+    for y in range(h):
+        rows.append(b"\x00" + a[3 * wl * y:3 * wl * (y + 1)] + b"\xff" * (3 * gap) + b[3 * wr * y:3 * wr * (y + 1)])
+
+    def chunk(tag, data):
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))
+
+    w = wl + gap + wr
+    with open(png, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)) +
+                chunk(b"IDAT", zlib.compress(b"".join(rows), 9)) + chunk(b"IEND", b""))
+
+
 def fmt(v, nd=3):
     return "-" if v is None else "%.*f" % (nd, v)
 
@@ -588,6 +608,9 @@ def main(argv=None):
     ap.add_argument("--embree-reps", type=int, default=5, help="embree_rays --reps (default 5)")
     ap.add_argument("--dry-run", action="store_true", help="check tools, write the .pov files, render nothing")
     ap.add_argument("--out", help="output folder (default BUILD/peer)")
+    ap.add_argument("--picture", metavar="PNG", help="only write the first scene (nopruning) at --size by streamrt "
+                    "(left) and POV-Ray (right) side by side into PNG, and stop (docs/img/peer_bunny.png: "
+                    "--scenes bunny --size 400x225)")
     args = ap.parse_args(argv)
     width, height = (int(x) for x in args.size.split("x"))
     names = [s for s in args.scenes.split(",") if s]
@@ -630,6 +653,15 @@ def main(argv=None):
             cache = prepare_meshes(sc, out_dir, s)
             for m in modes:
                 write_pov(sc, os.path.join(out_dir, "%s_%s.pov" % (s, m)), width, height, MODES[m][0], cache)
+    if args.picture and povray and names:
+        s = names[0]
+        pov_path = os.path.join(out_dir, "%s_%s.pov" % (s, modes[0] if "nopruning" not in modes else "nopruning"))
+        pov_img, srt_img = os.path.join(out_dir, "picture_povray.ppm"), os.path.join(out_dir, "picture_streamrt.ppm")
+        run_povray(povray, pov_path, pov_img, width, height)
+        run_stream(exe, SCENES[s], srt_img, width, height, 0.0)
+        side_by_side_png(srt_img, pov_img, args.picture)
+        print("wrote %s: streamrt (left), POV-Ray (right); PSNR %.1f dB" % (args.picture, ppm_psnr(pov_img, srt_img)[0]))
+        return 0
     if args.dry_run:
         print("dry run: wrote %s; streamrt %s, POV-Ray %s, embree_rays %s; nothing rendered" % (
             ", ".join(os.path.relpath(os.path.join(out_dir, "%s_%s.pov" % (s, m)), pc.ROOT) for s in names
