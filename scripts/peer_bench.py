@@ -44,7 +44,6 @@ import shutil
 import struct
 import subprocess
 import sys
-import tempfile
 import time
 
 sys.dont_write_bytecode = True  # no __pycache__ in scripts/
@@ -653,7 +652,10 @@ def main(argv=None):
             cache = prepare_meshes(sc, out_dir, s)
             for m in modes:
                 write_pov(sc, os.path.join(out_dir, "%s_%s.pov" % (s, m)), width, height, MODES[m][0], cache)
-    if args.picture and povray and names:
+    if args.picture and not (povray and names):
+        print("no picture: it needs POV-Ray and a scene whose mesh is there")
+        return 0
+    if args.picture:
         s = names[0]
         pov_path = os.path.join(out_dir, "%s_%s.pov" % (s, modes[0] if "nopruning" not in modes else "nopruning"))
         pov_img, srt_img = os.path.join(out_dir, "picture_povray.ppm"), os.path.join(out_dir, "picture_streamrt.ppm")
