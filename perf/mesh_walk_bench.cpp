@@ -7,14 +7,13 @@
 // every size and shape). One view (1280x720, the camera of mesh_bench), primary rays in 4x4
 // pixel tiles; at each primary hit, in the same order, a shadow ray to a point light (any
 // hit), a mirror-reflected ray, a glass-refracted ray (index 1.5) and a diffuse ray (uniform
-// over the hemisphere: incoherent) (closest hit). Each
+// over the hemisphere: incoherent) (closest hit): the ray sets of perf/mesh_rays.h. Each
 // stream runs through the level's flat mesh kernel (KernelTable closest/any[Mesh], one
 // thread) with MeshView::single_ray_lanes = each value of --lanes (0: packet walk only; 64:
 // single-ray walk only; between: the hybrid), median of N runs (default 5), in Mrays/s. Row
 // "scene1": the same streams through the scene hierarchy's single-ray traversal (the mesh one
 // leaf object; its mesh walk is the single-ray walk).
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -23,34 +22,16 @@
 #include <vector>
 
 #include "kernels/kernel_table.h"
+#include "mesh_rays.h"
 #include "mesh/mesh.h"
 #include "scene/scene_bvh.h"
 #include "stream/stream_accel.h"
 #include "simd/lanes.h"
 
 using namespace streamrt;
+using namespace streamrt::perf;
 
 namespace {
-
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
-/// A ray stream padded to 16 lanes with inactive rays (t_max = 0).
-struct Stream {
-    simd::AlignedVec<float> ox, oy, oz, dx, dy, dz, t_max;
-    std::size_t count = 0;
-    void add(const Vec3f& o, const Vec3f& d, float t) {
-        ox.push_back(o.x), oy.push_back(o.y), oz.push_back(o.z);
-        dx.push_back(d.x), dy.push_back(d.y), dz.push_back(d.z);
-        t_max.push_back(t);
-        ++count;
-    }
-    void pad() {
-        const std::size_t n = count;
-        while (ox.size() % 16) add({0, 0, 0}, {0, 0, 1}, 0.f);
-        count = n;
-    }
-    RayView view(float* t) const { return {count, ox.data(), oy.data(), oz.data(), dx.data(), dy.data(), dz.data(), t}; }
-};
 
 MeshData irregular_mesh() {
     MeshData m = uv_sphere(317, 317);
@@ -63,60 +44,6 @@ MeshData irregular_mesh() {
         for (int a = 0; a < 3; ++a) p[a] = p[a] * lump + jitter(rng) * step;
     }
     return m;
-}
-
-struct Streams {
-    Stream primary, shadow, mirror, glass, diffuse;
-};
-
-/// The four ray streams of the view: primary rays traced once (packet walk) for the hits.
-Streams make_streams(const Mesh& mesh, const KernelTable& kt, const ObjectXf& xf) {
-    Streams s;
-    const int w = 1280, h = 720;
-    const Vec3f eye{0.4f, 0.8f, 3.2f};
-    const Vec3f fwd = normalize(Vec3f{0, 0, 0} - eye);
-    const Vec3f right = normalize(cross(fwd, Vec3f{0, 1, 0})), up = cross(right, fwd);
-    const float scale = std::tan(22.5f * 3.14159265f / 180.f);
-    for (int ty = 0; ty < h; ty += 4)
-        for (int tx = 0; tx < w; tx += 4)
-            for (int y = ty; y < ty + 4; ++y)
-                for (int x = tx; x < tx + 4; ++x) {
-                    const float px = (2.f * (x + 0.5f) / w - 1.f) * scale * w / h, py = (1.f - 2.f * (y + 0.5f) / h) * scale;
-                    s.primary.add(eye, normalize(fwd + px * right + py * up), 1e30f);
-                }
-    s.primary.pad();
-    simd::AlignedVec<float> t(s.primary.t_max), bu(t.size()), bv(t.size());
-    simd::AlignedVec<std::int32_t> id(t.size(), -1), prim(t.size(), -1);
-    RayView v = s.primary.view(t.data());
-    v.prim = prim.data(), v.bu = bu.data(), v.bv = bv.data();
-    kt.closest[int(ShapeKind::Mesh)](v, id.data(), &xf, 1);
-    const Vec3f light{3, 5, 4};
-    std::mt19937 rng(3);
-    std::normal_distribution<float> gauss(0.f, 1.f);
-    for (std::size_t i = 0; i < s.primary.count; ++i) {
-        if (id[i] != 0) continue;
-        const Vec3f o{s.primary.ox[i], s.primary.oy[i], s.primary.oz[i]}, d{s.primary.dx[i], s.primary.dy[i],
-                                                                                s.primary.dz[i]};
-        const Vec3f p = o + t[i] * d;
-        const float* q = &mesh.tri[9 * std::size_t(prim[i])];
-        Vec3f n = normalize(cross(Vec3f{q[3] - q[0], q[4] - q[1], q[5] - q[2]}, Vec3f{q[6] - q[0], q[7] - q[1], q[8] - q[2]}));
-        if (dot(n, d) > 0) n = -n;
-        const Vec3f out = p + 1e-4f * n, in = p - 1e-4f * n;
-        const Vec3f to_light = light - out;
-        const float dist = length(to_light);
-        s.shadow.add(out, (1.f / dist) * to_light, dist);
-        s.mirror.add(out, d - 2.f * dot(d, n) * n, 1e30f);
-        const float eta = 1.f / 1.5f, c = -dot(d, n), k = 1.f - eta * eta * (1.f - c * c);
-        s.glass.add(in, normalize(eta * d + (eta * c - std::sqrt(k)) * n), 1e30f);
-        Vec3f r{gauss(rng), gauss(rng), gauss(rng)};  // uniform over the outer hemisphere
-        if (dot(r, n) < 0) r = -r;
-        s.diffuse.add(out, normalize(r), 1e30f);
-    }
-    s.shadow.pad();
-    s.mirror.pad();
-    s.glass.pad();
-    s.diffuse.pad();
-    return s;
 }
 
 /// The stream through the scene hierarchy's single-ray walk (AccelConfig Traversal::Single),
@@ -134,26 +61,6 @@ double scene_single_mrays(const Stream& st, bool any, const KernelTable& kt, con
         } else {
             v.prim = prim.data(), v.bu = bu.data(), v.bv = bv.data();
             sa.closest(kt, v, id.data(), false);
-        }
-        secs.push_back(now() - t0);
-    }
-    std::sort(secs.begin(), secs.end());
-    return double(st.count) / secs[secs.size() / 2] * 1e-6;
-}
-
-double mrays(const Stream& st, bool any, const KernelTable& kt, const ObjectXf& xf, int reps) {
-    std::vector<double> secs;
-    simd::AlignedVec<float> t(st.t_max.size()), bu(t.size()), bv(t.size());
-    simd::AlignedVec<std::int32_t> id(t.size()), prim(t.size());
-    for (int r = 0; r < reps; ++r) {
-        std::copy(st.t_max.begin(), st.t_max.end(), t.begin());
-        RayView v = st.view(t.data());
-        const double t0 = now();
-        if (any) {
-            kt.any[int(ShapeKind::Mesh)](v, &xf, 1);
-        } else {
-            v.prim = prim.data(), v.bu = bu.data(), v.bv = bv.data();
-            kt.closest[int(ShapeKind::Mesh)](v, id.data(), &xf, 1);
         }
         secs.push_back(now() - t0);
     }

@@ -1,0 +1,225 @@
+// Embree 3 against streamrt's mesh kernels on the same rays (docs/performance.md, "Against
+// POV-Ray and Embree"). Not a test; built only when CMake finds Embree 3 (perf/CMakeLists.txt).
+//
+//   embree_rays [--reps N] [--isa LEVEL] MESH.{obj,ply} ...
+//
+// Each mesh is read by streamrt's own reader (load_mesh_file) and built twice: streamrt's mesh
+// (its 8-wide hierarchy, as a scene uses it) and an Embree scene of the same triangles, in the
+// same order (RTC_GEOMETRY_TYPE_TRIANGLE, RTC_BUILD_QUALITY_HIGH for the scene and the
+// geometry, a device with threads=1). The ray sets are perf/mesh_rays.h's, over a view fitted
+// to the mesh's bounds (1280x720 primary rays in 4x4 tiles; from their hits, shadow rays to a
+// point light, mirror-reflected rays and, as the incoherent extreme, diffuse rays). Every set
+// runs on this one thread, median of N runs (default 5), in Mrays/s:
+//   Embree16   rtcIntersect16 / rtcOccluded16 on packets of 16 consecutive rays (a 4x4 pixel
+//              tile for primary rays); the packets are filled before the clock starts
+//   Embree1    rtcIntersect1 / rtcOccluded1 ray by ray
+//   streamrt   the level's flat mesh kernel (KernelTable closest/any[Mesh]) over the stream
+// ratio = streamrt / Embree16. The numbers of rays hit (or blocked) by each are printed as a
+// check that all three traced the same rays.
+#include <embree3/rtcore.h>
+#include <xmmintrin.h>
+#include <pmmintrin.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "kernels/kernel_table.h"
+#include "mesh/mesh.h"
+#include "mesh/ply_reader.h"
+#include "mesh_rays.h"
+
+using namespace streamrt;
+using namespace streamrt::perf;
+
+namespace {
+
+void embree_error(void*, RTCError code, const char* msg) {
+    std::fprintf(stderr, "embree error %d: %s\n", int(code), msg ? msg : "");
+    std::exit(1);
+}
+
+/// The mesh's triangles as an Embree scene (vertices shared as in the mesh, triangles in the
+/// mesh's leaf order, so Embree's primID is streamrt's triangle number).
+RTCScene embree_scene(RTCDevice dev, const Mesh& mesh) {
+    const std::size_t nt = mesh.triangle_count();
+    std::uint32_t nv = 0;
+    for (std::uint32_t i : mesh.index) nv = std::max(nv, i + 1);
+    RTCScene scene = rtcNewScene(dev);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+    auto* vb = static_cast<float*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+    auto* ib = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt));
+    std::fill(vb, vb + 3 * std::size_t(nv), 0.f);
+    for (std::size_t t = 0; t < nt; ++t)
+        for (int j = 0; j < 3; ++j) {
+            const std::uint32_t v = mesh.index[3 * t + j];
+            ib[3 * t + j] = v;
+            std::memcpy(vb + 3 * std::size_t(v), &mesh.tri[9 * t + 3 * j], 3 * sizeof(float));
+        }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(scene);
+    return scene;
+}
+
+struct Result {
+    double mrays = 0;
+    std::size_t hits = 0;
+};
+
+/// rtcIntersect16 / rtcOccluded16 over the stream in packets of 16 consecutive rays.
+Result embree16(RTCScene scene, const Stream& st, bool any, int reps) {
+    const std::size_t packets = st.ox.size() / 16;
+    std::vector<RTCRayHit16> fresh(packets), work(packets);
+    simd::AlignedVec<int> valid(st.ox.size());  // 64-byte aligned, as rtcIntersect16 needs
+    for (std::size_t p = 0; p < packets; ++p) {
+        RTCRayHit16& rh = fresh[p];
+        std::memset(&rh, 0, sizeof rh);
+        for (int k = 0; k < 16; ++k) {
+            const std::size_t i = 16 * p + k;
+            rh.ray.org_x[k] = st.ox[i], rh.ray.org_y[k] = st.oy[i], rh.ray.org_z[k] = st.oz[i];
+            rh.ray.dir_x[k] = st.dx[i], rh.ray.dir_y[k] = st.dy[i], rh.ray.dir_z[k] = st.dz[i];
+            rh.ray.tnear[k] = 0.f;
+            rh.ray.tfar[k] = st.t_max[i];
+            rh.ray.mask[k] = ~0u;
+            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+            valid[i] = i < st.count && st.t_max[i] > 0 ? -1 : 0;
+        }
+    }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    const double sec = median_seconds(reps, [&] {
+        std::copy(fresh.begin(), fresh.end(), work.begin());
+        const double t0 = now();
+        if (any) {
+            for (std::size_t p = 0; p < packets; ++p) rtcOccluded16(&valid[16 * p], scene, &ctx, &work[p].ray);
+        } else {
+            for (std::size_t p = 0; p < packets; ++p) rtcIntersect16(&valid[16 * p], scene, &ctx, &work[p]);
+        }
+        return now() - t0;
+    });
+    Result r{double(st.count) / sec * 1e-6, 0};
+    for (std::size_t i = 0; i < st.count; ++i) {
+        const RTCRayHit16& rh = work[i / 16];
+        const int k = int(i % 16);
+        if (valid[i]) r.hits += any ? rh.ray.tfar[k] < 0 : rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+    }
+    return r;
+}
+
+/// rtcIntersect1 / rtcOccluded1 ray by ray.
+Result embree1(RTCScene scene, const Stream& st, bool any, int reps) {
+    std::vector<RTCRayHit> fresh(st.count), work(st.count);
+    for (std::size_t i = 0; i < st.count; ++i) {
+        RTCRayHit& rh = fresh[i];
+        std::memset(&rh, 0, sizeof rh);
+        rh.ray.org_x = st.ox[i], rh.ray.org_y = st.oy[i], rh.ray.org_z = st.oz[i];
+        rh.ray.dir_x = st.dx[i], rh.ray.dir_y = st.dy[i], rh.ray.dir_z = st.dz[i];
+        rh.ray.tnear = 0.f;
+        rh.ray.tfar = st.t_max[i];
+        rh.ray.mask = ~0u;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    const double sec = median_seconds(reps, [&] {
+        std::copy(fresh.begin(), fresh.end(), work.begin());
+        const double t0 = now();
+        if (any) {
+            for (RTCRayHit& rh : work) rtcOccluded1(scene, &ctx, &rh.ray);
+        } else {
+            for (RTCRayHit& rh : work) rtcIntersect1(scene, &ctx, &rh);
+        }
+        return now() - t0;
+    });
+    Result r{double(st.count) / sec * 1e-6, 0};
+    for (const RTCRayHit& rh : work) r.hits += any ? rh.ray.tfar < 0 : rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Isa isa = best_isa();
+    int reps = 5;
+    std::vector<std::string> files;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--reps" && i + 1 < argc) {
+            reps = std::max(1, std::atoi(argv[++i]));
+        } else if (a == "--isa" && i + 1 < argc) {
+            if (!parse_isa(argv[++i], isa)) return std::fprintf(stderr, "unknown level %s\n", argv[i]), 2;
+        } else if (a == "-h" || a == "--help" || a.rfind("--", 0) == 0) {
+            std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa sse2|sse4.2|avx2|avx512] MESH.{obj,ply} ...\n");
+            return a == "-h" || a == "--help" ? 0 : 2;
+        } else {
+            files.push_back(a);
+        }
+    }
+    if (files.empty()) return std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa LEVEL] MESH.{obj,ply} ...\n"), 2;
+    // Embree's advice for its kernels (denormals flushed); the same mode for streamrt's below.
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    RTCDevice dev = rtcNewDevice("threads=1");
+    if (!dev) return std::fprintf(stderr, "rtcNewDevice failed\n"), 1;
+    rtcSetDeviceErrorFunction(dev, embree_error, nullptr);
+    const KernelTable& kt = kernel_table(isa);
+    std::printf("Embree %s (native 16-wide packets: %s), streamrt kernels %s (%d-lane packets); one thread, "
+                "median of %d, Mrays/s\n",
+                RTC_VERSION_STRING, rtcGetDeviceProperty(dev, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? "yes" : "no",
+                kt.name, kt.float_lanes, reps);
+    for (const std::string& file : files) {
+        std::shared_ptr<const Mesh> mesh;
+        const double t_read = now();
+        try {
+            mesh = load_mesh_file(file, false);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "%s\n", e.what());
+            return 1;
+        }
+        const double t_built = now();
+        RTCScene scene = embree_scene(dev, *mesh);
+        const double t_embree = now() - t_built;
+        ObjectXf xf{};
+        xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
+        xf.mesh = &mesh->view();
+        const View view = view_of_bounds(mesh->lo, mesh->hi);
+        const Streams s = make_streams(*mesh, kt, xf, view);
+        std::printf("\n%s: %zu triangles; streamrt read + build %.2f s, Embree build (high quality, 1 thread) "
+                    "%.2f s; %dx%d view\n",
+                    file.c_str(), mesh->triangle_count(), t_built - t_read, t_embree, view.width, view.height);
+        std::printf("%-8s %9s %10s %10s %10s %7s   %s\n", "rays", "count", "Embree16", "Embree1", "streamrt", "ratio",
+                    "hits: Embree16 / Embree1 / streamrt");
+        struct Kind {
+            const char* name;
+            const Stream* st;
+            bool any;
+        };
+        for (const Kind& k : {Kind{"primary", &s.primary, false}, Kind{"shadow", &s.shadow, true},
+                              Kind{"mirror", &s.mirror, false}, Kind{"diffuse", &s.diffuse, false}}) {
+            const Result e16 = embree16(scene, *k.st, k.any, reps);
+            const Result e1 = embree1(scene, *k.st, k.any, reps);
+            std::size_t hits = 0;
+            const double ours = mrays(*k.st, k.any, kt, xf, reps, &hits);
+            std::printf("%-8s %9zu %10.2f %10.2f %10.2f %6.2fx   %zu / %zu / %zu\n", k.name, k.st->count, e16.mrays,
+                        e1.mrays, ours, ours / e16.mrays, e16.hits, e1.hits, hits);
+            std::fflush(stdout);
+        }
+        rtcReleaseScene(scene);
+    }
+    rtcReleaseDevice(dev);
+    return 0;
+}
