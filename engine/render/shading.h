@@ -324,6 +324,13 @@ inline V max_abs(const Vec3T<V>& a) {
 }
 }  // namespace detail
 
+/// Whether a ray of direction d meets the surface of outward normal n_out from outside: the
+/// side shade_hit lights and sends shadow rays from is n_out's then, -n_out's otherwise.
+template <class V>
+inline MaskOf<V> meets_outside(const Vec3T<V>& n_out, const Vec3T<V>& d) {
+    return dot(n_out, d) < V(0);
+}
+
 /// Moves a hit point p off its surface along n (unit, the side the new ray leaves on) by an
 /// amount proportional to the magnitude of the numbers it was computed from: the point
 /// itself and the origin `from` of the ray that found it (p = from + t d carries an error of a
@@ -513,6 +520,9 @@ template <bool kShadows, class V, class T, class M, class Sink>
 ///                                                  lights only: sampling.h light_key)
 /// A sink with kTestsShadowsNow (the recursive engine) answers sink.occluded(origin, to,
 /// t_max) at once instead, and the unblocked light joins the local colour.
+/// shadow_shift, when given (smooth meshes: mesh/terminator.h terminator_shift, computed for
+/// the side meets_outside gives), moves the shadow rays' origin before its usual offset;
+/// reflected and refracted rays still start from p.
 /// The features are compile-time flags so a scene's pipeline carries no code for what it
 /// lacks: kLit (degree >= 1), kShadows (degree 5), kReflect (degree >= 3 and some refl),
 /// kRefract (degree >= 4 and some trans). p is the world hit point, n_out the unit outward
@@ -520,7 +530,8 @@ template <bool kShadows, class V, class T, class M, class Sink>
 template <bool kLit, bool kShadows, bool kReflect, bool kRefract, class V, class T, class M, class Sink>
 inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const LightT<T>* lights,
                       std::size_t n_lights, const ArrivingRay<V>& ray, const Vec3T<V>& p, const Vec3T<V>& n_out,
-                      const ColorT<V>& color, const M& active, Sink& sink) {
+                      const ColorT<V>& color, const M& active, Sink& sink,
+                      const Vec3T<V>* shadow_shift = nullptr) {
     using namespace simd;
     const Vec3T<V>& d = ray.dir;
     const ColorT<V> base =
@@ -532,10 +543,11 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
     } else {
         // Light on the side the ray arrives from (a camera inside a room or a sphere sees the
         // inner faces lit).
-        const Vec3T<V> n = select3(dot(n_out, d) < V(0), n_out, -n_out);
+        const Vec3T<V> n = select3(meets_outside(n_out, d), n_out, -n_out);
         ColorT<V> local = mul(ray.weight, ambient_light(rules.degree, rules.ambient, m, base));
         Vec3T<V> shadow_origin{};
-        if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, ray.origin);
+        if constexpr (kShadows)
+            shadow_origin = offset_ray_origin(shadow_shift ? p + *shadow_shift : p, n, ray.origin);
         for (std::size_t li = 0; li < n_lights; ++li) {
             const LightT<T>& l = lights[li];
             if (l.shaped) {  // uniform per light: the handout's lights never enter

@@ -9,6 +9,7 @@
 
 #include "kernels/kernel_table.h"
 #include "mesh/mesh_trace.h"
+#include "mesh/terminator.h"
 #include "parallel/parallelism.h"
 #include "render/render_stats.h"
 #include "render/sampling.h"
@@ -428,8 +429,14 @@ struct PipelineStages {
                                                  mesh_hits.v[i], scale, footprint)
                             : texture_color(m, kind, pc, ob.xf.param, scale, footprint);
             }
+            // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
+            Vec3f shift{};
+            const bool smooth = kShadows && kind == ShapeKind::Mesh && ob.xf.param != 0.f;
+            if (smooth)
+                shift = terminator_shift(ob.xf.m, smooth_corners<float>(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i])),
+                                         mesh_hits.u[i], mesh_hits.v[i], meets_outside(n_out, d));
             shade_hit<kLighting, kShadows, kReflect, kRefract>(rules, m, sc.lights.data(), sc.lights.size(), arriving,
-                                                               p, n_out, color, true, sink);
+                                                               p, n_out, color, true, sink, smooth ? &shift : nullptr);
         }
     }
 
