@@ -52,10 +52,9 @@ const Vec3d kConvex[3] = {{-0.6, 0, 0.8}, {0.6, 0, 0.8}, {0, 0.6, 0.8}};
 
 }  // namespace
 
-// Proven against: the projection applied to points above the plane too (min dropped: the
-// concave case moves), the side ignored (the inside case moves), the barycentric weights of
-// p1 and p2 swapped (the hand value changes in x and y), the world normal normalised once
-// only (the scaled case is off by the scale).
+// Proven against: the projection applied to points above the planes too (max(0, .) dropped:
+// the inside, concave and mixed cases fail), the side ignored (the inside case), the weights
+// of p1 and p2 swapped (the unequal-weights and the shared-edge cases), no shift at all.
 TEST_CASE("terminator: the shift equals hand-computed values; zero for flat normals and above the planes") {
     // At barycentrics (b0, b1, b2) = (0.5, 0.25, 0.25), p = (0.25, 0.25, 0). Heights over the
     // corners' tangent planes: (p - p0).n0 = -0.15, (p - p1).n1 = -0.45, (p - p2).n2 = -0.45,
@@ -110,6 +109,8 @@ TEST_CASE("terminator: the shift equals hand-computed values; zero for flat norm
     CHECK(a.z > 0.0);
 }
 
+// Proven against: the world normal divided by |m| instead of |m|^2 (all four points off), no
+// shift at all.
 TEST_CASE("terminator: under a non-uniform scale the shift is the world-space projection") {
     // Md: scale (3, 1, 0.5), rotate about y, translate. The shift from canonical corners and
     // Mi's rows equals the shift computed directly in world space, with the world corners,
@@ -133,6 +134,11 @@ TEST_CASE("terminator: under a non-uniform scale the shift is the world-space pr
     }
 }
 
+// Proven against: no shift at all (978, 984 and 978 pixels off, the engines 59.3 dB apart);
+// no shift passed by one caller of shade_hit: the recursive engine (984 off, engines 48.7 dB
+// apart), the SIMD shade kernel (978 off, 49.1 dB from both the recursive engine and the
+// scalar shade path), the scalar shade path (978 off, 49.1 dB from the SIMD kernel); the light
+// moved in front of the sphere (no pixel at risk).
 TEST_CASE("terminator: a smooth low-poly sphere lit from the side has no dark blotches, both engines agree") {
     const Scene scene = load_scene(std::string(STREAMRT_SOURCE_DIR) + "/scenes/meshes/terminator.cfg");
     REQUIRE(scene.objects.size() == 1);
