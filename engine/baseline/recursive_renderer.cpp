@@ -179,14 +179,13 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     const ColorT<double> object_color = material.texture ? texture_color_at(material, ray, hit)
                                                          : ColorT<double>{object.color.x, object.color.y, object.color.z};
     RecursiveSink sink{*this, depth, counts, key};
+    // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
+    const PreparedObject& ob = objects_[std::size_t(hit.object)];
+    const bool smooth = ob.kind == ShapeKind::Mesh && ob.param != 0.0;
+    const auto shadow_point = [&](const Vec3d& p) { return smooth ? p + terminator_shift_at(ray, hit) : p; };
     const auto shade = [&]<bool kLit, bool kShadows>() {
-        // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
-        const PreparedObject& ob = objects_[std::size_t(hit.object)];
-        Vec3d shift;
-        const bool smooth = kShadows && ob.kind == ShapeKind::Mesh && ob.param != 0.0;
-        if (smooth) shift = terminator_shift_at(ray, hit);
         shade_hit<kLit, kShadows, true, true>(rules, material, lights_.data(), lights_.size(), arriving, hit.point,
-                                              hit.normal, object_color, true, sink, smooth ? &shift : nullptr);
+                                              hit.normal, object_color, true, sink, shadow_point);
     };
     if (s.degree == 0) shade.template operator()<false, false>();
     else if (s.degree < 5) shade.template operator()<true, false>();

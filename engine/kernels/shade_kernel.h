@@ -243,7 +243,7 @@ void shade_run(const ShadeJob& job) {
     // Textures: the object's canonical units per world unit, once per run (gathered: per lane).
     const float run_scale = m.texture && !kGathered ? canonical_per_world<float>(ob.m) : -1.f;
     const B lanes = B::load_aligned(lane_index);
-    const bool smooth_mesh = kShadows && !kGathered && kind == ShapeKind::Mesh && ob.param != 0.f;
+    const bool smooth_mesh = !kGathered && kind == ShapeKind::Mesh && ob.param != 0.f;
 
     for (std::size_t i = job.begin; i < job.end; i += W) {
         // The last packet may be partial: its extra lanes read padding and are never stored
@@ -287,11 +287,13 @@ void shade_run(const ShadeJob& job) {
         SimdSink<B> sink{job, i};
         // A smooth mesh's shadow rays start from its curved patch, not the flat triangle (one
         // branch per run).
-        Vec3T<B> shift{};
-        if constexpr (kShadows && !kGathered)
-            if (smooth_mesh) shift = terminator_shifts<B>(job, i, rows, meets_outside(n_out, d));
+        const auto shadow_point = [&](const Vec3T<B>& at) {
+            if constexpr (!kGathered)
+                if (smooth_mesh) return at + terminator_shifts<B>(job, i, rows, meets_outside(n_out, d));
+            return at;
+        };
         shade_hit<kLit, kShadows, kReflect, kRefract>(job.rules, m, job.lights, job.n_lights, arriving, p, n_out, color,
-                                                      active, sink, smooth_mesh ? &shift : nullptr);
+                                                      active, sink, shadow_point);
     }
 }
 

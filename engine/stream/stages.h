@@ -430,13 +430,14 @@ struct PipelineStages {
                             : texture_color(m, kind, pc, ob.xf.param, scale, footprint);
             }
             // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
-            Vec3f shift{};
-            const bool smooth = kShadows && kind == ShapeKind::Mesh && ob.xf.param != 0.f;
-            if (smooth)
-                shift = terminator_shift(ob.xf.m, smooth_corners<float>(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i])),
-                                         mesh_hits.u[i], mesh_hits.v[i], meets_outside(n_out, d));
+            const bool smooth = kind == ShapeKind::Mesh && ob.xf.param != 0.f;
+            const auto shadow_point = [&](const Vec3f& at) {
+                if (!smooth) return at;
+                return at + terminator_shift(ob.xf.m, smooth_corners<float>(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i])),
+                                             mesh_hits.u[i], mesh_hits.v[i], meets_outside(n_out, d));
+            };
             shade_hit<kLighting, kShadows, kReflect, kRefract>(rules, m, sc.lights.data(), sc.lights.size(), arriving,
-                                                               p, n_out, color, true, sink, smooth ? &shift : nullptr);
+                                                               p, n_out, color, true, sink, shadow_point);
         }
     }
 
