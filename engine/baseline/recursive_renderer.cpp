@@ -2,6 +2,7 @@
 
 #include <limits>
 
+#include "mesh/terminator.h"
 #include "render/sampling.h"
 #include "render/texture.h"
 #include "shapes/shapes.h"
@@ -157,6 +158,13 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
                : texture_color(material, ob.kind, hit.canonical, ob.param, scale, footprint);
 }
 
+// Out of line, like texture_color_at: the corners stay out of trace's frame.
+[[gnu::noinline]] Vec3d RecursiveRenderer::terminator_shift_at(const RayD& ray, const HitD& hit) const {
+    const PreparedObject& ob = objects_[std::size_t(hit.object)];
+    return terminator_shift(RowsOf{ob.mi}, smooth_corners<double>(ob.mesh->view(), hit.tri), hit.bu, hit.bv,
+                            meets_outside(hit.normal, ray.dir));
+}
+
 ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& counts, std::uint32_t key) const {
     const RenderSettings& s = scene_.settings;
     HitD hit;
@@ -172,9 +180,13 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     const ColorT<double> object_color = material.texture ? texture_color_at(material, ray, hit)
                                                          : ColorT<double>{object.color.x, object.color.y, object.color.z};
     RecursiveSink sink{*this, depth, counts, key};
+    // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
+    const PreparedObject& ob = objects_[std::size_t(hit.object)];
+    const bool smooth = ob.kind == ShapeKind::Mesh && ob.param != 0.0;
+    const auto shadow_point = [&](const Vec3d& p) { return smooth ? p + terminator_shift_at(ray, hit) : p; };
     const auto shade = [&]<bool kLit, bool kShadows>() {
-        shade_hit<kLit, kShadows, true, true>(rules, material, lights_.data(), lights_.size(),
-                                              arriving, hit.point, hit.normal, object_color, true, sink);
+        shade_hit<kLit, kShadows, true, true>(rules, material, lights_.data(), lights_.size(), arriving, hit.point,
+                                              hit.normal, object_color, true, sink, shadow_point);
     };
     if (s.degree == 0) shade.template operator()<false, false>();
     else if (s.degree < 5) shade.template operator()<true, false>();

@@ -75,6 +75,8 @@ class RecursiveRenderer {
     };
     /// The texture colour at a hit of a textured material (out of trace's frame).
     ColorT<double> texture_color_at(const MaterialT<double>& material, const RayD& ray, const HitD& hit) const;
+    /// A smooth mesh's hit: the shift of its shadow rays' origin (mesh/terminator.h).
+    Vec3d terminator_shift_at(const RayD& ray, const HitD& hit) const;
     /// What a closer hit leaves behind: the canonical ray, and for a mesh the triangle and
     /// its barycentric coordinates.
     struct Candidate {

@@ -48,13 +48,18 @@ inline Vec3T<V> apply_vector(const Rows& m, const Vec3T<V>& v) {
             mul_add(V(m[4]), v.x, mul_add(V(m[5]), v.y, V(m[6]) * v.z)),
             mul_add(V(m[8]), v.x, mul_add(V(m[9]), v.y, V(m[10]) * v.z))};
 }
-/// Mn n, normalised, with Mn = (Mi's linear part) transposed, read from Mi's rows.
+/// Mn n, not normalised, with Mn = (Mi's linear part) transposed, read from Mi's rows.
+template <class Rows, class V>
+inline Vec3T<V> normal_direction(const Rows& mi, const Vec3T<V>& n) {
+    using simd::mul_add;
+    return {mul_add(V(mi[0]), n.x, mul_add(V(mi[4]), n.y, V(mi[8]) * n.z)),
+            mul_add(V(mi[1]), n.x, mul_add(V(mi[5]), n.y, V(mi[9]) * n.z)),
+            mul_add(V(mi[2]), n.x, mul_add(V(mi[6]), n.y, V(mi[10]) * n.z))};
+}
+/// Mn n, normalised.
 template <class Rows, class V>
 inline Vec3T<V> apply_normal(const Rows& mi, const Vec3T<V>& n) {
-    using simd::mul_add;
-    return normalize(Vec3T<V>{mul_add(V(mi[0]), n.x, mul_add(V(mi[4]), n.y, V(mi[8]) * n.z)),
-                              mul_add(V(mi[1]), n.x, mul_add(V(mi[5]), n.y, V(mi[9]) * n.z)),
-                              mul_add(V(mi[2]), n.x, mul_add(V(mi[6]), n.y, V(mi[10]) * n.z))});
+    return normalize(normal_direction(mi, n));
 }
 
 STREAMRT_ISA_END

@@ -13,6 +13,7 @@
 
 #include "kernels/compress.h"
 #include "kernels/shade_job.h"
+#include "mesh/terminator.h"
 #include "render/shading.h"
 #include "render/texture.h"
 #include "shapes/shapes.h"
@@ -72,6 +73,45 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
         }
     }
     return {B::load_aligned(nx), B::load_aligned(ny), B::load_aligned(nz)};
+}
+
+/// The shift of each lane's shadow origin on a smooth mesh (mesh/terminator.h): the hit
+/// triangles' corners, vertex normals and barycentrics gathered lane by lane (the floats
+/// smooth_corners reads), the formula in SIMD. Lanes past the run get a flat triangle at
+/// (0, 0): no shift.
+template <class B, class Rows, class M>
+inline Vec3T<B> terminator_shifts(const ShadeJob& job, std::size_t i, const Rows& rows, const M& outside) {
+    constexpr std::size_t W = B::size;
+    const MeshView& m = *job.object->xf.mesh;
+    alignas(64) float corner[2][3][3][W], us[W], vs[W];  // [position / normal][corner][axis][lane]
+    for (std::size_t l = 0; l < W; ++l) {
+        if (i + l >= job.end) {
+            for (int j = 0; j < 3; ++j)
+                for (int a = 0; a < 3; ++a) {
+                    corner[0][j][a][l] = j == a + 1 ? 1.f : 0.f;
+                    corner[1][j][a][l] = a == 2 ? 1.f : 0.f;
+                }
+            us[l] = vs[l] = 0.f;
+            continue;
+        }
+        const std::size_t k = std::size_t(job.prim[i + l]);
+        for (int j = 0; j < 3; ++j) {
+            const float* p = m.tri + 9 * k + 3 * std::size_t(j);
+            const float* n = m.vertex_normals + 3 * std::size_t(m.index[3 * k + std::size_t(j)]);
+            for (int a = 0; a < 3; ++a) {
+                corner[0][j][a][l] = p[a];
+                corner[1][j][a][l] = n[a];
+            }
+        }
+        us[l] = job.bu[i + l];
+        vs[l] = job.bv[i + l];
+    }
+    SmoothCorners<B> c;
+    for (int j = 0; j < 3; ++j) {
+        c.p[j] = {B::load_aligned(corner[0][j][0]), B::load_aligned(corner[0][j][1]), B::load_aligned(corner[0][j][2])};
+        c.n[j] = {B::load_aligned(corner[1][j][0]), B::load_aligned(corner[1][j][1]), B::load_aligned(corner[1][j][2])};
+    }
+    return terminator_shift(rows, c, B::load_aligned(us), B::load_aligned(vs), outside);
 }
 
 /// The texture colour of each lane's hit (render/texture.h): the UV mapping, the mip level,
@@ -203,6 +243,7 @@ void shade_run(const ShadeJob& job) {
     // Textures: the object's canonical units per world unit, once per run (gathered: per lane).
     const float run_scale = m.texture && !kGathered ? canonical_per_world<float>(ob.m) : -1.f;
     const B lanes = B::load_aligned(lane_index);
+    const bool smooth_mesh = !kGathered && kind == ShapeKind::Mesh && ob.param != 0.f;
 
     for (std::size_t i = job.begin; i < job.end; i += W) {
         // The last packet may be partial: its extra lanes read padding and are never stored
@@ -244,8 +285,15 @@ void shade_run(const ShadeJob& job) {
                                    run_scale, footprint);
         }
         SimdSink<B> sink{job, i};
+        // A smooth mesh's shadow rays start from its curved patch, not the flat triangle (one
+        // branch per run).
+        const auto shadow_point = [&](const Vec3T<B>& at) {
+            if constexpr (!kGathered)
+                if (smooth_mesh) return at + terminator_shifts<B>(job, i, rows, meets_outside(n_out, d));
+            return at;
+        };
         shade_hit<kLit, kShadows, kReflect, kRefract>(job.rules, m, job.lights, job.n_lights, arriving, p, n_out, color,
-                                                      active, sink);
+                                                      active, sink, shadow_point);
     }
 }
 

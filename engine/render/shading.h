@@ -231,6 +231,13 @@ inline V max_abs(const Vec3T<V>& a) {
 }
 }  // namespace detail
 
+/// Whether a ray of direction d meets the surface of outward normal n_out from outside: the
+/// side shade_hit lights and sends shadow rays from is n_out's then, -n_out's otherwise.
+template <class V>
+inline MaskOf<V> meets_outside(const Vec3T<V>& n_out, const Vec3T<V>& d) {
+    return dot(n_out, d) < V(0);
+}
+
 /// Moves a hit point p off its surface along n (unit, the side the new ray leaves on) by an
 /// amount proportional to the magnitude of the numbers it was computed from: the point
 /// itself and the origin `from` of the ray that found it (p = from + t d carries an error of a
@@ -248,6 +255,12 @@ inline Vec3T<V> offset_ray_origin(const Vec3T<V>& p, const Vec3T<V>& n, const Ve
     const V step = simd::max(m, V(std::numeric_limits<S>::min())) * V(detail::kOffsetRelative<S>);
     return p + n * step;
 }
+
+/// shade_hit's shadow_point for every surface but a smooth mesh: shadow rays leave from p.
+struct KeepPoint {
+    template <class V>
+    const Vec3T<V>& operator()(const Vec3T<V>& p) const { return p; }
+};
 
 STREAMRT_ISA_END
 
@@ -356,14 +369,20 @@ template <bool kShadows, class V, class T, class M, class Sink>
 ///                                                  lights only: sampling.h light_key)
 /// A sink with kTestsShadowsNow (the recursive engine) answers sink.occluded(origin, to,
 /// t_max) at once instead, and the unblocked light joins the local colour.
+/// shadow_point(p) gives the point the shadow rays leave from, before its usual offset: p
+/// itself (KeepPoint), or on a smooth mesh p lifted off the flat triangle (mesh/terminator.h,
+/// for the side meets_outside gives); reflected and refracted rays still start from p. It is
+/// called once, and only when some lane sends a shadow ray (a smooth mesh's lift gathers its
+/// triangles' corners lane by lane).
 /// The features are compile-time flags so a scene's pipeline carries no code for what it
 /// lacks: kLit (degree >= 1), kShadows (degree 5), kReflect (degree >= 3 and some refl),
 /// kRefract (degree >= 4 and some trans). p is the world hit point, n_out the unit outward
 /// normal (needed when kLit or the material is a checker), color the object's colour.
-template <bool kLit, bool kShadows, bool kReflect, bool kRefract, class V, class T, class M, class Sink>
+template <bool kLit, bool kShadows, bool kReflect, bool kRefract, class V, class T, class M, class Sink,
+          class ShadowPoint = KeepPoint>
 inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const LightT<T>* lights,
                       std::size_t n_lights, const ArrivingRay<V>& ray, const Vec3T<V>& p, const Vec3T<V>& n_out,
-                      const ColorT<V>& color, const M& active, Sink& sink) {
+                      const ColorT<V>& color, const M& active, Sink& sink, const ShadowPoint& shadow_point = {}) {
     using namespace simd;
     const Vec3T<V>& d = ray.dir;
     const ColorT<V> base =
@@ -375,13 +394,20 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
     } else {
         // Light on the side the ray arrives from (a camera inside a room or a sphere sees the
         // inner faces lit).
-        const Vec3T<V> n = select3(dot(n_out, d) < V(0), n_out, -n_out);
+        const Vec3T<V> n = select3(meets_outside(n_out, d), n_out, -n_out);
         ColorT<V> local = mul(ray.weight, ambient_light(rules.degree, rules.ambient, m, base));
+        // The shadow rays' origin, made at the first light that sends one.
         Vec3T<V> shadow_origin{};
-        if constexpr (kShadows) shadow_origin = offset_ray_origin(p, n, ray.origin);
+        bool have_origin = false;
+        [[maybe_unused]] const auto make_origin = [&] {
+            if (have_origin) return;
+            shadow_origin = offset_ray_origin(shadow_point(p), n, ray.origin);
+            have_origin = true;
+        };
         for (std::size_t li = 0; li < n_lights; ++li) {
             const LightT<T>& l = lights[li];
             if (l.shaped) {  // uniform per light: the handout's lights never enter
+                if constexpr (kShadows) make_origin();
                 shade_shaped_light<kShadows>(rules, m, base, n, ray, l, std::uint32_t(li), p, shadow_origin, active,
                                              local, sink);
                 continue;
@@ -392,6 +418,7 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
             if (!any(send)) continue;
             const ColorT<V> c = mul(ray.weight, dl.color);
             if constexpr (kShadows) {
+                make_origin();
                 // Towards the light from the moved origin, so t_max = 1 still ends at it.
                 const Vec3T<V> to = l.kind == LightKind::Directional ? ls.to_light : splat<V>(l.pos) - shadow_origin;
                 if constexpr (Sink::kTestsShadowsNow) {

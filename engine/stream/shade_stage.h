@@ -9,6 +9,7 @@
 #include "kernels/kernel_table.h"
 #include "kernels/shade_job.h"
 #include "mesh/mesh_trace.h"
+#include "mesh/terminator.h"
 #include "render/render_stats.h"
 #include "render/texture.h"
 #include "shapes/shapes.h"
@@ -165,8 +166,15 @@ struct ShadeStage {
                                                  mesh_hits.v[i], scale, footprint)
                             : texture_color(m, kind, pc, ob.xf.param, scale, footprint);
             }
+            // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
+            const bool smooth = kind == ShapeKind::Mesh && ob.xf.param != 0.f;
+            const auto shadow_point = [&](const Vec3f& at) {
+                if (!smooth) return at;
+                return at + terminator_shift(ob.xf.m, smooth_corners<float>(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i])),
+                                             mesh_hits.u[i], mesh_hits.v[i], meets_outside(n_out, d));
+            };
             shade_hit<kLighting, kShadows, kReflect, kRefract>(rules, m, sc.lights.data(), sc.lights.size(), arriving,
-                                                               p, n_out, color, true, sink);
+                                                               p, n_out, color, true, sink, shadow_point);
         }
     }
 
