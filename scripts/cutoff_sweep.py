@@ -6,12 +6,13 @@ usage: /usr/bin/python3 scripts/cutoff_sweep.py [--scene scenes/whitted.cfg] [--
 
 Renders the scene with each cut-off (image cutoff=, --cutoff) with both engines, and reports
 each picture's error against the same engine's exact picture (cut-off 0), the render time
-(streamrt's render clock, median of --runs) and the secondary rays traced.
+(streamrt's render clock, median of --runs) and the rays traced (every kind). The renders run in
+this process through the streamrt Python module (build/python, docs/python.md): the pictures
+stay NumPy arrays, no image files are written.
 """
 import argparse
 import os
 import sys
-import tempfile
 
 sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -30,24 +31,26 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"))
     a = ap.parse_args()
-    exe = pc.binary(a.build)
+    rt = pc.module(a.build)
     cutoffs = [float(c) for c in a.cutoffs.split(",")]
     print(f"{os.path.relpath(a.scene, pc.ROOT)} {a.width}x{a.height} spp {a.spp} depth {a.depth} -j{a.jobs}, "
           f"median of {a.runs}")
     print("| engine | cut-off | render s | rays | PSNR vs exact (dB) | RMSE |")
     print("|---|---|---|---|---|---|")
-    with tempfile.TemporaryDirectory() as tmp:
-        for engine in ("stream", "recursive"):
-            exact = os.path.join(tmp, f"{engine}_exact.pfm")
-            for c in cutoffs:
-                out = exact if c == 0 else os.path.join(tmp, f"{engine}_{c}.pfm")
-                runs = [pc.run_streamrt(exe, a.scene, out, engine=engine, jobs=a.jobs, spp=a.spp, width=a.width,
-                                        height=a.height, depth=a.depth, extra=("--cutoff", str(c)))
-                        for _ in range(a.runs if engine == "stream" else 1)]
-                seconds = pc.median([r["seconds"] for r in runs])
-                err = pc.image_error(out, exact)
-                psnr = "exact" if c == 0 else f"{err['psnr']:.1f}"
-                print(f"| {engine} | {c:g} | {seconds:.3f} | {runs[0]['rays']} | {psnr} | {err['rmse']:.2e} |")
+    for engine in ("stream", "recursive"):
+        exact = None
+        for c in cutoffs:
+            runs = [rt.render(a.scene, engine=engine, threads=a.jobs, spp=a.spp, width=a.width, height=a.height,
+                              depth=a.depth, cutoff=c)
+                    for _ in range(a.runs if engine == "stream" else 1)]
+            seconds = pc.median([r.seconds["render"] for r in runs])
+            image = runs[0].image
+            if c == 0:
+                exact = image
+            err = pc.array_error(image, exact if exact is not None else image)
+            psnr = "exact" if c == 0 else f"{err['psnr']:.1f}"
+            rays = runs[0].rays
+            print(f"| {engine} | {c:g} | {seconds:.3f} | {rays['total']} | {psnr} | {err['rmse']:.2e} |")
     return 0
 
 
