@@ -183,8 +183,7 @@ class ChunkReader {
                 p_ = next_line(p_, end_);
                 continue;
             }
-            // The statement's values are read: a comment or the line's end may follow.
-            if (!line_done()) fail(p_, "unexpected " + quote_at(p_, end_));
+            // The statement's values are read up to the line's end or a comment.
             p_ = p_ < end_ && *p_ == '#' ? next_line(p_, end_) : skip_eol(p_);
         }
     }
@@ -313,6 +312,7 @@ class ChunkReader {
         out[0] = number("a texture coordinate (vt u [v [w]])");
         out[1] = line_done() ? 0.f : number("a texture coordinate (vt u [v [w]])");
         if (!line_done()) number("a texture coordinate (vt u [v [w]])");
+        if (!line_done()) fail(p_, "unexpected " + quote_at(p_, end_) + " after a texture coordinate's u v w");
         ++vt_;
     }
 
@@ -470,11 +470,12 @@ void triangulate(const float* pos, std::uint32_t* tri, std::uint32_t* uv, std::u
     }
 }
 
-/// Cuts `bytes` into chunks of about `size` bytes, each ending after a '\n' (or at the end).
+/// Cuts `bytes` into chunks of about `size` bytes, each ending after a '\n' (or at the end);
+/// a UTF-8 byte order mark (Windows tools write one) is left out.
 std::vector<Chunk> cut(std::string_view bytes, std::size_t size) {
     std::vector<Chunk> chunks;
     size = std::max<std::size_t>(size, 1);
-    for (std::size_t pos = 0; pos < bytes.size();) {
+    for (std::size_t pos = bytes.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0; pos < bytes.size();) {
         std::size_t end = bytes.size();
         if (bytes.size() - pos > size) {
             const std::size_t nl = bytes.find('\n', pos + size - 1);
@@ -509,6 +510,7 @@ void obj_fail_at(std::string_view bytes, const std::string& name, std::size_t of
             ++line;
             start = i + 1;
         }
+    if (line == 1 && bytes.substr(0, 3) == "\xEF\xBB\xBF") start = std::min<std::size_t>(3, offset);  // columns after the mark
     throw std::runtime_error(name + ":" + std::to_string(line) + ":" + std::to_string(offset - start + 1) + ": " +
                              message);
 }
@@ -521,7 +523,7 @@ ObjData parse_obj(std::string_view bytes, const std::string& name, const ObjRead
         c.v_before = totals.v, c.vt_before = totals.vt, c.vn_before = totals.vn;
         if (totals.v + c.v > options.max_vertices)
             obj_fail_at(bytes, name, vertex_line(bytes, c, options.max_vertices - totals.v),
-                        "more than " + std::to_string(options.max_vertices) + " vertices");
+                        "more than " + count_of(options.max_vertices, kVertex));
         totals.v += c.v, totals.vt += c.vt, totals.vn += c.vn;
     }
 
