@@ -9,6 +9,7 @@
 #include <system_error>
 #include <utility>
 
+#include "core/error.h"
 #include "core/memory_advice.h"
 #include "parallel/parallelism.h"
 
@@ -16,7 +17,6 @@ namespace streamrt {
 
 namespace {
 
-constexpr std::size_t kNone = std::size_t(-1);
 /// Polygons of more corners are fanned: ear clipping takes up to n^3 steps on a hostile one.
 constexpr std::uint32_t kEarClipCorners = 256;
 
@@ -54,24 +54,11 @@ const char* next_line(const char* p, const char* end) {
     return nl < end ? nl + 1 : end;
 }
 
-/// The word at p for a message: quoted, at most 40 bytes, control bytes as \xNN (messages are
-/// one printable line).
+/// The word at p for a message (core/error.h's quote: one printable line, at most 60 bytes).
 std::string quote_at(const char* p, const char* end) {
     const char* q = p;
-    while (q < end && !is_blank(*q) && !is_eol(*q) && q - p < 40) ++q;
-    std::string s = "'";
-    for (const char* c = p; c < q; ++c) {
-        const auto u = static_cast<unsigned char>(*c);
-        if (u < 0x20 || u == 0x7f) {
-            static const char kHex[] = "0123456789abcdef";
-            s += "\\x";
-            s += kHex[u >> 4];
-            s += kHex[u & 15];
-        } else {
-            s += *c;
-        }
-    }
-    return s + (q < end && !is_blank(*q) && !is_eol(*q) ? "...'" : "'");
+    while (q < end && !is_blank(*q) && !is_eol(*q) && q - p <= 60) ++q;
+    return quote(std::string_view(p, std::size_t(q - p)));
 }
 
 struct IndexKind {
