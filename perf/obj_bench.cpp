@@ -8,7 +8,8 @@
 //   tinyobjloader  as the engine read OBJ files before obj_reader: the file into a string,
 //                  ObjReader::ParseFromString, the triangles' vertex numbers gathered (one thread);
 //   parse_obj      the file mapped and parsed (what load_obj_mesh reads with);
-//   load_obj_mesh  all of it: parse_obj and the mesh built (normals, hierarchy), for scale.
+//   load_obj_mesh  all of it: parse_obj and the mesh built (normals, hierarchy), for scale;
+//     before       the same with tinyobjloader reading (the engine's load_obj_mesh before).
 // Prints the median wall time, the MB/s it gives and the median CPU time (user + system, all
 // threads), and whether both readers agree.
 #include <sys/resource.h>
@@ -164,7 +165,14 @@ int main(int argc, char** argv) {
     print("tinyobjloader", 0, tiny, mb);
     for (const int j : jobs) {
         Parallelism par(j);
-        Timing parse, load;
+        Timing parse, load, old_load;
+        for (int r = 0; r < runs; ++r)
+            old_load.add([&] {
+                par.run([&] {
+                    tinyobj_read(path, tiny_pos, tiny_tris);
+                    Mesh::build(path, tiny_pos, tiny_tris);
+                });
+            });
         for (int r = 0; r < runs; ++r)
             parse.add([&] {
                 par.run([&] {
@@ -176,6 +184,7 @@ int main(int argc, char** argv) {
             load.add([&] { par.run([&] { load_obj_mesh(path); }); });
         print("parse_obj", j, parse, mb);
         print("load_obj_mesh", j, load, mb);
+        print("  before", j, old_load, mb);
     }
     return 0;
 }
