@@ -312,27 +312,31 @@ TEST_CASE("obj reader: materials=obj groups, materials and texture coordinates a
                             "usemtl red\nf 6 5 4\n";
     d.write("lib.mtl", mtl);
     const std::string path = d.write("m.obj", obj);
-    for (const bool with_uv : {false}) {
-        const ObjModel model = load_obj_model(path, with_uv);
-        tinyobj::ObjReaderConfig config;
-        tinyobj::ObjReader lib;
-        REQUIRE(lib.ParseFromString("mtllib x\n", mtl, config));
-        const auto& mats = lib.GetMaterials();
-        const Oracle o = oracle(obj, mtl, true, [&](int m) { return with_uv || (m >= 0 && !mats[std::size_t(m)].diffuse_texname.empty()); });
-        REQUIRE(model.parts.size() == o.groups.size());
-        REQUIRE(model.parts.size() == 4);  // -1 (first faces, before the library, unknown name), red, pic, blue
-        std::size_t k = 0;
-        for (const auto& [key, g] : o.groups) {
-            INFO("material ", key);
-            CHECK(model.parts[k].material == key);
-            check_same_mesh(*model.parts[k].mesh, *Mesh::build(path, o.positions, g.tris, {}, g.corner_uv));
-            ++k;
-        }
-        CHECK(model.parts[0].mesh->triangle_count() == 4);  // 2 before red is read, 1 after, 1 nosuch
-        REQUIRE(model.materials.size() == 3);
-        CHECK(model.materials[0].name == "red");
-        CHECK(model.materials[1].map_kd == "quad.png");
-        CHECK(model.mtl_path == (d.dir / "lib.mtl").string());
+    const ObjModel model = load_obj_model(path, false);
+    tinyobj::ObjReaderConfig config;
+    tinyobj::ObjReader lib;
+    REQUIRE(lib.ParseFromString("mtllib x\n", mtl, config));
+    const auto& mats = lib.GetMaterials();
+    const Oracle o = oracle(obj, mtl, true, [&](int m) { return (m >= 0 && !mats[std::size_t(m)].diffuse_texname.empty()); });
+    REQUIRE(model.parts.size() == o.groups.size());
+    REQUIRE(model.parts.size() == 4);  // -1 (first faces, before the library, unknown name), red, pic, blue
+    std::size_t k = 0;
+    for (const auto& [key, g] : o.groups) {
+        INFO("material ", key);
+        CHECK(model.parts[k].material == key);
+        check_same_mesh(*model.parts[k].mesh, *Mesh::build(path, o.positions, g.tris, {}, g.corner_uv));
+        ++k;
+    }
+    CHECK(model.parts[0].mesh->triangle_count() == 4);  // 2 before red is read, 1 after, 1 nosuch
+    REQUIRE(model.materials.size() == 3);
+    CHECK(model.materials[0].name == "red");
+    CHECK(model.materials[1].map_kd == "quad.png");
+    CHECK(model.mtl_path == (d.dir / "lib.mtl").string());
+    REQUIRE(o.materials.size() == model.materials.size());
+    for (std::size_t m = 0; m < o.materials.size(); ++m) {
+        CHECK(model.materials[m].name == o.materials[m].name);
+        CHECK(model.materials[m].kd[2] == o.materials[m].diffuse[2]);
+        CHECK(model.materials[m].d == o.materials[m].dissolve);
     }
     // Textured (with_uv): every face needs vt; the first without is at line 11, column 3.
     try {
