@@ -420,7 +420,8 @@ void ear_clip(const float* pos, const std::vector<std::uint32_t>& v, std::vector
 
 /// Cuts the polygon whose n corners are tri[0, n) (and uv[0, n), when uv) into the n - 2
 /// triangles over tri[0, 3(n - 2)), as tinyobjloader did: a quad along its shorter diagonal
-/// (the first on a tie), larger ones by ear clipping (fanned beyond kEarClipCorners).
+/// (on a tie the one from its second corner to its fourth), larger ones by ear clipping
+/// (fanned beyond kEarClipCorners).
 void triangulate(const float* pos, std::uint32_t* tri, std::uint32_t* uv, std::uint32_t n,
                  std::vector<std::uint32_t> (&scratch)[3]) {
     std::vector<std::uint32_t>& v = scratch[0];
