@@ -150,9 +150,10 @@ std::string long_lines() {
 
 /// The files compared with tinyobjloader (none uses a case it read differently, see below).
 std::vector<std::pair<std::string, std::string>> cases() {
-    // Quads: 1 2 3 4 along 1-3 (the shorter diagonal), 2 5 6 3 along 5-3.
+    // Quads: 1 2 3 4 along 1-3 (the shorter diagonal), 2 5 6 3 along 5-3, the square 7 8 9 10
+    // (a tie) along 8-10.
     const std::string quads = "# quads\n\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0.25\nv 2 0 0\nv 2 1.5 0.5\n"
-                              "f 1 2 3\nf 1 2 3 4\nf 2 5 6 3\n";
+                              "v 3 0 0\nv 4 0 0\nv 4 1 0\nv 3 1 0\nf 1 2 3\nf 1 2 3 4\nf 2 5 6 3\nf 7 8 9 10\n";
     const std::string relative = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 1 1 1\nf -1 -2 -3\n"
                                  "vt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nvn 0 1 0\n"
                                  "f -4/-3/-1 -3/-2/-2 -2/-1/-1\nf 1/1 2/2 4/3\nf 2//1 3//2 4//1\nf 1/1/1 +2/+2/+2 3/3/1\n";
@@ -200,7 +201,7 @@ std::string parse_error(const std::string& bytes, const ObjReadOptions& options 
 }  // namespace
 
 // Proven against: a quad fanned (0 1 2, 0 2 3) whatever its diagonals ("quads": 2 5 6 3
-// differed); the ear clipper always projecting onto yz, or without its inside test, or used
+// differed), or split along 1-3 on a tie (the square); the ear clipper always projecting onto yz, or without its inside test, or used
 // from 5 corners on only up to 4 ("polygons"); relative indices counted from the chunk's start
 // ("relative" at chunk_bytes 16); relative vt counted with the vertices; '\r' not a line end.
 TEST_CASE("obj reader: the positions, triangles, texture coordinates and meshes tinyobjloader gave") {
