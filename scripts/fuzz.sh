@@ -6,30 +6,32 @@
 # Usage: scripts/fuzz.sh [SECONDS] [extra libFuzzer flags...]
 #        scripts/fuzz.sh ply [SECONDS] [flags...]: the PLY reader alone on raw bytes
 #        (tests/fuzz/ply_fuzz.cpp, seeds tests/fuzz/ply_corpus), into build-fuzz/ply_fuzz.
+#        scripts/fuzz.sh obj [SECONDS] [flags...]: the OBJ reader alone, the same way
+#        (tests/fuzz/obj_fuzz.cpp, seeds tests/fuzz/obj_corpus), into build-fuzz/obj_fuzz.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 target=scene
-[[ ${1:-} == ply ]] && target=ply && shift
+[[ ${1:-} == ply || ${1:-} == obj ]] && target=$1 && shift
 seconds=${1:-60}
 shift || true
 CXX=${FUZZ_CXX:-clang++-14}
 command -v "$CXX" >/dev/null || CXX=clang++
 out=build-fuzz
-if [[ $target == ply ]]; then
-  mkdir -p "$out/ply_corpus" "$out/artifacts"
-  bin="$out/ply_fuzz"
-  ply_sources=(tests/fuzz/ply_fuzz.cpp engine/core/*.cpp engine/accel/*.cpp engine/mesh/*.cpp)
+if [[ $target == ply || $target == obj ]]; then
+  mkdir -p "$out/${target}_corpus" "$out/artifacts"
+  bin="$out/${target}_fuzz"
+  reader_sources=(tests/fuzz/${target}_fuzz.cpp engine/core/*.cpp engine/accel/*.cpp engine/mesh/*.cpp)
   rebuild=0
   [[ -x $bin ]] || rebuild=1
-  for s in "${ply_sources[@]}" engine/{core,accel,mesh}/*.h; do [[ $s -nt $bin ]] && rebuild=1; done
+  for s in "${reader_sources[@]}" engine/{core,parallel,accel,mesh}/*.h; do [[ $s -nt $bin ]] && rebuild=1; done
   if ((rebuild)); then
     echo "fuzz.sh: building $bin with $CXX"
     "$CXX" -std=c++20 -O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined \
-      -fno-sanitize-recover=undefined -Iengine "${ply_sources[@]}" -ltinyobjloader -ltbb -o "$bin"
+      -fno-sanitize-recover=undefined -Iengine "${reader_sources[@]}" -ltinyobjloader -ltbb -o "$bin"
   fi
-  cp -n tests/fuzz/ply_corpus/* "$out/ply_corpus/" 2>/dev/null || true
-  exec "$bin" "$out/ply_corpus" -max_total_time="$seconds" -max_len=4096 -timeout=10 -rss_limit_mb=2048 \
-    -malloc_limit_mb=64 -print_final_stats=1 -artifact_prefix="$out/artifacts/ply-" "$@"
+  cp -n tests/fuzz/${target}_corpus/* "$out/${target}_corpus/" 2>/dev/null || true
+  exec "$bin" "$out/${target}_corpus" -max_total_time="$seconds" -max_len=4096 -timeout=10 -rss_limit_mb=2048 \
+    -malloc_limit_mb=64 -print_final_stats=1 -artifact_prefix="$out/artifacts/${target}-" "$@"
 fi
 mkdir -p "$out/corpus" "$out/artifacts"
 # The scene reader and everything it may call: the layers up to scene/ (docs/architecture.md; the

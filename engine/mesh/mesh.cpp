@@ -2,6 +2,7 @@
 
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -11,7 +12,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/mapped_file.h"
 #include "core/vec3.h"
+#include "mesh/obj_reader.h"
 #include "parallel/parallelism.h"
 
 namespace streamrt {
@@ -149,80 +152,21 @@ std::string read_file_bytes(const std::string& path, const char* what) {
     return ss.str();
 }
 
-/// The triangles of an OBJ text, grouped by material id (all in group -1 unless by_material),
-/// with their corners' texture coordinates where uv_for(group) says so.
-struct ObjFaces {
-    std::vector<float> positions;
-    struct Group {
-        std::vector<std::uint32_t> tris;
-        std::vector<float> corner_uv;
-    };
-    std::map<int, Group> groups;
-    std::vector<tinyobj::material_t> materials;
-};
+constexpr const char* kNeedsUv = "face without texture coordinates (vt), which a texture needs";
 
-template <class UvFor>
-ObjFaces read_obj_faces(const std::string& obj_text, const std::string& mtl_text, bool by_material, UvFor uv_for) {
-    tinyobj::ObjReaderConfig config;
-    config.triangulate = true;
-    config.vertex_color = false;
-    tinyobj::ObjReader reader;
-    // From strings: the material text is the one given (none: `mtllib` lines are ignored).
-    if (!reader.ParseFromString(obj_text, mtl_text, config)) {
-        std::string err = reader.Error();
-        while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
-        throw std::runtime_error("cannot parse OBJ file: " + err);
+/// The texture coordinates of triangles[first, first + count) of `d` (6 per triangle).
+void append_corner_uv(const ObjData& d, std::size_t first, std::size_t count, std::vector<float>& out) {
+    for (std::size_t k = 3 * first; k < 3 * (first + count); ++k) {
+        const std::uint32_t t = d.triangle_uv[k];  // every corner has one: parse_obj listed no gap
+        out.push_back(d.texcoords[2 * std::size_t(t)]);
+        out.push_back(d.texcoords[2 * std::size_t(t) + 1]);
     }
-    ObjFaces out;
-    const tinyobj::attrib_t& at = reader.GetAttrib();
-    out.positions.assign(at.vertices.begin(), at.vertices.end());
-    out.materials = reader.GetMaterials();
-    // The group of the previous face, looked up again only when the material changes.
-    int last_key = -2;
-    ObjFaces::Group* group = nullptr;
-    bool with_uv = false;
-    for (const tinyobj::shape_t& s : reader.GetShapes()) {
-        std::size_t off = 0;
-        for (std::size_t f = 0; f < s.mesh.num_face_vertices.size(); ++f) {
-            const auto nv = s.mesh.num_face_vertices[f];
-            const int key = by_material && f < s.mesh.material_ids.size() ? s.mesh.material_ids[f] : -1;
-            if (nv == 3) {
-                if (key != last_key) {
-                    group = &out.groups[key];
-                    with_uv = uv_for(key);
-                    last_key = key;
-                }
-                ObjFaces::Group& g = *group;
-                for (int j = 0; j < 3; ++j) {
-                    const tinyobj::index_t& ix = s.mesh.indices[off + std::size_t(j)];
-                    const int v = ix.vertex_index;
-                    if (v < 0 || std::size_t(v) >= out.positions.size() / 3)
-                        throw std::runtime_error("OBJ face refers to a missing vertex");
-                    g.tris.push_back(std::uint32_t(v));
-                    if (!with_uv) continue;
-                    const int t = ix.texcoord_index;
-                    if (t < 0 || 2 * std::size_t(t) + 1 >= at.texcoords.size())
-                        throw std::runtime_error("OBJ file has a face without texture coordinates (vt), which a "
-                                                 "texture needs");
-                    g.corner_uv.push_back(at.texcoords[2 * std::size_t(t)]);
-                    g.corner_uv.push_back(at.texcoords[2 * std::size_t(t) + 1]);
-                }
-            }
-            off += nv;
-        }
-    }
-    for (float p : out.positions)
-        if (!std::isfinite(p)) throw std::runtime_error("OBJ file has a vertex that is not finite");
-    for (const auto& [key, g] : out.groups)
-        for (float t : g.corner_uv)
-            if (!std::isfinite(t)) throw std::runtime_error("OBJ file has a texture coordinate that is not finite");
-    return out;
 }
 
 std::shared_ptr<const Mesh> build_checked(const std::string& path, const std::vector<float>& positions,
-                                          const ObjFaces::Group& g) {
-    const std::size_t faces = g.tris.size() / 3;
-    auto mesh = Mesh::build(path, positions, g.tris, {}, g.corner_uv);
+                                          const std::vector<std::uint32_t>& tris, const std::vector<float>& corner_uv) {
+    const std::size_t faces = tris.size() / 3;
+    auto mesh = Mesh::build(path, positions, tris, {}, corner_uv);
     if (mesh->triangle_count() == 0)
         throw std::runtime_error(faces == 0 ? "OBJ file has no faces"
                                             : "OBJ file has no triangles of non-zero area (" +
@@ -233,62 +177,89 @@ std::shared_ptr<const Mesh> build_checked(const std::string& path, const std::ve
 }  // namespace
 
 std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv) {
-    const ObjFaces faces = read_obj_faces(read_file_bytes(path, "mesh file"), "", false, [&](int) { return with_uv; });
-    static const ObjFaces::Group kNone;
-    const auto it = faces.groups.find(-1);
-    return build_checked(path, faces.positions, it == faces.groups.end() ? kNone : it->second);
+    MappedFile file;
+    if (!file.open(path)) throw std::runtime_error("cannot open mesh file");
+    ObjData d = parse_obj(file.text(), path, {.keep_uv = with_uv});
+    std::vector<float> corner_uv;
+    if (with_uv) {
+        if (!d.uv_gaps.empty()) obj_fail_at(file.text(), path, d.uv_gaps.front().offset, kNeedsUv);
+        corner_uv.reserve(2 * d.triangle_uv.size());
+        append_corner_uv(d, 0, d.triangles.size() / 3, corner_uv);
+    }
+    return build_checked(path, d.positions, d.triangles, corner_uv);
 }
 
 ObjModel load_obj_model(const std::string& path, bool with_uv) {
-    const std::string obj_text = read_file_bytes(path, "mesh file");
+    MappedFile file;
+    if (!file.open(path)) throw std::runtime_error("cannot open mesh file");
+    const ObjData d = parse_obj(file.text(), path, {.keep_uv = true});
     ObjModel model;
-    std::string mtl_text;
-    {
-        std::istringstream lines(obj_text);
-        std::string line;
-        while (std::getline(lines, line)) {
-            std::istringstream words(line);
-            std::string word, name;
-            if (words >> word && word == "mtllib" && words >> name) {
-                const std::size_t slash = path.find_last_of('/');
-                model.mtl_path = slash == std::string::npos ? name : path.substr(0, slash + 1) + name;
-                mtl_text = read_file_bytes(model.mtl_path, ("material library '" + model.mtl_path + "'").c_str());
-                break;
+    // The library (tinyobjloader reads MTL files): the materials in file order, their numbers by name.
+    std::map<std::string, int> ids;
+    if (!d.mtllib.empty()) {
+        const std::size_t slash = path.find_last_of('/');
+        model.mtl_path = slash == std::string::npos ? d.mtllib : path.substr(0, slash + 1) + d.mtllib;
+        std::istringstream mtl(read_file_bytes(model.mtl_path, ("material library '" + model.mtl_path + "'").c_str()));
+        std::vector<tinyobj::material_t> materials;
+        std::string warn, err;
+        tinyobj::LoadMtl(&ids, &materials, &mtl, &warn, &err);
+        for (const tinyobj::material_t& m : materials) {
+            ObjMaterial o;
+            o.name = m.name;
+            for (int c = 0; c < 3; ++c) {
+                o.kd[c] = m.diffuse[c];
+                o.ks[c] = m.specular[c];
             }
+            o.ns = m.shininess;
+            o.ni = m.ior;
+            o.d = m.dissolve;
+            o.map_kd = m.diffuse_texname;
+            model.materials.push_back(o);
         }
     }
-    std::vector<bool> mapped;  // per material: has map_Kd
-    const auto uv_for = [&](int m) { return with_uv || (m >= 0 && std::size_t(m) < mapped.size() && mapped[m]); };
-    // The materials are known only once parsed: a first pass without coordinates finds them.
-    {
-        tinyobj::ObjReaderConfig config;
-        tinyobj::ObjReader reader;
-        if (reader.ParseFromString("mtllib library\n", mtl_text, config))
-            for (const tinyobj::material_t& m : reader.GetMaterials()) mapped.push_back(!m.diffuse_texname.empty());
+    // The material of each usemtl line: none before the library is read or for a name it lacks.
+    std::vector<int> use_material;
+    for (const ObjData::MaterialUse& u : d.material_uses) {
+        const auto it = u.before_library ? ids.end() : ids.find(u.name);
+        use_material.push_back(it == ids.end() ? -1 : it->second);
     }
-    const ObjFaces faces = read_obj_faces(obj_text, mtl_text, true, uv_for);
-    for (const tinyobj::material_t& m : faces.materials) {
-        ObjMaterial o;
-        o.name = m.name;
-        for (int c = 0; c < 3; ++c) {
-            o.kd[c] = m.diffuse[c];
-            o.ks[c] = m.specular[c];
+    const auto material_of = [&](std::size_t triangle) {  // the last usemtl at or before it
+        const auto it = std::upper_bound(d.material_uses.begin(), d.material_uses.end(), triangle,
+                                         [](std::size_t t, const ObjData::MaterialUse& u) { return t < u.first_triangle; });
+        return it == d.material_uses.begin() ? -1 : use_material[std::size_t(it - d.material_uses.begin()) - 1];
+    };
+    const auto uv_for = [&](int m) {
+        return with_uv || (m >= 0 && std::size_t(m) < model.materials.size() && !model.materials[std::size_t(m)].map_kd.empty());
+    };
+    for (const ObjData::UvGap& g : d.uv_gaps)  // in file order: the first gap that matters
+        if (uv_for(material_of(g.triangle))) obj_fail_at(file.text(), path, g.offset, kNeedsUv);
+
+    // One group per material (-1 first), each its triangles in file order: runs between usemtl lines.
+    struct Group {
+        std::vector<std::uint32_t> tris;
+        std::vector<float> corner_uv;
+    };
+    std::map<int, Group> groups;
+    const std::size_t n_tris = d.triangles.size() / 3;
+    for (std::size_t u = 0, first = 0; first < n_tris; ++u) {
+        const std::size_t end = u < d.material_uses.size() ? std::min(d.material_uses[u].first_triangle, n_tris) : n_tris;
+        if (end > first) {
+            const int key = u == 0 ? -1 : use_material[u - 1];
+            Group& g = groups[key];
+            g.tris.insert(g.tris.end(), d.triangles.begin() + std::ptrdiff_t(3 * first),
+                          d.triangles.begin() + std::ptrdiff_t(3 * end));
+            if (uv_for(key)) append_corner_uv(d, first, end - first, g.corner_uv);
         }
-        o.ns = m.shininess;
-        o.ni = m.ior;
-        o.d = m.dissolve;
-        o.map_kd = m.diffuse_texname;
-        model.materials.push_back(o);
+        first = std::max(first, end);
     }
-    for (const auto& [key, g] : faces.groups) {
-        auto mesh = Mesh::build(path, faces.positions, g.tris, {}, g.corner_uv);
+    for (const auto& [key, g] : groups) {
+        auto mesh = Mesh::build(path, d.positions, g.tris, {}, g.corner_uv);
         if (mesh->triangle_count() == 0) continue;  // a group of degenerate faces only
         const int material = key >= 0 && std::size_t(key) < model.materials.size() ? key : -1;
         model.parts.push_back({std::move(mesh), material});
     }
     if (model.parts.empty())
-        throw std::runtime_error(faces.groups.empty() ? "OBJ file has no faces"
-                                                      : "OBJ file has no triangles of non-zero area");
+        throw std::runtime_error(groups.empty() ? "OBJ file has no faces" : "OBJ file has no triangles of non-zero area");
     return model;
 }
 

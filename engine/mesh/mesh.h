@@ -61,11 +61,12 @@ struct Mesh {
                                              const std::vector<float>& normals = {});
 };
 
-/// Reads a Wavefront OBJ file (tinyobjloader; polygons are triangulated, materials and
+/// Reads a Wavefront OBJ file (mesh/obj_reader.h; polygons are triangulated, materials and
 /// normals in the file are ignored). Texture coordinates (vt) are kept only when `with_uv`
 /// (a textured object uses the mesh); then every face must have them. Throws
-/// std::runtime_error with a message (no location) for a missing, unreadable or malformed
-/// file, one with no triangles, or (with_uv) a face without texture coordinates.
+/// std::runtime_error for a missing or unreadable file (no location), a malformed one or
+/// (with_uv) a face without texture coordinates (`file:line:col: message`), or one with no
+/// triangles of non-zero area.
 std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv = false);
 
 /// One material of an OBJ file's material library (MTL), as read (docs/scene-format.md,
@@ -94,9 +95,9 @@ struct ObjModel {
 };
 
 /// Reads an OBJ file and the material library its first `mtllib` line names (relative to
-/// the OBJ file's folder). A part keeps its texture coordinates when `with_uv` or its
-/// material has map_Kd. Throws std::runtime_error like load_obj_mesh, and for a library that
-/// cannot be read.
+/// the OBJ file's folder; read with tinyobjloader). A part keeps its texture coordinates when
+/// `with_uv` or its material has map_Kd. Throws std::runtime_error like load_obj_mesh, and for
+/// a library that cannot be read.
 ObjModel load_obj_model(const std::string& path, bool with_uv);
 
 // ---- generated surfaces (tests, benchmarks, the sample scene) -----------------------------
