@@ -39,8 +39,12 @@ struct RecursiveSink {
 };
 }  // namespace
 
-RecursiveRenderer::RecursiveRenderer(const Scene& scene, const accel::AccelConfig& accel)
-    : scene_(scene), accel_config_(accel), bvh_(accel::SceneBvh::build_for(scene, accel_config_)), camera_(CameraRays<double>::from(scene)) {
+RecursiveRenderer::RecursiveRenderer(const Scene& scene, const RenderSettings& settings, const accel::AccelConfig& accel)
+    : scene_(&scene),
+      settings_(settings),
+      accel_config_(accel),
+      bvh_(accel::SceneBvh::build_for(scene, accel_config_)),
+      camera_(CameraRays<double>::from(scene.camera, settings_)) {
     objects_.resize(scene.objects.size());
     parallel_for_index(scene.objects.size(), 4096, [&](std::size_t i) {
         const Object& o = scene.objects[i];
@@ -53,7 +57,7 @@ RecursiveRenderer::RecursiveRenderer(const Scene& scene, const accel::AccelConfi
             materials_.back().uv_scale = m.uv_scale;
         }
     }
-    for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(l));
+    for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(rendered_light(l, settings_)));
 }
 
 bool RecursiveRenderer::test_object(std::size_t i, const RayD& ray, double t_min, double& t_max,
@@ -111,7 +115,7 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
                          : visit_shape(ob.kind, [&](auto shape) { return shape.template normal<double>(pc, ob.param); });
     hit.object = best;
     hit.t = best_t;
-    hit.point = apply_point(RowsOf{scene_.objects[std::size_t(best)].md}, pc);
+    hit.point = apply_point(RowsOf{scene_->objects[std::size_t(best)].md}, pc);
     hit.normal = apply_normal(RowsOf{ob.mi}, nc);
     hit.canonical = pc;
     hit.tri = cand.tri;
@@ -166,11 +170,11 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
 }
 
 ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& counts, std::uint32_t key) const {
-    const RenderSettings& s = scene_.settings;
+    const RenderSettings& s = settings_;
     HitD hit;
     if (!closest_hit(ray, 0.0, kInf, hit)) return {s.background.x, s.background.y, s.background.z};
 
-    const Object& object = scene_.objects[std::size_t(hit.object)];
+    const Object& object = scene_->objects[std::size_t(hit.object)];
     const ShadeRules<double> rules{
         .degree = s.degree, .ambient = s.ambient, .spawn = depth < s.depth, .cutoff = s.cutoff, .spread = camera_.spread};
     // Weight 1: the caller multiplies what this ray brings back by its weight.
@@ -195,7 +199,7 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
 }
 
 ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) const {
-    const RenderSettings& s = scene_.settings;
+    const RenderSettings& s = settings_;
     const CameraRays<double>& cam = camera_;
     const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(s.width) + std::uint64_t(x);
     ColorT<double> sum{0, 0, 0};
@@ -215,7 +219,7 @@ ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) 
 }
 
 Framebuffer RecursiveRenderer::render(Parallelism& par, RenderProgress* progress) const {
-    const RenderSettings& s = scene_.settings;
+    const RenderSettings& s = settings_;
     Framebuffer fb = Framebuffer::uninitialized(s.width, s.height);  // every tile writes its pixels
     par.for_each_tile(s.width, s.height, kTileSize, [&](int, Tile tile) {
         if (progress && progress->cancelled()) return;
@@ -235,17 +239,18 @@ Framebuffer RecursiveRenderer::render(Parallelism& par, RenderProgress* progress
 }
 
 // ---- animation: per-frame update ----
-void RecursiveRenderer::update(const FrameChange& change) {
-    for (const std::uint32_t i : change.objects) objects_[i].mi = affine_inverse(scene_.objects[i].md);
+void RecursiveRenderer::update(const Scene& scene, const FrameChange& change) {
+    scene_ = &scene;
+    for (const std::uint32_t i : change.objects) objects_[i].mi = affine_inverse(scene.objects[i].md);
     if (change.lights) {
         lights_.clear();
-        for (const Light& l : scene_.lights) lights_.push_back(LightT<double>::from(l));
+        for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(rendered_light(l, settings_)));
     }
-    if (change.camera) camera_ = CameraRays<double>::from(scene_);
+    if (change.camera) camera_ = CameraRays<double>::from(scene.camera, settings_);
     if (bvh_ && !change.objects.empty()) {
         if (bvh_->refit_pays(change.objects.size(), accel_config_))
-            bvh_->refit(scene_, change.objects, bvh_->bvh.prim_index);
-        else bvh_ = accel::SceneBvh::build(scene_, accel_config_.build);
+            bvh_->refit(scene, change.objects, bvh_->bvh.prim_index);
+        else bvh_ = accel::SceneBvh::build(scene, accel_config_.build);
     }
 }
 

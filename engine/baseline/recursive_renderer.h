@@ -41,7 +41,11 @@ struct HitD {
 class RecursiveRenderer {
   public:
     /// accel: whether and how the object hierarchy is used (EngineOptions::accel).
-    explicit RecursiveRenderer(const Scene& scene, const accel::AccelConfig& accel = {});
+    /// `settings`: what is rendered (a render job's, the scene's own otherwise); the scene's
+    /// objects are read while rendering, so `scene` must outlive the renderer.
+    RecursiveRenderer(const Scene& scene, const RenderSettings& settings, const accel::AccelConfig& accel = {});
+    explicit RecursiveRenderer(const Scene& scene, const accel::AccelConfig& accel = {})
+        : RecursiveRenderer(scene, scene.settings, accel) {}
 
     /// Renders the whole image; tiles in parallel, each pixel independent of -j.
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr) const;
@@ -60,9 +64,10 @@ class RecursiveRenderer {
     /// One pixel's colour: the average over its samples.
     ColorT<double> render_pixel(int x, int y, RayCounts& counts) const;
 
-    /// Animation: the scene was put at another frame (set_frame); re-derives what `change`
+    /// Animation: `scene` is the scene at another frame (scene_at_frame: the same objects,
+    /// materials and meshes, at other places), read from now on; re-derives what `change`
     /// names only (moved objects' Mi and their boxes, lights, camera).
-    void update(const FrameChange& change);
+    void update(const Scene& scene, const FrameChange& change);
 
   private:
     /// What the loop over objects reads: Mi (world -> canonical, top three rows) computed
@@ -86,7 +91,8 @@ class RecursiveRenderer {
     };
     /// Tests object i in its canonical space; shrinks t_max and records it on a closer hit.
     bool test_object(std::size_t i, const RayD& ray, double t_min, double& t_max, Candidate& c) const;
-    const Scene& scene_;
+    const Scene* scene_;
+    RenderSettings settings_;
     accel::AccelConfig accel_config_;
     std::unique_ptr<accel::SceneBvh> bvh_;  ///< null: the handout's loop over all objects
     CameraRays<double> camera_;

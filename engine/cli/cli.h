@@ -85,10 +85,13 @@ struct Options {
     bool tiled() const { return mpi || shard_n > 0 || !checkpoint.empty() || !tile_costs.empty(); }
 };
 
-/// A render ready to go (driver/render_job.h), and what the command line adds to it.
+/// A render ready to go (driver/render_job.h), and what the command line adds to it. The
+/// scene is never changed: a frame is set here, its scene made when the engine is prepared
+/// and its file name where the file is written (output_name).
 struct Job : RenderJob {
     double read_seconds = 0;
-    int frame = -1;  ///< the frame being rendered (animation; -1: a still picture)
+    int frame = -1;         ///< the frame being rendered (animation; -1: a still picture)
+    bool animated = false;  ///< the scene has keys (kept when the job lets go of the scene)
 };
 
 using Clock = std::chrono::steady_clock;
@@ -113,10 +116,11 @@ void check_output_path(const std::string& out, const std::string& scene_path);
 /// Applies the command line to a loaded scene and checks everything before rendering.
 /// `writes`: this process writes the output (false on MPI ranks other than 0).
 /// `check_isa`: --isa must be supported here (MPI ranks agree on it together instead).
-Job make_job(const Options& opt, Scene scene, bool writes, bool check_isa);
-/// The engine's set-up; the scene's object records are released when the engine renders
-/// from its own tables.
-std::unique_ptr<PreparedRender> prepare(Job& job, EngineKind which, bool keep_objects);
+Job make_job(const Options& opt, std::shared_ptr<const Scene> scene, bool writes, bool check_isa);
+/// The engine's set-up for the job's frame. Unless `keep_scene` (more set-ups follow) or the
+/// scene is animated, the job lets go of its scene: the stream engine renders from its own
+/// tables, and the scene's objects are freed then (the recursive engine holds the scene).
+std::unique_ptr<PreparedRender> prepare(Job& job, EngineKind which, bool keep_scene);
 void report_profile(const Options& opt, const StreamProfile* profile);
 /// The summary line.
 void print_summary(const Options& opt, const Job& job, int jobs, const std::string& how, double seconds,
@@ -125,6 +129,9 @@ void print_summary(const Options& opt, const Job& job, int jobs, const std::stri
 // ---- picture.cpp ----
 /// The output name of frame `frame` (printf-style %d), nullopt without one.
 std::optional<std::string> frame_output_name(const std::string& pattern, int frame);
+/// The file the job's picture goes to: the output name, for an animated scene with the
+/// frame's number put in its %d (a still picture of an animated scene is frame 0).
+std::string output_name(const Job& job);
 FramePlan plan_frames(const Options& opt, const RenderSettings& s);
 int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle,
                    std::unique_ptr<PreparedRender>& prepared);

@@ -106,25 +106,24 @@ int run(int argc, char** argv) {
     // render_once), rendering and writing.
     auto phase_start = Clock::now();
     SceneBundle bundle;
-    Scene loaded = opt.tiled() ? load_scene_bundled(opt.scene_path, opt.jobs, bundle)
-                               : load_scene(opt.scene_path, opt.jobs);
+    // Immutable from here on (scene/scene.h): the job renders it with its own settings.
+    auto loaded = std::make_shared<const Scene>(opt.tiled() ? load_scene_bundled(opt.scene_path, opt.jobs, bundle)
+                                                            : load_scene(opt.scene_path, opt.jobs));
     const double read_seconds = since(phase_start);
     Job job = make_job(opt, std::move(loaded), true, true);
     job.read_seconds = read_seconds;
-    const RenderSettings& s = job.scene.settings;
+    const RenderSettings& s = job.render_settings;
     const FramePlan frames = plan_frames(opt, s);
     if (opt.check_only) {
         if (!opt.quiet)
             std::printf("%s: ok (%zu objects, %zu lights, %dx%d, spp %d, degree %d)\n", opt.scene_path.c_str(),
-                        job.scene.objects.size(), job.scene.lights.size(), s.width, s.height, s.spp, s.degree);
+                        job.scene->objects.size(), job.scene->lights.size(), s.width, s.height, s.spp, s.degree);
         return 0;
     }
     if (g_cancel.load()) throw Interrupted{};
     Parallelism par(opt.jobs);
     // ---- animation: --frames / image frames= (scene/animation.h) ----
     if (frames.any) return render_frames(opt, job, par, bundle, frames);
-    // A still picture of an animated scene is frame 0, also in the output name's %d.
-    if (job.scene.animation) job.scene.settings.output = frame_output_name(s.output, 0).value_or(s.output);
     std::unique_ptr<PreparedRender> prepared;
     return render_picture(opt, job, par, bundle, prepared);
 }

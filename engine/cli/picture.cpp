@@ -37,6 +37,12 @@ std::optional<std::string> frame_output_name(const std::string& pattern, int fra
     return out;
 }
 
+std::string output_name(const Job& job) {
+    const std::string& pattern = job.render_settings.output;
+    const int frame = job.frame >= 0 ? job.frame : job.animated ? 0 : -1;
+    return frame >= 0 ? frame_output_name(pattern, frame).value_or(pattern) : pattern;
+}
+
 FramePlan plan_frames(const Options& opt, const RenderSettings& s) {
     FramePlan p;
     if (!opt.frames.empty()) {
@@ -64,7 +70,8 @@ FramePlan plan_frames(const Options& opt, const RenderSettings& s) {
 int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle,
                    std::unique_ptr<PreparedRender>& prepared) {
     if (opt.tiled()) return render_tiled(opt, job, par, bundle, nullptr, prepared);
-    const RenderSettings& s = job.scene.settings;
+    const RenderSettings& s = job.render_settings;
+    const std::string output = output_name(job);
     const EngineKind engine = job.engine;
     EngineOptions& eo = job.options;
     WriteOptions wo;
@@ -94,7 +101,7 @@ int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBu
         const RenderResult base = render_once(EngineKind::Recursive, true);
         eo.profile = stream_profile;
         const RenderResult str = render_once(EngineKind::Stream, true);
-        if (!write_image(s.output, str.image, display_of(s), wo)) throw Interrupted{};
+        if (!write_image(output, str.image, display_of(s), wo)) throw Interrupted{};
         const ImageDifference d = compare_images(str.image, base.image);
         std::printf("%s: %dx%d, spp %d, degree %d, -j%d, isa %s\n", opt.scene_path.c_str(), s.width, s.height, s.spp,
                     s.degree, par.jobs(), isa_name(eo.isa));
@@ -106,14 +113,14 @@ int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBu
         std::printf("difference (stream vs recursive, calibrated): max %.5f, rmse %.6f, psnr %.2f dB, "
                     "pixels off by > 1/255: %.4f%%\n",
                     d.max_abs, d.rmse, d.psnr, 100.0 * d.share_over);
-        std::printf("image (stream engine) -> %s\n", s.output.c_str());
+        std::printf("image (stream engine) -> %s\n", output.c_str());
         report_profile(opt, job.profile.get());
         return 0;
     }
 
     const RenderResult r = render_once(engine, true);
     const auto phase_start = Clock::now();
-    if (!write_image(s.output, r.image, display_of(s), wo)) throw Interrupted{};
+    if (!write_image(output, r.image, display_of(s), wo)) throw Interrupted{};
     const double write_seconds = since(phase_start);
     report_profile(opt, job.profile.get());
     print_summary(opt, job, par.jobs(), "", r.seconds, r.counts, r.setup_seconds, write_seconds);
@@ -123,15 +130,13 @@ int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBu
 
 /// --frames A..B or image frames=A..B: each frame is one picture written to the output name
 /// with the frame number put in its printf-style %d (out_%04d.png), the engine's set-up
-/// updated from frame to frame (only what moved is rebuilt).
+/// updated from frame to frame (only what moved is rebuilt). Each frame's scene is a new one
+/// made from the job's, which stays as read.
 int render_frames(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle, const FramePlan& plan) {
-    const std::string pattern = job.scene.settings.output;
     std::unique_ptr<PreparedRender> prepared;
     for (int f = plan.first; f <= plan.last; ++f) {
-        const FrameChange change = set_frame(job.scene, f);
+        if (prepared) update_job_frame(*prepared, job, job.frame, f);
         job.frame = f;
-        job.scene.settings.output = frame_output_name(pattern, f).value_or(pattern);
-        if (prepared) prepared->update(job.scene, change);
         if (const int status = render_picture(opt, job, par, bundle, prepared); status != 0) return status;
     }
     return 0;

@@ -10,7 +10,8 @@ namespace streamrt::cli {
 /// `prepared`: the engine's set-up, kept from frame to frame (animation); made when null.
 int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBundle& bundle, const MpiSession* mpi,
                  std::unique_ptr<PreparedRender>& prepared) {
-    const RenderSettings& s = job.scene.settings;
+    const RenderSettings& s = job.render_settings;
+    const std::string output = output_name(job);
     const bool rank0 = !mpi || mpi->rank() == 0;
     if (!prepared) prepared = prepare(job, job.engine, false);
     RenderProgress progress;
@@ -57,12 +58,12 @@ int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBund
     if (journal) journal->sync();
     const auto write_start = Clock::now();
     if (opt.shard_n > 0) {
-        write_text_file(s.output, header.line() + "\n" + assembly.records(mine));
+        write_text_file(output, header.line() + "\n" + assembly.records(mine));
     } else {
         WriteOptions wo;
         wo.par = &par;
         wo.cancel = &g_cancel;
-        if (!write_image(s.output, assembly.image(), display_of(s), wo)) throw Interrupted{};
+        if (!write_image(output, assembly.image(), display_of(s), wo)) throw Interrupted{};
     }
     const double write_seconds = since(write_start);
     if (!opt.tile_costs.empty()) write_text_file(opt.tile_costs, assembly.costs_csv());
@@ -91,7 +92,7 @@ int run_mpi(const Options& opt, int argc, char** argv) {
     if (rank0) {
         try {
             const auto start = Clock::now();
-            Scene scene = load_scene_bundled(opt.scene_path, opt.jobs, bundle);
+            auto scene = std::make_shared<const Scene>(load_scene_bundled(opt.scene_path, opt.jobs, bundle));
             const double read_seconds = since(start);
             job.emplace(make_job(opt, std::move(scene), true, false));
             job->read_seconds = read_seconds;
@@ -104,16 +105,15 @@ int run_mpi(const Options& opt, int argc, char** argv) {
     try {
         if (!rank0) {
             const auto start = Clock::now();
-            job.emplace(make_job(opt, load_scene_from_bundle(bundle, opt.jobs), false, false));
+            job.emplace(make_job(opt, std::make_shared<const Scene>(load_scene_from_bundle(bundle, opt.jobs)), false,
+                                 false));
             job->read_seconds = since(start);
         }
         // An animated scene: every rank renders its one frame, image frames=F or frame 0
-        // (several frames are refused by make_job, --frames by run()).
-        if (RenderSettings& rs = job->scene.settings; job->scene.animation || rs.has_frames()) {
+        // (several frames are refused by make_job, --frames by run()); its scene is made
+        // when the engine is prepared, its file name where the file is written.
+        if (const RenderSettings& rs = job->render_settings; job->animated || rs.has_frames())
             job->frame = rs.has_frames() ? rs.frames_first : 0;
-            set_frame(job->scene, job->frame);
-            rs.output = frame_output_name(rs.output, job->frame).value_or(rs.output);
-        }
         // One kernel level for all: the one asked for if every rank has it, else the best
         // every rank has (float results differ in the last bits between levels).
         if (job->engine == EngineKind::Stream) {
@@ -129,7 +129,7 @@ int run_mpi(const Options& opt, int argc, char** argv) {
         if (opt.check_only) {
             if (rank0 && !opt.quiet)
                 std::printf("%s: ok (%zu objects, %zu lights, %d ranks)\n", opt.scene_path.c_str(),
-                            job->scene.objects.size(), job->scene.lights.size(), mpi.size());
+                            job->scene->objects.size(), job->scene->lights.size(), mpi.size());
             return 0;
         }
         Parallelism par(opt.jobs);

@@ -23,8 +23,7 @@ constexpr double kSortedBytes = 16 * 4 + 3 * 4;
 constexpr double kRecursiveFrameBytes = 2048;  // one recursion level of the baseline, generous
 }  // namespace
 
-MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, int threads) {
-    const RenderSettings& s = scene.settings;
+MemoryEstimate estimate_render_memory(const Scene& scene, const RenderSettings& s, bool stream_engine, int threads) {
     MemoryEstimate e;
     e.threads = std::max(1, threads);
     const double pixels = double(s.width) * double(s.height);
@@ -42,7 +41,10 @@ MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, in
         const double streams = (double(e.generations) + 3) * 2 * slice * kRayBytes;
         // Shadow rays per hit: one per light, `samples` per area light.
         double lights = 0.0;
-        for (const Light& l : scene.lights) lights += s.degree >= 5 ? (l.is_area() ? double(l.samples) : 1.0) : 0.0;
+        for (const Light& given : scene.lights) {
+            const Light l = rendered_light(given, s);
+            lights += s.degree >= 5 ? (l.is_area() ? double(l.samples) : 1.0) : 0.0;
+        }
         // The shadow rays of a slice, twice (regrouped by pixel after gathered shading).
         e.per_thread_bytes = streams + 2 * slice * kHitBytes + slice * kSortedBytes + 2 * slice * lights * kShadowBytes;
     } else {
@@ -73,12 +75,12 @@ std::string format_bytes(double bytes) {
     return buf;
 }
 
-void check_render_memory(const Scene& scene, bool stream_engine, int threads, double limit_bytes) {
+void check_render_memory(const Scene& scene, const RenderSettings& s, bool stream_engine, int threads,
+                         double limit_bytes) {
     if (limit_bytes < 0) limit_bytes = physical_memory_bytes();
     if (!(limit_bytes > 0)) return;
-    const MemoryEstimate e = estimate_render_memory(scene, stream_engine, threads);
+    const MemoryEstimate e = estimate_render_memory(scene, s, stream_engine, threads);
     if (e.total_bytes <= limit_bytes) return;
-    const RenderSettings& s = scene.settings;
     std::string msg = "image " + std::to_string(s.width) + "x" + std::to_string(s.height) + ", spp " +
                       std::to_string(s.spp) + ", depth " + std::to_string(s.depth) + " would need about " +
                       format_bytes(e.total_bytes) + " of memory (framebuffer " + format_bytes(e.framebuffer_bytes) +

@@ -23,14 +23,23 @@ struct MemoryEstimate {
 /// the generations deepest first (stream/stages.h, trace_generation): per thread it holds at
 /// most 2 x slice rays per generation a ray can reach (depth + 2 with mirrors or glass, else 1),
 /// plus a few slice-sized buffers; linear in depth, never 2^depth.
-MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, int threads);
+/// `settings`: what is rendered (a render job's); the scene's own in the second form.
+MemoryEstimate estimate_render_memory(const Scene& scene, const RenderSettings& settings, bool stream_engine,
+                                      int threads);
+inline MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_engine, int threads) {
+    return estimate_render_memory(scene, scene.settings, stream_engine, threads);
+}
 
 /// Physical memory of the machine: sysconf(_SC_PHYS_PAGES) * page size (0 if unknown).
 double physical_memory_bytes();
 
 /// Throws UsageError (one line, what it would need and what there is) when the estimate
 /// exceeds `limit_bytes` (default: physical memory; a limit <= 0 means unknown: no check).
-void check_render_memory(const Scene& scene, bool stream_engine, int threads, double limit_bytes = -1);
+void check_render_memory(const Scene& scene, const RenderSettings& settings, bool stream_engine, int threads,
+                         double limit_bytes = -1);
+inline void check_render_memory(const Scene& scene, bool stream_engine, int threads, double limit_bytes = -1) {
+    check_render_memory(scene, scene.settings, stream_engine, threads, limit_bytes);
+}
 
 /// "12.0 GiB", "512 KiB", "3.5e+70 GiB".
 std::string format_bytes(double bytes);

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <utility>
 
 #include "baseline/recursive_renderer.h"
 #include "stream/stream_renderer.h"
@@ -16,12 +17,19 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+/// A scene the caller keeps alive: a shared pointer that owns nothing.
+std::shared_ptr<const Scene> borrowed(const Scene& scene) { return std::shared_ptr<const Scene>(std::shared_ptr<const Scene>(), &scene); }
+
 class PreparedRecursive final : public PreparedRender {
   public:
-    PreparedRecursive(const Scene& scene, const EngineOptions& options) : renderer_(scene, options.accel) {}
+    PreparedRecursive(std::shared_ptr<const Scene> scene, const RenderSettings& settings, const EngineOptions& options)
+        : scene_(std::move(scene)), renderer_(*scene_, settings, options.accel) {}
     Framebuffer render(Parallelism& par, RenderProgress* progress) override { return renderer_.render(par, progress); }
     bool reads_scene_objects() const override { return true; }
-    void update_engine(const Scene&, const FrameChange& change) override { renderer_.update(change); }
+    void update_engine(std::shared_ptr<const Scene> scene, const FrameChange& change) override {
+        renderer_.update(*scene, change);
+        scene_ = std::move(scene);  // the frame before is let go once the renderer reads this one
+    }
     void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
         for (int y = tile.y0; y < tile.y1; ++y)
             for (int x = tile.x0; x < tile.x1; ++x) {
@@ -35,18 +43,22 @@ class PreparedRecursive final : public PreparedRender {
     }
 
   private:
+    std::shared_ptr<const Scene> scene_;  ///< the scene renderer_ reads: declared first, destroyed last
     RecursiveRenderer renderer_;
 };
 
 class PreparedStream final : public PreparedRender {
   public:
-    PreparedStream(const Scene& scene, const EngineOptions& options)
-        : renderer_(scene, options.isa, options.shade, options.slice_rays, options.accel), profile_(options.profile) {}
+    PreparedStream(const Scene& scene, const RenderSettings& settings, const EngineOptions& options)
+        : renderer_(scene, settings, options.isa, options.shade, options.slice_rays, options.accel),
+          profile_(options.profile) {}
     Framebuffer render(Parallelism& par, RenderProgress* progress) override {
         return renderer_.render(par, progress, profile_);
     }
     bool reads_scene_objects() const override { return false; }
-    void update_engine(const Scene& scene, const FrameChange& change) override { renderer_.update(scene, change); }
+    void update_engine(std::shared_ptr<const Scene> scene, const FrameChange& change) override {
+        renderer_.update(*scene, change);  // converted: the scene is not kept
+    }
     void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
         if (!profile_) return renderer_.render_one_tile(tile, rgb, counts, nullptr, cancel);
         StreamProfile local;
@@ -69,24 +81,31 @@ class PreparedStream final : public PreparedRender {
 
 }  // namespace
 
-std::unique_ptr<PreparedRender> prepare_render(const Scene& scene, EngineKind engine, const EngineOptions& options) {
+std::unique_ptr<PreparedRender> prepare_render(std::shared_ptr<const Scene> scene, const RenderSettings& settings,
+                                               EngineKind engine, const EngineOptions& options) {
     // Set-up (the engine's tables, the object hierarchy) and rendering are timed apart, so
     // that rays/s speaks of the rendering alone.
     const auto start = Clock::now();
     std::unique_ptr<PreparedRender> p;
-    if (engine == EngineKind::Recursive) p = std::make_unique<PreparedRecursive>(scene, options);
-    else p = std::make_unique<PreparedStream>(scene, options);
+    if (engine == EngineKind::Recursive) p = std::make_unique<PreparedRecursive>(std::move(scene), settings, options);
+    else p = std::make_unique<PreparedStream>(*scene, settings, options);
     p->setup_seconds = seconds_since(start);
-    p->width = scene.settings.width;
-    p->height = scene.settings.height;
+    p->width = settings.width;
+    p->height = settings.height;
     return p;
 }
 
-void PreparedRender::update(const Scene& scene, const FrameChange& change) {
+std::unique_ptr<PreparedRender> prepare_render(const Scene& scene, EngineKind engine, const EngineOptions& options) {
+    return prepare_render(borrowed(scene), scene.settings, engine, options);
+}
+
+void PreparedRender::update(std::shared_ptr<const Scene> scene, const FrameChange& change) {
     const auto start = Clock::now();
-    if (change.any()) update_engine(scene, change);
+    update_engine(std::move(scene), change);  // also without changes: the engine may hold the new scene
     setup_seconds = seconds_since(start);
 }
+
+void PreparedRender::update(const Scene& scene, const FrameChange& change) { update(borrowed(scene), change); }
 
 void render_tiles(PreparedRender& prepared, Parallelism& par, const TileSource& source, const TileSink& sink,
                   RenderProgress* progress) {

@@ -42,16 +42,23 @@ class PreparedRender {
   public:
     virtual ~PreparedRender() = default;
     virtual Framebuffer render(Parallelism& par, RenderProgress* progress) = 0;
-    /// False when the engine rendering no longer reads the scene's objects (the stream engine
-    /// renders from its own tables): the caller may then release them before rendering.
+    /// True when the engine reads the scene's objects while rendering (the recursive engine:
+    /// its hit points go through Md): it then holds the scene it renders (prepare_render's
+    /// shared pointer) as long as it lives. False when it renders from its own tables (the
+    /// stream engine: its meshes and images held through their own shared pointers): it holds
+    /// nothing of the scene, and a caller that lets go of the scene frees its objects.
     virtual bool reads_scene_objects() const = 0;
     /// Renders one tile into `rgb` (tile.width() x tile.height() x 3 floats, row by row): the
     /// values render() gives those pixels, on any thread, in any process. Thread-safe.
     virtual void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) = 0;
-    /// Animation (scene/animation.h): the scene given to prepare_render was put at another
-    /// frame by set_frame, which said what changed; the engine re-derives only that (moved
-    /// objects' records and hierarchy boxes, refitted or rebuilt; lights; camera).
-    /// setup_seconds becomes the time this took.
+    /// Animation (scene/animation.h): `scene` is the scene at another frame, a scene of the
+    /// same objects at other places (scene_at_frame, never the prepared scene changed in
+    /// place), and `change` what differs from the frame rendered so far (frame_change); the
+    /// engine re-derives only that (moved objects' records and hierarchy boxes, refitted or
+    /// rebuilt; lights; camera) and, if it reads the scene, holds `scene` in place of the one
+    /// before. setup_seconds becomes the time this took.
+    void update(std::shared_ptr<const Scene> scene, const FrameChange& change);
+    /// The same for a scene the caller keeps alive as long as this (tests, perf/).
     void update(const Scene& scene, const FrameChange& change);
     /// After render_tile calls: completes the profile's description (stream engine).
     virtual void finish_tiles(double /*wall_seconds*/, int /*threads*/) {}
@@ -59,7 +66,7 @@ class PreparedRender {
     int width = 0, height = 0;  ///< the image's size (the scene's settings)
 
   protected:
-    virtual void update_engine(const Scene& scene, const FrameChange& change) = 0;
+    virtual void update_engine(std::shared_ptr<const Scene> scene, const FrameChange& change) = 0;
 };
 
 /// One finished tile: its number (tile_rect), rectangle, pixels, rays and render time.
@@ -75,7 +82,13 @@ using TileSink = std::function<void(const TileOutput&)>;
 /// Hands out tile numbers to render (thread-safe); a negative number: no more.
 using TileSource = std::function<int()>;
 
-/// The set-up of an engine for `scene`, which must outlive it.
+/// The set-up of an engine for `scene` rendered with `settings` (a render job's, overrides
+/// applied; the scene's own settings are not read). The prepared render holds `scene` while
+/// it reads it (reads_scene_objects), so the caller's reference may be let go.
+std::unique_ptr<PreparedRender> prepare_render(std::shared_ptr<const Scene> scene, const RenderSettings& settings,
+                                               EngineKind engine, const EngineOptions& options = {});
+/// The set-up of an engine for `scene` with its own settings; `scene` must outlive it (tests,
+/// perf/).
 std::unique_ptr<PreparedRender> prepare_render(const Scene& scene, EngineKind engine, const EngineOptions& options = {});
 
 /// Set-up then rendering, the two timed apart.

@@ -115,10 +115,11 @@ std::string settings_token(const PixelSettings& s) {
     return token;
 }
 
-RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile) {
+RenderJob build_render_job(std::shared_ptr<const Scene> scene, const RenderOverrides& o, bool profile) {
     RenderJob job;
     job.scene = std::move(scene);
-    RenderSettings& s = job.scene.settings;
+    job.render_settings = job.scene->settings;
+    RenderSettings& s = job.render_settings;
     const auto in = [](const char* name, int v, int lo, int hi) {
         if (v < lo || v > hi)
             throw UsageError(std::string(name) + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
@@ -134,18 +135,14 @@ RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile) 
         if (!(*o.cutoff >= 0 && *o.cutoff <= 1)) throw UsageError("cutoff must be in [0, 1]");
         s.cutoff = *o.cutoff;
     }
-    if (o.light_samples)
-        for (Light& l : job.scene.lights)
-            if (l.is_area()) l.samples = in("light_samples", *o.light_samples, 1, 4096);
+    if (o.light_samples) s.light_samples = in("light_samples", *o.light_samples, 1, 4096);  // rendered_light
     if (o.sampler) s.pattern = named("sampler", *o.sampler, kSamplePatternNames);
     if (o.colorspace) s.colorspace = named("colorspace", *o.colorspace, kColorSpaceNames);
     if (o.tonemap) s.tonemap = named("tonemap", *o.tonemap, kTonemapNames);
     if (o.output) s.output = *o.output;
     if (o.exposure) s.exposure = *o.exposure;
-    if (o.frame) {
-        if (*o.frame < 0) throw UsageError("frame must be >= 0");
-        if (job.scene.animation) set_frame(job.scene, *o.frame);
-    }
+    // The frame's scene is made when the engine is prepared (prepare_job).
+    if (o.frame && *o.frame < 0) throw UsageError("frame must be >= 0");
     job.engine = o.engine ? named("engine", *o.engine, kEngineNames) : EngineKind::Stream;
     job.threads = o.threads.value_or(0);
     if (o.accel) job.options.accel.mode = named("accel", *o.accel, accel::kAccelModeNames);
@@ -167,6 +164,16 @@ RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile) 
     p.exr = s.exr;
     p.engine = job.engine, p.isa = job.options.isa, p.accel = job.options.accel.mode, p.shade = job.options.shade;
     return job;
+}
+
+std::unique_ptr<PreparedRender> prepare_job(const RenderJob& job, EngineKind engine, int frame) {
+    return prepare_render(scene_at_frame(job.scene, frame), job.render_settings, engine, job.options);
+}
+
+void update_job_frame(PreparedRender& prepared, const RenderJob& job, int from, int to) {
+    // Without keys every frame is the scene as read (which a job may have let go of then).
+    if (!job.scene || !job.scene->animation) return;
+    prepared.update(scene_at_frame(job.scene, to), frame_change(*job.scene->animation, from, to));
 }
 
 }  // namespace streamrt

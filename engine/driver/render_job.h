@@ -1,6 +1,7 @@
 #pragma once
-// A render job: a scene with the command line's overrides applied, the engine and its
-// options. Built once here for every front end (the Python module; the command line).
+// A render job: a parsed scene, never changed, with the settings it is rendered with (the
+// scene's own, the front end's overrides applied), the engine and its options. Built once
+// here for every front end (the Python module; the command line).
 #include <memory>
 #include <optional>
 #include <string>
@@ -66,7 +67,14 @@ bool set_override(RenderOverrides& o, const std::string& name, const std::string
 std::string override_names();
 
 struct RenderJob {
-    Scene scene;
+    /// The scene as read, immutable and shared (jobs made from one parsed scene share it). A
+    /// front end may let go of it (reset) once the engine is prepared and nothing is prepared
+    /// from it again: a prepared render holds what it reads (PreparedRender::reads_scene_objects).
+    std::shared_ptr<const Scene> scene;
+    /// The scene's settings with the overrides applied: what the engines render and the image
+    /// is written with. `output` is the name as given: for frames a pattern (printf-style %d)
+    /// whose name for a frame is made where the file is written.
+    RenderSettings render_settings;
     PixelSettings settings;  ///< what the pixels depend on beside the scene's files
     EngineKind engine = EngineKind::Stream;
     EngineOptions options;
@@ -74,7 +82,16 @@ struct RenderJob {
     int threads = 0;                         ///< <= 0: all cores
 };
 
-/// Applies the overrides to the scene and checks them (UsageError: one line).
-RenderJob build_render_job(Scene scene, const RenderOverrides& o, bool profile);
+/// The job for `scene` with the overrides applied to its settings (the scene is not
+/// changed) and checked (UsageError: one line).
+RenderJob build_render_job(std::shared_ptr<const Scene> scene, const RenderOverrides& o, bool profile);
+
+/// The engine's set-up for the job's scene at `frame` (< 0: the scene as read; an animated
+/// frame is a new scene, scene_at_frame), rendered with the job's settings.
+std::unique_ptr<PreparedRender> prepare_job(const RenderJob& job, EngineKind engine, int frame);
+
+/// Brings a set-up of the job's scene at frame `from` to frame `to` (only what changed is
+/// re-derived). An animated scene's job must still hold its scene.
+void update_job_frame(PreparedRender& prepared, const RenderJob& job, int from, int to);
 
 }  // namespace streamrt

@@ -107,7 +107,7 @@ struct Result {
 /// Renders `job` on a worker thread while this (the Python) thread waits with the GIL
 /// released, waking every 50 ms to run Python's signal handlers and the progress callback.
 /// A pending KeyboardInterrupt (or an exception from the callback) cancels the render.
-RenderResult render_watched(RenderJob& job, EngineKind engine, const py::object& progress) {
+RenderResult render_watched(const RenderJob& job, EngineKind engine, const py::object& progress) {
     std::atomic<bool> cancel{false};
     RenderProgress watch;
     watch.cancel = &cancel;
@@ -117,7 +117,7 @@ RenderResult render_watched(RenderJob& job, EngineKind engine, const py::object&
     std::thread worker([&] {
         try {
             Parallelism par(job.threads);
-            auto prepared = prepare_render(job.scene, engine, job.options);
+            auto prepared = prepare_job(job, engine, job.settings.frame);
             watch.tiles_total = tile_count(prepared->width, prepared->height);
             result = render_prepared(*prepared, par, &watch);
         } catch (...) {
@@ -191,16 +191,17 @@ RenderOverrides overrides_of(const py::kwargs& kw, bool& profile, py::object& pr
     return o;
 }
 
-/// The scene a call names: a Scene built in Python, a .cfg path, or .cfg text.
-Scene read_any(const py::object& scene, int threads) {
+/// The scene a call names: a Scene built in Python, a .cfg path, or .cfg text; immutable
+/// once read (the job renders it with its own settings).
+std::shared_ptr<const Scene> read_any(const py::object& scene, int threads) {
     if (py::isinstance<PyScene>(scene)) {
         const PyScene& s = scene.cast<const PyScene&>();
         py::gil_scoped_release release;
-        return read_scene(s, threads);
+        return std::make_shared<const Scene>(read_scene(s, threads));
     }
     const std::string text = scene.cast<std::string>();
     py::gil_scoped_release release;
-    return read_scene(text, threads);
+    return std::make_shared<const Scene>(read_scene(text, threads));
 }
 
 Result render(const py::object& scene, const py::kwargs& kw) {
@@ -208,7 +209,7 @@ Result render(const py::object& scene, const py::kwargs& kw) {
     py::object progress = py::none();
     const RenderOverrides o = overrides_of(kw, profile, progress);
     const auto start = Clock::now();
-    Scene sc = read_any(scene, o.threads.value_or(0));
+    std::shared_ptr<const Scene> sc = read_any(scene, o.threads.value_or(0));
     const double read_seconds = since(start);
     RenderJob job = build_render_job(std::move(sc), o, profile);
     RenderResult r = render_watched(job, job.engine, progress);
@@ -220,7 +221,7 @@ py::dict compare(const py::object& scene, const py::kwargs& kw) {
     py::object progress = py::none();
     const RenderOverrides o = overrides_of(kw, profile, progress);
     const auto start = Clock::now();
-    Scene sc = read_any(scene, o.threads.value_or(0));
+    std::shared_ptr<const Scene> sc = read_any(scene, o.threads.value_or(0));
     const double read_seconds = since(start);
     RenderJob job = build_render_job(std::move(sc), o, profile);
     RenderResult stream = render_watched(job, EngineKind::Stream, progress);

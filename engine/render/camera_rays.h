@@ -28,9 +28,11 @@ struct CameraRays {
     Vec3T<T> lens_u{}, lens_v{};
     T lens_radius = T(0), focus_scale = T(1);
 
-    static CameraRays from(const Scene& scene) {
-        const RenderSettings& s = scene.settings;
-        const glm::dmat4 md = scene.camera.world_from_canonical(s.width, s.height);
+    static CameraRays from(const Scene& scene) { return from(scene.camera, scene.settings); }
+    /// The camera for an image of these settings (a render job's, which may override the
+    /// scene's size and samples).
+    static CameraRays from(const Camera& camera, const RenderSettings& s) {
+        const glm::dmat4 md = camera.world_from_canonical(s.width, s.height);
         const glm::dvec3 e = transform_point(md, {0.0, 0.0, 1.0});
         const auto v = [](const glm::dvec3& a) { return Vec3T<T>{T(a.x), T(a.y), T(a.z)}; };
         // A pixel spans 2 / width of the canonical screen (|Md x| per unit) at distance
@@ -49,8 +51,8 @@ struct CameraRays {
                 T(pixel / std::sqrt(double(s.spp))),
                 v(lu),
                 v(lv),
-                T(scene.camera.aperture),
-                T(scene.camera.focus_distance(md) / glm::length(glm::dvec3(md[2])))};
+                T(camera.aperture),
+                T(camera.focus_distance(md) / glm::length(glm::dvec3(md[2])))};
     }
 
     bool has_lens() const { return lens_radius > T(0); }

@@ -104,13 +104,20 @@ glm::dmat4 keyed_transform(const ObjectTrack& track, int frame) {
     return m;
 }
 
+namespace {
+/// An object's Md at `frame`: its keys' T R S times its statement's Md.
+glm::dmat4x3 keyed_md(const ObjectTrack& t, int frame) {
+    return glm::dmat4x3(keyed_transform(t, frame) * glm::dmat4(t.base));
+}
+}  // namespace
+
 FrameChange set_frame(Scene& scene, int frame) {
     FrameChange change;
     if (!scene.animation) return change;
     const Animation& anim = *scene.animation;
     for (const ObjectTrack& t : anim.objects) {
         Object& o = scene.objects[t.object];
-        const glm::dmat4x3 md(keyed_transform(t, frame) * glm::dmat4(t.base));
+        const glm::dmat4x3 md = keyed_md(t, frame);
         if (md != o.md) {
             o.md = md;
             change.objects.push_back(t.object);
@@ -137,6 +144,26 @@ FrameChange set_frame(Scene& scene, int frame) {
         change.camera = c.eye != before.eye || c.look != before.look || c.fov != before.fov;
     }
     return change;
+}
+
+FrameChange frame_change(const Animation& anim, int from, int to) {
+    from = std::max(from, 0), to = std::max(to, 0);
+    FrameChange change;
+    if (from == to) return change;
+    for (const ObjectTrack& t : anim.objects)
+        if (keyed_md(t, from) != keyed_md(t, to)) change.objects.push_back(t.object);
+    const auto moved = [&](const auto& track) { return !track.empty() && sample(track, from) != sample(track, to); };
+    for (const LightTrack& t : anim.lights) change.lights = change.lights || moved(t.pos) || moved(t.color);
+    change.camera = moved(anim.camera.eye) || moved(anim.camera.look) || moved(anim.camera.fov);
+    return change;
+}
+
+std::shared_ptr<const Scene> scene_at_frame(const std::shared_ptr<const Scene>& base, int frame) {
+    // The scene as read is at frame 0: a frame with frame 0's values is that scene.
+    if (!base->animation || !frame_change(*base->animation, 0, frame).any()) return base;
+    auto at = std::make_shared<Scene>(*base);  // a new scene: the objects are copied once
+    set_frame(*at, frame);
+    return at;
 }
 
 }  // namespace streamrt

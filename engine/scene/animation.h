@@ -11,6 +11,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -87,9 +88,21 @@ glm::dquat sample(const Track<glm::dquat>& track, int frame);
 /// The keyed part T R S of an object's Md at `frame` (identity for tracks without keys).
 glm::dmat4 keyed_transform(const ObjectTrack& track, int frame);
 
-/// Puts the scene at `frame`: keyed objects' Md, keyed lights, the keyed camera. Returns what
-/// differs from the scene's state before the call. A scene without animation: nothing.
-/// Throws UsageError when the camera is degenerate at that frame (eye on look).
+/// Puts a scene being built at `frame`: keyed objects' Md, keyed lights, the keyed camera.
+/// Returns what differs from the scene's state before the call. A scene without animation:
+/// nothing. Throws UsageError when the camera is degenerate at that frame (eye on look).
+/// The reader puts its scene at frame 0 with it, scene_at_frame its new scene at the frame
+/// asked for; a scene the reader has returned is never put at another frame.
 FrameChange set_frame(Scene& scene, int frame);
+
+/// The scene at `frame` (< 0: the scene as read) as a new scene built from `base`, the scene
+/// as read (frame 0), which is left as it is: `base` itself when that frame changes nothing
+/// (no animation, frame 0, keys that hold frame 0's values). UsageError as set_frame.
+std::shared_ptr<const Scene> scene_at_frame(const std::shared_ptr<const Scene>& base, int frame);
+
+/// What differs between frames `from` and `to` of one animation (frames < 0: frame 0), as
+/// set_frame would report putting a scene at `from` at `to`: what an engine set up at `from`
+/// re-derives (PreparedRender::update).
+FrameChange frame_change(const Animation& animation, int from, int to);
 
 }  // namespace streamrt

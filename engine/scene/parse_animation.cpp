@@ -37,8 +37,8 @@ void Parser::name_thing(const std::string& file, int line, const Arg& a, Named w
 }
 
 Animation& Parser::animation() {
-    if (!scene.animation) scene.animation = std::make_shared<Animation>();
-    return *scene.animation;
+    if (!animation_) animation_ = std::make_shared<Animation>();
+    return *animation_;
 }
 
 void Parser::key(Statement& st, const std::vector<Token>& toks) {
@@ -145,7 +145,8 @@ glm::dquat Parser::rotation(const Statement& st, const Arg& a) {
 }
 
 void Parser::finish() {
-    if (!scene.animation) return;
+    if (!animation_) return;
+    scene.animation = std::move(animation_);
     try {
         set_frame(scene, 0);
     } catch (const UsageError& e) {

@@ -279,7 +279,9 @@ class Parser {
     /// and the camera.
     void name_thing(const std::string& file, int line, const Arg& a, Named what, std::uint32_t index);
 
+    /// The keys read so far (made at the first key statement); given to the scene by finish().
     Animation& animation();
+    std::shared_ptr<Animation> animation_;
 
     /// key NAME frame=F k=v...: one key at frame F for each quantity given.
     void key(Statement& st, const std::vector<Token>& toks);
@@ -292,8 +294,8 @@ class Parser {
     static void frame_range(const Statement& st, const Arg& a, int& first, int& last);
 
   public:
-    /// After the whole text: the scene is put at frame 0 (a still picture of an animated
-    /// scene is frame 0).
+    /// After the whole text: the scene gets its keys and is put at frame 0 (a still picture of
+    /// an animated scene is frame 0).
     void finish();
 };
 

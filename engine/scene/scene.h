@@ -3,6 +3,10 @@
 // a camera placed by Md, and the render settings. Geometry is in double (Md, lights, camera);
 // objects are compact records with an index into deduplicated materials (a scene may hold
 // millions). Each engine converts to its own tables when it builds its pipeline.
+//
+// A scene is immutable once the reader returns it: front ends hold it as
+// std::shared_ptr<const Scene> (driver/render_job.h). Overrides live in the render job's
+// settings, a frame of an animation is a new scene (scene_at_frame, scene/animation.h).
 #include <glm/glm.hpp>
 
 #include <array>
@@ -127,6 +131,9 @@ struct RenderSettings {
     Tonemap tonemap = Tonemap::Clamp;
     double exposure = 1.0;  ///< > 0, multiplies the linear values before the tone curve
     ExrPixels exr = ExrPixels::Half;
+    /// > 0: every area light's samples per shaded point, in place of its own samples= (a
+    /// front end's override, --light-samples; no `image` key sets it). 0: each light's own.
+    int light_samples = 0;
 
     // ---- animation (scene/animation.h) ----
     /// `image frames=A..B`: the frames rendered by default (frames_last < frames_first: none
@@ -137,6 +144,13 @@ struct RenderSettings {
 
 /// The `image` keys' display colour chain (image/display_settings.h).
 Display display_of(const RenderSettings& s);
+
+/// The light as a render with these settings samples it: an area light's samples are
+/// settings.light_samples when that is set (the scene's own light is not changed).
+inline Light rendered_light(Light l, const RenderSettings& s) {
+    if (s.light_samples > 0 && l.is_area()) l.samples = s.light_samples;
+    return l;
+}
 
 struct Scene {
     std::string path;  ///< the file it was read from
@@ -151,8 +165,9 @@ struct Scene {
     std::vector<ObjectLoc> object_locs;
     std::vector<std::string> files;  ///< the files objects came from (ObjectLoc::file)
     /// The keys of `key` statements (scene/animation.h); null for a scene without keys. The
-    /// scene as read is at frame 0; set_frame() puts it at another.
-    std::shared_ptr<Animation> animation;
+    /// scene as read is at frame 0; scene_at_frame() builds the scene at another frame as a
+    /// new scene (a parsed scene is never changed).
+    std::shared_ptr<const Animation> animation;
 
     const Material& material_of(const Object& o) const { return materials[o.material]; }
     /// The object's mesh (Mesh objects only; nullptr otherwise).

@@ -10,9 +10,9 @@
 
 namespace streamrt {
 
-StreamRenderer::StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade, std::size_t slice_rays,
-                               const accel::AccelConfig& accel)
-    : scene_(scene, accel),
+StreamRenderer::StreamRenderer(const Scene& scene, const RenderSettings& settings, Isa isa, ShadeMode shade,
+                               std::size_t slice_rays, const accel::AccelConfig& accel)
+    : scene_(scene, settings, accel),
       kernels_(kernel_table(isa)),
       tile_fn_(nullptr),
       shade_mode_(resolve_shade_mode(scene_, shade)),

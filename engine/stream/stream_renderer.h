@@ -22,8 +22,13 @@ class StreamRenderer {
     /// slice_rays: the most rays of one generation traced at once per thread (0: the default,
     /// max(kSliceRays, spp)); smaller values are for tests.
     /// accel: whether and how the object hierarchy is used (EngineOptions::accel).
+    /// settings: what is rendered (a render job's; the scene's own in the second form). The
+    /// renderer keeps no reference to `scene` (StreamScene).
+    StreamRenderer(const Scene& scene, const RenderSettings& settings, Isa isa, ShadeMode shade = ShadeMode::Auto,
+                   std::size_t slice_rays = 0, const accel::AccelConfig& accel = {});
     StreamRenderer(const Scene& scene, Isa isa, ShadeMode shade = ShadeMode::Auto, std::size_t slice_rays = 0,
-                   const accel::AccelConfig& accel = {});
+                   const accel::AccelConfig& accel = {})
+        : StreamRenderer(scene, scene.settings, isa, shade, slice_rays, accel) {}
 
     /// Renders the image. With a profile, every stage is timed and counted into it.
     Framebuffer render(Parallelism& par, RenderProgress* progress = nullptr, StreamProfile* profile = nullptr) const;
@@ -37,8 +42,8 @@ class StreamRenderer {
     /// Fills the profile's description of the run: wall time, threads, kernels and stages.
     void describe(StreamProfile& profile, double wall_seconds, int threads) const;
 
-    /// Animation: `scene` (the one this renderer was made for) was put at another frame;
-    /// only what `change` names is converted again (StreamScene::update).
+    /// Animation: `scene` is the scene at another frame (of the one this renderer was made
+    /// for); only what `change` names is converted again (StreamScene::update).
     void update(const Scene& scene, const FrameChange& change) { scene_.update(scene, change); }
 
     /// Names of the stages and kernels this scene's pipeline is built from.

@@ -19,17 +19,15 @@ namespace {
 /// applied in double: Md' = T(-e) Md and Mi' = Mi T(e) (from the exact Mi, not re-inverted).
 /// The checker pattern needs world positions: MaterialT::cell_offset carries e / cell,
 /// reduced modulo the pattern's period of 2 cells (exactly, in double).
-/// The eye, and the camera-only scene (no objects) that places the camera relative to it.
-Scene camera_relative_to_eye(const Scene& scene, glm::dvec3& eye) {
-    Scene r;
-    r.settings = scene.settings;
-    const RenderSettings& s = scene.settings;
-    const glm::dmat4 cam = scene.camera.world_from_canonical(s.width, s.height);
+/// The eye, and the camera placed relative to it, for an image of these settings.
+Camera camera_relative_to_eye(const Camera& camera, const RenderSettings& s, glm::dvec3& eye) {
+    Camera r;
+    const glm::dmat4 cam = camera.world_from_canonical(s.width, s.height);
     eye = transform_point(cam, {0.0, 0.0, 1.0});
-    r.camera.look_at = false;
-    r.camera.md = translate_matrix(-eye) * cam;
-    r.camera.aperture = scene.camera.aperture;
-    r.camera.focus = scene.camera.focus_distance(cam);  // resolved: the default depends on the form
+    r.look_at = false;
+    r.md = translate_matrix(-eye) * cam;
+    r.aperture = camera.aperture;
+    r.focus = camera.focus_distance(cam);  // resolved: the default depends on the form
     return r;
 }
 
@@ -45,14 +43,15 @@ glm::vec3 cell_offset(const Material& m, const glm::dvec3& eye) {
 
 }  // namespace
 
-StreamScene::StreamScene(const Scene& scene, const accel::AccelConfig& accel_config)
-    : settings(scene.settings), accel_config_(accel_config) {
+StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settings,
+                         const accel::AccelConfig& accel_config)
+    : settings(render_settings), accel_config_(accel_config) {
     // Objects are moved as they are converted (no copy of the scene: at 1e6 objects that copy
     // doubled the memory and the set-up time).
     glm::dvec3 eye;
-    camera = CameraRays<float>::from(camera_relative_to_eye(scene, eye));
+    camera = CameraRays<float>::from(camera_relative_to_eye(scene.camera, settings, eye), settings);
     eye_ = eye;
-    const RenderSettings& s = scene.settings;
+    const RenderSettings& s = settings;
     background = {float(s.background.x), float(s.background.y), float(s.background.z)};
     meshes = scene.meshes;
     textures = scene.textures;
@@ -110,7 +109,8 @@ void StreamScene::fill_surfaces(const Scene& scene) {
 
 void StreamScene::convert_lights(const Scene& scene) {
     lights.clear();
-    for (Light l : scene.lights) {
+    for (const Light& given : scene.lights) {
+        Light l = rendered_light(given, settings);
         l.pos -= eye_;
         lights.push_back(LightT<float>::from(l));
     }
@@ -154,7 +154,7 @@ void StreamScene::convert_flat(const Scene& scene) {
 // ---- animation: per-frame update ----
 void StreamScene::update(const Scene& scene, const FrameChange& change) {
     glm::dvec3 eye = eye_;
-    if (change.camera) camera = CameraRays<float>::from(camera_relative_to_eye(scene, eye));
+    if (change.camera) camera = CameraRays<float>::from(camera_relative_to_eye(scene.camera, settings, eye), settings);
     const bool shifted = eye != eye_;
     eye_ = eye;
     if (change.lights || shifted) convert_lights(scene);

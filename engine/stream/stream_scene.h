@@ -62,10 +62,16 @@ struct StreamScene {
     std::vector<std::shared_ptr<const Texture>> textures;
 
     /// accel: whether and how the object hierarchy is used (EngineOptions::accel).
-    explicit StreamScene(const Scene& scene, const accel::AccelConfig& accel = {});
+    /// `settings` are what is rendered (a render job's; the scene's own in the second form).
+    /// Nothing here points into `scene` afterwards: the tables are converted, and the meshes
+    /// and images are held through their shared pointers.
+    StreamScene(const Scene& scene, const RenderSettings& settings, const accel::AccelConfig& accel = {});
+    explicit StreamScene(const Scene& scene, const accel::AccelConfig& accel = {})
+        : StreamScene(scene, scene.settings, accel) {}
 
-    /// Animation (scene/animation.h): `scene` was put at another frame; brings the tables up
-    /// to it, converting only what `change` names (all objects when the eye moved).
+    /// Animation (scene/animation.h): `scene` is the scene at another frame (the same objects
+    /// at other places); brings the tables up to it, converting only what `change` names (all
+    /// objects when the eye moved).
     void update(const Scene& scene, const FrameChange& change);
     StreamScene(const StreamScene&) = delete;  // `objects` may point into flat_objects_
     StreamScene& operator=(const StreamScene&) = delete;

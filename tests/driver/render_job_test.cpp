@@ -77,10 +77,11 @@ TEST_CASE("settings record: a job carries the overrides and the scene's own valu
     REQUIRE(set_override(o, "tonemap", "reinhard"));
     CHECK_FALSE(set_override(o, "colour", "red"));
     CHECK_THROWS_AS(set_override(o, "sampler", "halton"), UsageError);
-    const RenderJob job = build_render_job(sc, o, false);
+    const RenderJob job = build_render_job(std::make_shared<const Scene>(sc), o, false);
     CHECK(job.settings.width == 40);
     CHECK(job.settings.spp == 5);
-    CHECK(job.scene.settings.spp == 5);
+    CHECK(job.render_settings.spp == 5);
+    CHECK(job.scene->settings.spp == 3);  // the scene is not changed
     CHECK(job.settings.cutoff == 0.25);
     CHECK(job.settings.light_samples == 7);
     CHECK(job.settings.sampler == SamplePattern::Grid);
