@@ -4,6 +4,8 @@
 
 namespace streamrt::cli {
 
+std::atomic<bool> g_cancel{false};
+
 /// This process's rank when an MPI launcher started it (0 otherwise): messages that every
 /// rank would print alike are printed by rank 0 only.
 int launcher_rank() {

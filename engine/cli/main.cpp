@@ -4,7 +4,6 @@
 
 namespace streamrt::cli {
 
-std::atomic<bool> g_cancel{false};
 extern "C" void on_sigint(int) { g_cancel.store(true); }
 
 int run(int argc, char** argv) {

@@ -18,7 +18,9 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 /// A scene the caller keeps alive: a shared pointer that owns nothing.
-std::shared_ptr<const Scene> borrowed(const Scene& scene) { return std::shared_ptr<const Scene>(std::shared_ptr<const Scene>(), &scene); }
+std::shared_ptr<const Scene> borrowed(const Scene& scene) {
+    return std::shared_ptr<const Scene>(std::shared_ptr<const Scene>(), &scene);
+}
 
 class PreparedRecursive final : public PreparedRender {
   public:
