@@ -198,24 +198,27 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     return sink.color;
 }
 
-ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) const {
+ColorT<double> RecursiveRenderer::render_sample(int x, int y, SampleRun run, int j, RayCounts& counts) const {
     const RenderSettings& s = settings_;
     const CameraRays<double>& cam = camera_;
     const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(s.width) + std::uint64_t(x);
-    ColorT<double> sum{0, 0, 0};
-    for (int k = 0; k < s.spp; ++k) {
-        const PixelSample ps = pixel_sample(s.pattern, s.spp, pixel, k);
-        RayD ray{cam.origin, {}, 0.0};
-        if (cam.has_lens()) {  // thin lens: the sample's point on the lens (render/sampling.h)
-            const PixelSample ls = lens_sample(s.pattern, s.spp, pixel, k);
-            cam.lens_ray(double(x + ps.x), double(y + ps.y), double(ls.x), double(ls.y), ray.origin, ray.dir);
-        } else {
-            ray.dir = cam.direction(double(x + ps.x), double(y + ps.y));
-        }
-        ++counts.primary;
-        sum = sum + trace(ray, 0, counts, light_key(pixel, k));
+    const PixelSample ps = pixel_sample(s.pattern, run, pixel, j);
+    RayD ray{cam.origin, {}, 0.0};
+    if (cam.has_lens()) {  // thin lens: the sample's point on the lens (render/sampling.h)
+        const PixelSample ls = lens_sample(s.pattern, run, pixel, j);
+        cam.lens_ray(double(x + ps.x), double(y + ps.y), double(ls.x), double(ls.y), ray.origin, ray.dir);
+    } else {
+        ray.dir = cam.direction(double(x + ps.x), double(y + ps.y));
     }
-    return sum * (1.0 / s.spp);
+    ++counts.primary;
+    return trace(ray, 0, counts, light_key(pixel, run.first + j));
+}
+
+ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) const {
+    const int spp = settings_.spp;
+    ColorT<double> sum{0, 0, 0};
+    for (int k = 0; k < spp; ++k) sum = sum + render_sample(x, y, SampleRun{0, spp}, k, counts);
+    return sum * (1.0 / spp);
 }
 
 Framebuffer RecursiveRenderer::render(Parallelism& par, RenderProgress* progress) const {

@@ -12,6 +12,7 @@
 #include "parallel/parallelism.h"
 #include "render/camera_rays.h"
 #include "render/render_stats.h"
+#include "render/sampling.h"
 #include "render/shading.h"
 #include "mesh/mesh_trace.h"
 #include "scene/animation.h"
@@ -63,6 +64,8 @@ class RecursiveRenderer {
 
     /// One pixel's colour: the average over its samples.
     ColorT<double> render_pixel(int x, int y, RayCounts& counts) const;
+    /// The colour of camera sample j of `run` (render/sampling.h) in pixel (x, y).
+    ColorT<double> render_sample(int x, int y, SampleRun run, int j, RayCounts& counts) const;
 
     /// Animation: `scene` is the scene at another frame (scene_at_frame: the same objects,
     /// materials and meshes, at other places), read from now on; re-derives what `change`

@@ -81,6 +81,9 @@ struct Options {
     std::string colorspace, tonemap;
     std::optional<double> exposure;
     std::string frames;  ///< --frames A..B (animation)
+    // Adaptive sampling (docs/adaptive-sampling.md).
+    std::optional<double> adaptive, target_error, time_limit;
+    std::string aov;  ///< --aov samples=FILE: the per-pixel sample counts and error estimates
     /// Rendered tile by tile (render_tiles) rather than as one image.
     bool tiled() const { return mpi || shard_n > 0 || !checkpoint.empty() || !tile_costs.empty(); }
 };
@@ -124,7 +127,10 @@ std::unique_ptr<PreparedRender> prepare(Job& job, EngineKind which, bool keep_sc
 void report_profile(const Options& opt, const StreamProfile* profile);
 /// The summary line.
 void print_summary(const Options& opt, const Job& job, int jobs, const std::string& how, double seconds,
-                   const RayCounts& counts, double setup_seconds, double write_seconds);
+                   const RayCounts& counts, double setup_seconds, double write_seconds,
+                   const std::optional<AdaptiveSummary>& adaptive = std::nullopt);
+/// The file of --aov samples=FILE (empty: none); UsageError for another AOV or format.
+std::string sample_map_path(const Options& opt);
 
 // ---- picture.cpp ----
 /// The output name of frame `frame` (printf-style %d), nullopt without one.

@@ -53,6 +53,7 @@ RenderOverrides overrides_of(const Options& opt) {
     RenderOverrides o;
     o.width = opt.width, o.height = opt.height, o.spp = opt.spp, o.depth = opt.depth, o.degree = opt.degree;
     o.cutoff = opt.cutoff, o.light_samples = opt.light_samples, o.exposure = opt.exposure;
+    o.adaptive = opt.adaptive, o.target_error = opt.target_error, o.time_limit = opt.time_limit;
     const auto text = [](const std::string& v) { return v.empty() ? std::nullopt : std::optional<std::string>(v); };
     o.sampler = text(opt.sampler), o.colorspace = text(opt.colorspace), o.tonemap = text(opt.tonemap);
     o.engine = opt.engine, o.accel = opt.accel, o.shade = opt.shade;
@@ -81,7 +82,17 @@ Job make_job(const Options& opt, std::shared_ptr<const Scene> scene, bool writes
     if (opt.mpi && s.frames_last > s.frames_first)
         throw UsageError("--mpi renders one picture, the scene's image frames= asks for several (render them as a job "
                          "array, docs/distributed.md)");
+    // The image's target and the clock decide across the whole image at once: a tile
+    // rendered alone (another process, a resumed journal) cannot know them.
+    if ((opt.target_error || opt.time_limit) && opt.tiled())
+        throw UsageError("--target-error and --time-limit decide over the whole image: not with --mpi, --shard, "
+                         "--checkpoint or --tile-costs (--adaptive T is the same in every tile)");
+    const std::string sample_map = sample_map_path(opt);
+    if (!sample_map.empty() && (job.render_settings.adaptive == 0 || opt.tiled() || opt.compare))
+        throw UsageError("--aov samples= needs adaptive sampling (--adaptive, --target-error or image adaptive=) on "
+                         "one whole image (not --compare or a tiled render)");
     if (writes) {
+        if (!sample_map.empty()) check_writable_path(sample_map, opt.scene_path);
         // A shard part is a tile file (docs/distributed.md), whatever its name.
         if (opt.shard_n > 0) check_writable_path(s.output, opt.scene_path);
         else check_output_path(s.output, opt.scene_path);
@@ -111,16 +122,34 @@ void report_profile(const Options& opt, const StreamProfile* profile) {
     if (!opt.profile_json.empty()) write_text_file(opt.profile_json, profile->json());
 }
 
+std::string sample_map_path(const Options& opt) {
+    if (opt.aov.empty()) return {};
+    const std::string prefix = "samples=";
+    const std::string path = opt.aov.rfind(prefix, 0) == 0 ? opt.aov.substr(prefix.size()) : std::string();
+    if (path.empty()) throw UsageError("--aov " + opt.aov + ": expected samples=FILE");
+    const ImageFormat* f = image_format_for(path);
+    if (!f || f->display_encoded)
+        throw UsageError("--aov samples=" + path + ": the sample map is written as .pfm or .exr (linear floats)");
+    return path;
+}
+
 /// The summary line.
 void print_summary(const Options& opt, const Job& job, int jobs, const std::string& how, double seconds,
-                   const RayCounts& counts, double setup_seconds, double write_seconds) {
+                   const RayCounts& counts, double setup_seconds, double write_seconds,
+                   const std::optional<AdaptiveSummary>& adaptive) {
     if (opt.quiet) return;
     const RenderSettings& s = job.render_settings;
     const std::string frame = job.frame >= 0 ? ", frame " + std::to_string(job.frame) : "";
     const double mrays = counts.total() / std::max(seconds, 1e-9) / 1e6;
-    std::printf("%s: %dx%d, spp %d, degree %d, %s engine%s, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s"
+    char spp[160];
+    if (adaptive)
+        std::snprintf(spp, sizeof spp, "spp %.2f adaptive (at most %d, estimated error %.3g%s)", adaptive->mean_spp,
+                      s.spp, adaptive->estimated_rmse, adaptive->time_limited ? ", time limit reached" : "");
+    else
+        std::snprintf(spp, sizeof spp, "spp %d", s.spp);
+    std::printf("%s: %dx%d, %s, degree %d, %s engine%s, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s"
                 " (read %.3f s, set-up %.3f s, render %.3f s, write %.3f s)\n",
-                opt.scene_path.c_str(), s.width, s.height, s.spp, s.degree, engine_name(job.engine), (how + frame).c_str(), jobs,
+                opt.scene_path.c_str(), s.width, s.height, spp, s.degree, engine_name(job.engine), (how + frame).c_str(), jobs,
                 seconds, static_cast<unsigned long long>(counts.total()), mrays, setup_seconds, output_name(job).c_str(),
                 job.read_seconds, setup_seconds, seconds, write_seconds);
 }

@@ -50,6 +50,18 @@ int run(int argc, char** argv) {
     app.add_flag("--compare", opt.compare, "Render with both engines and report times, speedup and image difference");
     app.add_option("--sampler", opt.sampler, "Pixel sampling: stratified, grid or random")
         ->check(CLI::IsMember(names_vector(kSamplePatternNames)));
+    app.add_option("--adaptive", opt.adaptive,
+                   "Adaptive sampling: a pixel stops taking samples once the standard error of its mean luminance is "
+                   "at most T (e.g. 0.002); --spp is the most it takes (default 64)")
+        ->check(CLI::Range(0.0, 1.0));
+    app.add_option("--target-error", opt.target_error,
+                   "Adaptive sampling until the image's estimated RMSE (luminance) is at most E")
+        ->check(CLI::Range(1e-9, 1.0));
+    app.add_option("--time-limit", opt.time_limit,
+                   "Adaptive sampling: stop refining after S seconds of rendering and write the picture so far")
+        ->check(CLI::Range(1e-9, 1e9));
+    app.add_option("--aov", opt.aov,
+                   "samples=FILE: write each pixel's sample count and estimated error (.pfm or .exr; adaptive)");
     app.add_flag("-q,--quiet", opt.quiet, "No progress bar and no summary line");
     app.add_flag("--check", opt.check_only, "Validate the scene and the output path, render nothing");
     app.add_flag("--mpi", opt.mpi, "Render with the ranks of an MPI job: mpirun -np N streamrt --mpi ...");

@@ -121,9 +121,14 @@ int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBu
     const RenderResult r = render_once(engine, true);
     const auto phase_start = Clock::now();
     if (!write_image(output, r.image, display_of(s), wo)) throw Interrupted{};
+    if (const std::string map = sample_map_path(opt); !map.empty() && r.adaptive) {
+        Display floats;
+        floats.exr = ExrPixels::Float;  // counts above 2048 are not all whole numbers in half
+        if (!write_image(map, r.sample_map, floats, wo)) throw Interrupted{};
+    }
     const double write_seconds = since(phase_start);
     report_profile(opt, job.profile.get());
-    print_summary(opt, job, par.jobs(), "", r.seconds, r.counts, r.setup_seconds, write_seconds);
+    print_summary(opt, job, par.jobs(), "", r.seconds, r.counts, r.setup_seconds, write_seconds, r.adaptive);
     return 0;
 }
 

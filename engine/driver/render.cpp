@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "baseline/recursive_renderer.h"
+#include "driver/adaptive_render.h"
 #include "stream/stream_renderer.h"
 
 namespace streamrt {
@@ -26,13 +27,28 @@ class PreparedRecursive final : public PreparedRender {
   public:
     PreparedRecursive(std::shared_ptr<const Scene> scene, const RenderSettings& settings, const EngineOptions& options)
         : scene_(std::move(scene)), renderer_(*scene_, settings, options.accel) {}
-    Framebuffer render(Parallelism& par, RenderProgress* progress) override { return renderer_.render(par, progress); }
     bool reads_scene_objects() const override { return true; }
+    void render_samples(const Tile& tile, SampleRun run, const std::uint32_t* pixels, int n_pixels, float* out,
+                        RayCounts& counts, const RenderProgress* cancel) override {
+        for (int i = 0; i < n_pixels; ++i) {
+            if (cancel && cancel->cancelled()) return;
+            const int x = tile.x0 + int(pixels[i]) % tile.width(), y = tile.y0 + int(pixels[i]) / tile.width();
+            for (int j = 0; j < run.count; ++j, out += 3) {
+                const ColorT<double> c = renderer_.render_sample(x, y, run, j, counts);
+                out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
+            }
+        }
+    }
+
+  protected:
+    Framebuffer render_uniform(Parallelism& par, RenderProgress* progress) override {
+        return renderer_.render(par, progress);
+    }
     void update_engine(std::shared_ptr<const Scene> scene, const FrameChange& change) override {
         renderer_.update(*scene, change);
         scene_ = std::move(scene);  // the frame before is let go once the renderer reads this one
     }
-    void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
+    void render_uniform_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
         for (int y = tile.y0; y < tile.y1; ++y)
             for (int x = tile.x0; x < tile.x1; ++x) {
                 if (cancel && cancel->cancelled()) return;
@@ -54,28 +70,42 @@ class PreparedStream final : public PreparedRender {
     PreparedStream(const Scene& scene, const RenderSettings& settings, const EngineOptions& options)
         : renderer_(scene, settings, options.isa, options.shade, options.slice_rays, options.accel),
           profile_(options.profile) {}
-    Framebuffer render(Parallelism& par, RenderProgress* progress) override {
-        return renderer_.render(par, progress, profile_);
-    }
     bool reads_scene_objects() const override { return false; }
-    void update_engine(std::shared_ptr<const Scene> scene, const FrameChange& change) override {
-        renderer_.update(*scene, change);  // converted: the scene is not kept
-    }
-    void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
-        if (!profile_) return renderer_.render_one_tile(tile, rgb, counts, nullptr, cancel);
-        StreamProfile local;
-        RayCounts c;
-        renderer_.render_one_tile(tile, rgb, c, &local, cancel);
-        counts += c;
-        std::lock_guard<std::mutex> lock(mutex_);
-        *profile_ += local;
-        profile_->counts += c;
+    void render_samples(const Tile& tile, SampleRun run, const std::uint32_t* pixels, int n_pixels, float* out,
+                        RayCounts& counts, const RenderProgress* cancel) override {
+        profiled(counts, [&](RayCounts& c, StreamProfile* p) {
+            renderer_.render_samples(tile, run, pixels, n_pixels, out, c, p, cancel);
+        });
     }
     void finish_tiles(double wall_seconds, int threads) override {
         if (profile_) renderer_.describe(*profile_, wall_seconds, threads);
     }
 
+  protected:
+    Framebuffer render_uniform(Parallelism& par, RenderProgress* progress) override {
+        return renderer_.render(par, progress, profile_);
+    }
+    void update_engine(std::shared_ptr<const Scene> scene, const FrameChange& change) override {
+        renderer_.update(*scene, change);  // converted: the scene is not kept
+    }
+    void render_uniform_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) override {
+        profiled(counts, [&](RayCounts& c, StreamProfile* p) { renderer_.render_one_tile(tile, rgb, c, p, cancel); });
+    }
+
   private:
+    /// Runs work(counts, profile): with a profile, into a local one merged under the lock.
+    template <class Work>
+    void profiled(RayCounts& counts, Work&& work) {
+        if (!profile_) return work(counts, nullptr);
+        StreamProfile local;
+        RayCounts c;
+        work(c, &local);
+        counts += c;
+        std::lock_guard<std::mutex> lock(mutex_);
+        *profile_ += local;
+        profile_->counts += c;
+    }
+
     StreamRenderer renderer_;
     StreamProfile* profile_;
     std::mutex mutex_;
@@ -94,11 +124,26 @@ std::unique_ptr<PreparedRender> prepare_render(std::shared_ptr<const Scene> scen
     p->setup_seconds = seconds_since(start);
     p->width = settings.width;
     p->height = settings.height;
+    p->adaptive = AdaptiveRule{settings.adaptive, settings.spp};
+    p->stop = options.adaptive_stop;
     return p;
 }
 
 std::unique_ptr<PreparedRender> prepare_render(const Scene& scene, EngineKind engine, const EngineOptions& options) {
     return prepare_render(borrowed(scene), scene.settings, engine, options);
+}
+
+Framebuffer PreparedRender::render(Parallelism& par, RenderProgress* progress) {
+    if (!adaptive.on()) return render_uniform(par, progress);
+    const auto start = Clock::now();
+    Framebuffer image = render_adaptive_image(*this, par, progress);
+    finish_tiles(seconds_since(start), par.jobs());
+    return image;
+}
+
+void PreparedRender::render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) {
+    if (adaptive.on()) render_adaptive_tile(*this, tile, rgb, counts, cancel);
+    else render_uniform_tile(tile, rgb, counts, cancel);
 }
 
 void PreparedRender::update(std::shared_ptr<const Scene> scene, const FrameChange& change) {
@@ -151,6 +196,8 @@ RenderResult render_prepared(PreparedRender& prepared, Parallelism& par, RenderP
     const auto start = Clock::now();
     r.image = prepared.render(par, &p);
     r.seconds = seconds_since(start);
+    r.adaptive = prepared.last_adaptive;
+    if (r.adaptive) r.sample_map = prepared.sample_map;
     r.counts = p.counts();
     return r;
 }

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "stream/profile.h"
 #include "stream/shade_mode.h"
 #include "parallel/parallelism.h"
+#include "render/adaptive.h"
 #include "render/render_stats.h"
 #include "scene/animation.h"
 #include "scene/scene.h"
@@ -24,9 +26,19 @@ const char* engine_name(EngineKind e);
 
 struct RenderResult {
     Framebuffer image;
+    /// Adaptive sampling only (render/adaptive.h): samples taken and the estimated error.
+    std::optional<AdaptiveSummary> adaptive;
+    /// Adaptive sampling only: per pixel, (samples taken, estimated standard error, 0).
+    Framebuffer sample_map;
     RayCounts counts;
     double seconds = 0;        ///< rendering
     double setup_seconds = 0;  ///< building the engine's tables and the object hierarchy
+};
+
+/// When an adaptive render of the whole image stops refining, beside the pixels' own rule.
+struct AdaptiveStop {
+    double target_error = 0;  ///< > 0: once the estimated image RMSE is at most this
+    double time_limit = 0;    ///< > 0: once this many seconds of rendering are spent
 };
 
 struct EngineOptions {
@@ -35,13 +47,18 @@ struct EngineOptions {
     ShadeMode shade = ShadeMode::Auto;  ///< stream engine: how the shade stage groups hits
     std::size_t slice_rays = 0;         ///< stream engine: most rays traced at once (0: default; tests)
     accel::AccelConfig accel;           ///< both engines: whether and how the object hierarchy is used
+    AdaptiveStop adaptive_stop;         ///< both engines: adaptive sampling's early stops (whole image)
 };
 
-/// An engine with its set-up done (tables, hierarchy), ready to render.
+/// An engine with its set-up done (tables, hierarchy), ready to render. Uniform or adaptive
+/// sampling (render/adaptive.h, driver/adaptive_render.h) is chosen here from the scene's
+/// settings; the engines trace what they are asked.
 class PreparedRender {
   public:
     virtual ~PreparedRender() = default;
-    virtual Framebuffer render(Parallelism& par, RenderProgress* progress) = 0;
+    /// The whole image. Adaptive: rounds across the image (stop may end them early), and
+    /// last_adaptive / sample_map describe the outcome.
+    Framebuffer render(Parallelism& par, RenderProgress* progress);
     /// True when the engine reads the scene's objects while rendering (the recursive engine:
     /// its hit points go through Md): it then holds the scene it renders (prepare_render's
     /// shared pointer) as long as it lives. False when it renders from its own tables (the
@@ -50,7 +67,11 @@ class PreparedRender {
     virtual bool reads_scene_objects() const = 0;
     /// Renders one tile into `rgb` (tile.width() x tile.height() x 3 floats, row by row): the
     /// values render() gives those pixels, on any thread, in any process. Thread-safe.
-    virtual void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) = 0;
+    void render_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel);
+    /// Traces samples `run` of the listed pixels of `tile` (tile-local numbers, row by row),
+    /// 3 floats per sample into `out`, pixel after pixel (adaptive sampling). Thread-safe.
+    virtual void render_samples(const Tile& tile, SampleRun run, const std::uint32_t* pixels, int n_pixels, float* out,
+                                RayCounts& counts, const RenderProgress* cancel) = 0;
     /// Animation (scene/animation.h): `scene` is the scene at another frame, a scene of the
     /// same objects at other places (scene_at_frame, never the prepared scene changed in
     /// place), and `change` what differs from the frame rendered so far (frame_change); the
@@ -64,8 +85,14 @@ class PreparedRender {
     virtual void finish_tiles(double /*wall_seconds*/, int /*threads*/) {}
     double setup_seconds = 0;
     int width = 0, height = 0;  ///< the image's size (the scene's settings)
+    AdaptiveRule adaptive;      ///< from the scene's settings (threshold 0: uniform)
+    AdaptiveStop stop;          ///< whole-image adaptive renders only
+    std::optional<AdaptiveSummary> last_adaptive;  ///< set by an adaptive render()
+    Framebuffer sample_map;                        ///< set by an adaptive render()
 
   protected:
+    virtual Framebuffer render_uniform(Parallelism& par, RenderProgress* progress) = 0;
+    virtual void render_uniform_tile(const Tile& tile, float* rgb, RayCounts& counts, const RenderProgress* cancel) = 0;
     virtual void update_engine(std::shared_ptr<const Scene> scene, const FrameChange& change) = 0;
 };
 

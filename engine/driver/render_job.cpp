@@ -1,6 +1,7 @@
 #include "driver/render_job.h"
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <type_traits>
 #include <functional>
@@ -64,6 +65,9 @@ const Field kFields[] = {
     {"tonemap", [](RenderOverrides& o, const std::string& v) { o.tonemap = one_of("tonemap", v, kTonemapNames); }},
     {"exposure", [](RenderOverrides& o, const std::string& v) { o.exposure = to_double("exposure", v); }},
     {"shade", [](RenderOverrides& o, const std::string& v) { o.shade = one_of("shade", v, kShadeModeNames); }},
+    {"adaptive", [](RenderOverrides& o, const std::string& v) { o.adaptive = to_double("adaptive", v); }},
+    {"target_error", [](RenderOverrides& o, const std::string& v) { o.target_error = to_double("target_error", v); }},
+    {"time_limit", [](RenderOverrides& o, const std::string& v) { o.time_limit = to_double("time_limit", v); }},
 };
 
 // The token's spelling of each kind of field.
@@ -135,6 +139,20 @@ RenderJob build_render_job(std::shared_ptr<const Scene> scene, const RenderOverr
         if (!(*o.cutoff >= 0 && *o.cutoff <= 1)) throw UsageError("cutoff must be in [0, 1]");
         s.cutoff = *o.cutoff;
     }
+    if (o.adaptive) {
+        if (!(*o.adaptive >= 0 && *o.adaptive <= 1)) throw UsageError("adaptive must be in [0, 1]");
+        s.adaptive = *o.adaptive;
+    }
+    if (o.target_error) {
+        if (!(*o.target_error > 0 && *o.target_error <= 1)) throw UsageError("target_error must be in (0, 1]");
+        job.options.adaptive_stop.target_error = *o.target_error;
+        if (s.adaptive == 0) s.adaptive = *o.target_error;  // no pixel need be finer than the image's target
+    }
+    if (o.time_limit) {
+        if (!(*o.time_limit > 0 && std::isfinite(*o.time_limit))) throw UsageError("time_limit must be a number of seconds > 0");
+        if (s.adaptive == 0) throw UsageError("time_limit stops adaptive sampling: it needs adaptive or target_error");
+        job.options.adaptive_stop.time_limit = *o.time_limit;
+    }
     if (o.light_samples) s.light_samples = in("light_samples", *o.light_samples, 1, 4096);  // rendered_light
     if (o.sampler) s.pattern = named("sampler", *o.sampler, kSamplePatternNames);
     if (o.colorspace) s.colorspace = named("colorspace", *o.colorspace, kColorSpaceNames);
@@ -143,6 +161,14 @@ RenderJob build_render_job(std::shared_ptr<const Scene> scene, const RenderOverr
     if (o.exposure) s.exposure = *o.exposure;
     // The frame's scene is made when the engine is prepared (prepare_job).
     if (o.frame && *o.frame < 0) throw UsageError("frame must be >= 0");
+    if (s.adaptive > 0) {
+        // spp is the most a pixel takes; a scene's one sample would leave nothing to adapt.
+        if (s.spp == 1 && !o.spp) s.spp = kDefaultAdaptiveCap;
+        if (s.spp < 2) throw UsageError("adaptive sampling needs spp >= 2, the most samples a pixel may take");
+        if (s.pattern == SamplePattern::Grid)
+            throw UsageError("adaptive sampling needs sampler stratified or random (grid puts every round's samples "
+                             "on the same points)");
+    }
     job.engine = o.engine ? named("engine", *o.engine, kEngineNames) : EngineKind::Stream;
     job.threads = o.threads.value_or(0);
     if (o.accel) job.options.accel.mode = named("accel", *o.accel, accel::kAccelModeNames);
@@ -160,6 +186,7 @@ RenderJob build_render_job(std::shared_ptr<const Scene> scene, const RenderOverr
     p.light_samples = o.light_samples.value_or(0);
     p.frame = o.frame.value_or(-1);
     p.cutoff = s.cutoff, p.exposure = s.exposure;
+    p.adaptive = s.adaptive, p.target_error = job.options.adaptive_stop.target_error;
     p.sampler = s.pattern, p.calibration = s.calibration, p.colorspace = s.colorspace, p.tonemap = s.tonemap;
     p.exr = s.exr;
     p.engine = job.engine, p.isa = job.options.isa, p.accel = job.options.accel.mode, p.shade = job.options.shade;

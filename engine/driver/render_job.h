@@ -19,6 +19,9 @@ namespace streamrt {
 struct RenderOverrides {
     std::optional<int> width, height, spp, depth, degree, light_samples, threads, frame;
     std::optional<double> cutoff, exposure;
+    /// Adaptive sampling (docs/adaptive-sampling.md): the pixels' threshold, the image's
+    /// target error, the seconds after which refinement stops.
+    std::optional<double> adaptive, target_error, time_limit;
     std::optional<std::string> sampler, engine, isa, accel, colorspace, tonemap, shade;
     std::optional<std::string> output;  ///< the file written (the scene's `image output=` otherwise)
 };
@@ -33,6 +36,7 @@ struct PixelSettings {
     int light_samples = 0;  ///< 0: every area light's own samples= (part of the scene's files)
     int frame = -1;         ///< -1: a still picture
     double cutoff = 0, exposure = 1;
+    double adaptive = 0, target_error = 0;  ///< 0: uniform sampling; 0: no image target
     SamplePattern sampler{};
     Calibration calibration{};
     ColorSpace colorspace{};
@@ -48,13 +52,14 @@ struct PixelSettings {
     void for_each_field(F&& f) const {
         f("width", width), f("height", height), f("spp", spp), f("depth", depth), f("degree", degree);
         f("light_samples", light_samples), f("frame", frame), f("cutoff", cutoff), f("exposure", exposure);
+        f("adaptive", adaptive), f("target_error", target_error);
         f("sampler", sampler), f("calibration", calibration), f("colorspace", colorspace), f("tonemap", tonemap);
         f("exr", exr), f("engine", engine), f("isa", isa), f("accel", accel), f("shade", shade);
     }
-    static constexpr int kFields = 18;  ///< for_each_field's count (checked by the tests)
+    static constexpr int kFields = 20;  ///< for_each_field's count (checked by the tests)
 };
 // Adding a field: list it in for_each_field and kFields, and update this size.
-static_assert(sizeof(PixelSettings) == 64, "PixelSettings changed: list every field in for_each_field");
+static_assert(sizeof(PixelSettings) == 80, "PixelSettings changed: list every field in for_each_field");
 
 /// "width=640,height=480,spp=4,...": every field of PixelSettings, enums by their names,
 /// numbers exactly (%.17g), the stream kernels' level as "none" for the recursive engine.

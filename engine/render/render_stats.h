@@ -27,11 +27,15 @@ struct RenderProgress {
     std::atomic<bool>* cancel = nullptr;  ///< set from a signal handler to stop early
 
     void add(const RayCounts& c) {
+        add_rays(c);
+        ++tiles_done;
+    }
+    /// Rays of work on a tile already counted done (adaptive sampling's later rounds).
+    void add_rays(const RayCounts& c) {
         primary += c.primary;
         shadow += c.shadow;
         reflected += c.reflected;
         refracted += c.refracted;
-        ++tiles_done;
     }
     RayCounts counts() const { return {primary.load(), shadow.load(), reflected.load(), refracted.load()}; }
     bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }

@@ -66,15 +66,30 @@ inline PixelSampleT<V> lattice_sample(SamplePattern pattern, const V& cx, const 
     return {(cx + ju) / cols, (cy + jv) / rows};
 }
 
-/// Sample `sample` of `spp` in pixel `pixel` (row-major index). spp = 1 always takes the
-/// pixel centre.
-inline PixelSample pixel_sample(SamplePattern pattern, int spp, std::uint64_t pixel, int sample) {
-    if (spp == 1) return {0.5f, 0.5f};
+/// A run of one pixel's samples: numbers [first, first + count), stratified among
+/// themselves on their own cols x rows lattice (grid_columns(count)). Uniform sampling is
+/// the one run {0, spp}; adaptive sampling (render/adaptive.h) takes its rounds as runs, so
+/// every round covers the pixel evenly whatever rounds come after it. The sample number
+/// (first + j) seeds the hashes, so no two samples of a pixel share their jitter.
+struct SampleRun {
+    int first = 0;
+    int count = 1;
+};
+
+/// Sample j (in [0, run.count)) of `run` in pixel `pixel` (row-major index). The run {0, 1}
+/// (spp = 1) takes the pixel centre.
+inline PixelSample pixel_sample(SamplePattern pattern, SampleRun run, std::uint64_t pixel, int j) {
+    if (run.first == 0 && run.count == 1) return {0.5f, 0.5f};
     std::uint32_t h1, h2;
-    sample_hashes(std::uint32_t(pixel), std::uint32_t(sample), h1, h2);
-    const int cols = grid_columns(spp);
-    return lattice_sample(pattern, float(sample % cols), float(sample / cols), float(cols), float(spp / cols),
+    sample_hashes(std::uint32_t(pixel), std::uint32_t(run.first + j), h1, h2);
+    const int cols = grid_columns(run.count);
+    return lattice_sample(pattern, float(j % cols), float(j / cols), float(cols), float(run.count / cols),
                           unit_from_hash(h1), unit_from_hash(h2));
+}
+
+/// Sample `sample` of `spp` in pixel `pixel`: uniform sampling, the run {0, spp}.
+inline PixelSample pixel_sample(SamplePattern pattern, int spp, std::uint64_t pixel, int sample) {
+    return pixel_sample(pattern, SampleRun{0, spp}, pixel, sample);
 }
 
 // ---- depth of field: where each sample falls on the lens ----------------------------------
@@ -150,16 +165,20 @@ inline PixelSampleT<V> concentric_disc(const V& u, const V& v) {
 
 /// The point on the unit lens disc of sample `sample` of `spp` in pixel `pixel` (row-major
 /// index): the lattice of pixel_sample with the permuted cell of LensCells, so grid puts
-/// lens points at cell centres, stratified one per cell, random anywhere.
-inline PixelSample lens_sample(SamplePattern pattern, int spp, std::uint64_t pixel, int sample) {
+/// lens points at cell centres, stratified one per cell, random anywhere. Sample j of a run
+/// (SampleRun) takes the run's own lattice and permutation.
+inline PixelSample lens_sample(SamplePattern pattern, SampleRun run, std::uint64_t pixel, int j) {
     std::uint32_t h1, h2;
-    lens_hashes(std::uint32_t(pixel), std::uint32_t(sample), h1, h2);
-    const int cols = grid_columns(spp);
+    lens_hashes(std::uint32_t(pixel), std::uint32_t(run.first + j), h1, h2);
+    const int cols = grid_columns(run.count);
     int cx, cy;
-    LensCells(spp, std::uint32_t(pixel)).cell(sample, cx, cy);
-    const PixelSample q = lattice_sample(pattern, float(cx), float(cy), float(cols), float(spp / cols),
+    LensCells(run.count, std::uint32_t(pixel)).cell(j, cx, cy);
+    const PixelSample q = lattice_sample(pattern, float(cx), float(cy), float(cols), float(run.count / cols),
                                          unit_from_hash(h1), unit_from_hash(h2));
     return concentric_disc(q.x, q.y);
+}
+inline PixelSample lens_sample(SamplePattern pattern, int spp, std::uint64_t pixel, int sample) {
+    return lens_sample(pattern, SampleRun{0, spp}, pixel, sample);
 }
 
 // ---- Area lights (docs/scene-format.md, "Area lights and soft shadows") ----------------

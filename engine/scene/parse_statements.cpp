@@ -31,6 +31,7 @@ void Parser::image(Statement& st, const std::vector<Token>& toks) {
         else if (k == "depth") s.depth = st.integer(a, 0, 256);
         else if (k == "degree") s.degree = st.integer(a, 0, 5);
         else if (k == "cutoff") s.cutoff = st.in_closed(a, 0.0, 1.0);
+        else if (k == "adaptive") s.adaptive = st.in_closed(a, 0.0, 1.0);
         else if (k == "output") s.output = std::string(a.value);
         else if (k == "frames") frame_range(st, a, s.frames_first, s.frames_last);
         else if (k == "sampler") s.pattern = st.word(a, kSamplePatternNames);

@@ -121,6 +121,10 @@ struct RenderSettings {
     /// Weight cut-off: reflected / refracted rays whose throughput (product of the refl and
     /// trans weights from the camera) is below this in every channel are not traced; 0 = all.
     double cutoff = 0.0;
+    /// Adaptive sampling (render/adaptive.h): a pixel stops taking samples once the estimated
+    /// standard error of its mean luminance is at most this; spp is then the most it takes.
+    /// 0: every pixel takes spp samples.
+    double adaptive = 0.0;
     glm::dvec3 background{0.0, 0.0, 0.0};
     Calibration calibration = Calibration::Clamp;
     SamplePattern pattern = SamplePattern::Stratified;

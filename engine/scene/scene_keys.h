@@ -25,7 +25,7 @@ inline const std::vector<std::string_view> kImageKeys = {"width",  "height",  "s
                                                   "depth",  "degree",  "output",
                                                   "sampler", "calibration", "cutoff",
                                                   "colorspace", "exposure", "tonemap", "exr",
-                                                  "frames"};
+                                                  "frames", "adaptive"};
 inline const std::vector<std::string_view> kLookAtKeys = {"eye", "look", "up", "fov"};
 inline const std::vector<std::string_view> kExplicitCameraKeys = {"rx",       "ry",       "df",
                                                            "scale",    "rotate_x", "rotate_y",

@@ -14,6 +14,7 @@
 #include "render/sampling.h"
 #include "shapes/shapes.h"
 #include "stream/profile.h"
+#include "stream/sample_request.h"
 #include "stream/shade_mode.h"
 #include "stream/shade_stage.h"
 #include "stream/slicing.h"
@@ -27,54 +28,57 @@ struct PipelineStages {
     static constexpr bool kSecondary = kReflect || kRefract;
     using Shade = ShadeStage<kLighting, kShadows, kReflect, kRefract>;
 
-    /// generate: camera rays for pixels [first, first + n_pixels) of the tile, spp per pixel,
-    /// consecutive, so a pixel's samples share a packet. Weight 1/spp each.
-    static void generate(const StreamScene& sc, const KernelTable& kt, const Tile& tile, int first, int n_pixels,
-                         Workspace& ws) {
+    /// generate: camera rays for pixels [first, first + n_pixels) of the request's list
+    /// (SampleRequest), its run of samples per pixel, consecutive, so a pixel's samples share
+    /// a packet. Each ray's accumulation slot and weight are the request's (slot_of, weight).
+    static void generate(const StreamScene& sc, const KernelTable& kt, const Tile& tile, const SampleRequest& req,
+                         int first, int n_pixels, Workspace& ws) {
         RayStream& rays = ws.current;
         GenerateScratch& g = ws.generate;
-        const int spp = sc.settings.spp;
-        const std::size_t n = std::size_t(n_pixels) * std::size_t(spp);
+        const int count = req.run.count;
+        const std::size_t n = std::size_t(n_pixels) * std::size_t(count);
         rays.reserve(n);
         const bool lens = sc.features.lens;  // one scene-wide choice: the thin-lens kernel
         g.reserve(n, lens);
-        // Integer bookkeeping (pixel of each ray, sample index, lattice cell) in scalar code;
+        // Integer bookkeeping (pixel of each ray, sample number, lattice cell) in scalar code;
         // the hashing, jitter and camera directions in the SIMD kernel.
-        const int cols = grid_columns(spp);
-        std::size_t i = 0;
-        for (int p = first; p < first + n_pixels; ++p) {
+        const int cols = grid_columns(count);
+        const auto image_pixel = [&](int p) {
             const int x = tile.x0 + p % tile.width(), y = tile.y0 + p / tile.width();
-            const std::uint32_t pixel = std::uint32_t(std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x));
+            return std::uint32_t(std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x));
+        };
+        std::size_t i = 0;
+        for (int q = first; q < first + n_pixels; ++q) {
+            const int p = req.pixel(q);
+            const float x = float(tile.x0 + p % tile.width()), y = float(tile.y0 + p / tile.width());
             int cx = 0, cy = 0;
-            for (int k = 0; k < spp; ++k, ++i) {
-                g.px[i] = float(x);
-                g.py[i] = float(y);
+            for (int j = 0; j < count; ++j, ++i) {
+                g.px[i] = x;
+                g.py[i] = y;
                 if constexpr (kJitter) {
-                    g.key_pixel[i] = pixel;
-                    g.key_sample[i] = std::uint32_t(k);
+                    g.key_pixel[i] = image_pixel(p);
+                    g.key_sample[i] = std::uint32_t(req.run.first + j);
                     g.cell_x[i] = float(cx);
                     g.cell_y[i] = float(cy);
                     if (++cx == cols) cx = 0, ++cy;
                 }
-                rays.pixel[i] = p;
+                rays.pixel[i] = req.slot_of(q - first, j, p);
                 rays.kind[i] = std::uint8_t(RayKind::Primary);
             }
         }
         rays.count = i;
         if (lens) {  // a second pass, so a pinhole camera runs exactly the loop above
-            std::size_t j = 0;
-            for (int p = first; p < first + n_pixels; ++p) {
-                const int x = tile.x0 + p % tile.width(), y = tile.y0 + p / tile.width();
-                const std::uint32_t pixel =
-                    std::uint32_t(std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x));
-                const LensCells cells(spp, pixel);  // render/sampling.h
-                for (int k = 0; k < spp; ++k, ++j) {
-                    g.key_pixel[j] = pixel;  // also at spp = 1: the lens hashes need them
-                    g.key_sample[j] = std::uint32_t(k);
+            std::size_t k = 0;
+            for (int q = first; q < first + n_pixels; ++q) {
+                const std::uint32_t pixel = image_pixel(req.pixel(q));
+                const LensCells cells(count, pixel);  // render/sampling.h
+                for (int j = 0; j < count; ++j, ++k) {
+                    g.key_pixel[k] = pixel;  // also at spp = 1: the lens hashes need them
+                    g.key_sample[k] = std::uint32_t(req.run.first + j);
                     int lx, ly;
-                    cells.cell(k, lx, ly);
-                    g.lens_x[j] = float(lx);
-                    g.lens_y[j] = float(ly);
+                    cells.cell(j, lx, ly);
+                    g.lens_x[k] = float(lx);
+                    g.lens_y[k] = float(ly);
                 }
             }
         }
@@ -88,26 +92,22 @@ struct PipelineStages {
                               .pattern = int(sc.settings.pattern),
                               .jitter = kJitter,
                               .cols = float(cols),
-                              .rows = float(spp / cols),
+                              .rows = float(count / cols),
                               .camera = &sc.camera,
-                              .weight = 1.f / float(spp),
+                              .weight = req.weight(),
                               .out = append_view(rays),
                               .lens_cell_x = g.lens_x.data(),
                               .lens_cell_y = g.lens_y.data()};
         (lens ? kt.generate_lens : kt.generate)(job);
-        if (sc.features.area_lights) area_light_keys(sc, tile, first, n_pixels, rays);
-    }
-
-    /// Area lights: each camera ray's light-sampling key (render/sampling.h light_key), from
-    /// its global pixel and sample index (the rays of a pixel are its samples in order).
-    static void area_light_keys(const StreamScene& sc, const Tile& tile, int first, int n_pixels, RayStream& rays) {
-        rays.reserve_keys();
-        const int spp = sc.settings.spp;
-        std::size_t i = 0;
-        for (int p = first; p < first + n_pixels; ++p) {
-            const int x = tile.x0 + p % tile.width(), y = tile.y0 + p / tile.width();
-            const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x);
-            for (int k = 0; k < spp; ++k, ++i) rays.key[i] = light_key(pixel, k);
+        if (sc.features.area_lights) {
+            // Each camera ray's light-sampling key (render/sampling.h light_key), from its
+            // image pixel and sample number: the rays of a pixel are its samples in order.
+            rays.reserve_keys();
+            std::size_t k = 0;
+            for (int q = first; q < first + n_pixels; ++q) {
+                const std::uint32_t pixel = image_pixel(req.pixel(q));
+                for (int j = 0; j < count; ++j, ++k) rays.key[k] = light_key(pixel, req.run.first + j);
+            }
         }
     }
 
@@ -179,6 +179,7 @@ struct PipelineStages {
         StreamProfile* profile;
         ShadeMode shade_mode;
         std::size_t slice_rays;  ///< the most rays traced at once
+        std::size_t slots;       ///< accumulation slots (accum holds 3 floats each; rays' `pixel`)
         StageFigures* fig(Stage s) const { return profile ? &profile->stages[int(s)] : nullptr; }
     };
 
@@ -205,7 +206,7 @@ struct PipelineStages {
             else
                 Shade::shade_sorted(sc, c.kt, rays, ws.object, depth, ws, c.accum, c.counts, c.shade_mode == ShadeMode::Gathered);
             if (kShadows && c.shade_mode == ShadeMode::Gathered)
-                Shade::order_shadows_by_pixel(ws, std::size_t(c.tile.width() * c.tile.height()));
+                Shade::order_shadows_by_pixel(ws, c.slots);
             if (c.profile) {
                 c.fig(Stage::Shade)->rays_in += rays.count;
                 c.fig(Stage::Shade)->rays_out += ws.next.count + (kShadows ? ws.shadows.count : 0);
@@ -246,7 +247,7 @@ struct PipelineStages {
             return;
         }
         const std::vector<std::size_t> bounds =
-            stage_detail::cut_into_slices(gen, ws.regroup, c.slice_rays, std::size_t(c.tile.width() * c.tile.height()),
+            stage_detail::cut_into_slices(gen, ws.regroup, c.slice_rays, c.slots,
                                           ws.pixel_rays, ws.pixel_slice, c.sc.features.area_lights);
         for (std::size_t k = 0; k + 1 < bounds.size(); ++k) {
             RayStream slice = ws.take(), spawned = ws.take();
@@ -265,15 +266,17 @@ struct PipelineStages {
         else c.ws.give(std::move(spawned));
     }
 
-    /// The whole algorithm for one chunk of a tile: camera rays, then every generation they
-    /// spawn (trace_generation). slice_rays: the most rays traced at once.
-    static void run_chunk(const StreamScene& sc, const KernelTable& kt, const Tile& tile, int first, int n_pixels,
-                          Workspace& ws, float* accum, RayCounts& counts, StreamProfile* profile,
-                          ShadeMode shade_mode, std::size_t slice_rays) {
-        const Chunk c{sc, kt, tile, ws, accum, counts, profile, shade_mode, std::max<std::size_t>(1, slice_rays)};
+    /// The whole algorithm for one chunk of a tile: camera rays for pixels [first, first +
+    /// n_pixels) of the request, then every generation they spawn (trace_generation), their
+    /// light added into `accum` (the request's slots). slice_rays: the most rays traced at once.
+    static void run_chunk(const StreamScene& sc, const KernelTable& kt, const Tile& tile, const SampleRequest& req,
+                          int first, int n_pixels, Workspace& ws, float* accum, RayCounts& counts,
+                          StreamProfile* profile, ShadeMode shade_mode, std::size_t slice_rays) {
+        const Chunk c{sc, kt, tile, ws, accum, counts, profile, shade_mode, std::max<std::size_t>(1, slice_rays),
+                      req.slots(n_pixels, tile)};
         {
             StageTimer timer(c.fig(Stage::Generate));
-            generate(sc, kt, tile, first, n_pixels, ws);
+            generate(sc, kt, tile, req, first, n_pixels, ws);
             counts.primary += ws.current.count;
             if (profile) c.fig(Stage::Generate)->rays_out += ws.current.count, c.fig(Stage::Generate)->rays_in += std::uint64_t(n_pixels);
         }

@@ -48,20 +48,20 @@ std::vector<std::string> StreamRenderer::built_stages() const {
 }
 
 template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
-void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, float* accum, RayCounts& counts,
-                                 StreamProfile* profile, const RenderProgress* cancel) {
+void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, const SampleRequest& req, float* accum,
+                                 RayCounts& counts, StreamProfile* profile, const RenderProgress* cancel) {
     using Stages = PipelineStages<kLighting, kShadows, kReflect, kRefract, kJitter>;
     const StreamScene& sc = self.scene_;
-    const int spp = sc.settings.spp;
-    // Memory in flight is bounded by the chunk, not the image: a tile's pixels are cut into
-    // chunks of whole pixels (all samples of a pixel in the same stream, hence packet).
-    const int tile_pixels = tile.width() * tile.height();
-    const int pixels_per_chunk = std::max(1, int(kMaxChunkRays / std::size_t(spp)));
+    // Memory in flight is bounded by the chunk, not the image: the request's pixels are cut
+    // into chunks of whole pixels (all samples of a pixel in the same stream, hence packet).
+    const int pixels_per_chunk = std::max(1, int(kMaxChunkRays / std::size_t(req.run.count)));
     static thread_local Workspace ws;
-    for (int first = 0; first < tile_pixels; first += pixels_per_chunk) {
+    for (int first = 0; first < req.n_pixels; first += pixels_per_chunk) {
         if (cancel && cancel->cancelled()) return;
-        const int n_pixels = std::min(pixels_per_chunk, tile_pixels - first);
-        Stages::run_chunk(sc, self.kernels_, tile, first, n_pixels, ws, accum, counts, profile, self.shade_mode_,
+        const int n_pixels = std::min(pixels_per_chunk, req.n_pixels - first);
+        // Per-sample slots are counted from the chunk's first pixel.
+        float* slots = req.per_sample ? accum + std::size_t(first) * std::size_t(req.run.count) * 3 : accum;
+        Stages::run_chunk(sc, self.kernels_, tile, req, first, n_pixels, ws, slots, counts, profile, self.shade_mode_,
                           self.slice_rays_);
     }
 }
@@ -91,11 +91,21 @@ void StreamRenderer::render_one_tile(const Tile& tile, float* rgb, RayCounts& co
                                      const RenderProgress* cancel) const {
     // Tile-local accumulation in a fixed order: the result cannot depend on scheduling.
     float accum[kTileSize * kTileSize * 3] = {};
-    tile_fn_(*this, tile, accum, counts, profile, cancel);
     const int pixels = tile.width() * tile.height();
+    const SampleRequest all{.run = {0, scene_.settings.spp}, .n_pixels = pixels};
+    tile_fn_(*this, tile, all, accum, counts, profile, cancel);
     StageTimer timer(profile ? &profile->stages[int(Stage::Accumulate)] : nullptr);
     std::copy_n(accum, pixels * 3, rgb);
     if (profile) profile->stages[int(Stage::Accumulate)].rays_in += std::uint64_t(pixels);
+}
+
+void StreamRenderer::render_samples(const Tile& tile, SampleRun run, const std::uint32_t* pixels, int n_pixels,
+                                    float* out, RayCounts& counts, StreamProfile* profile,
+                                    const RenderProgress* cancel) const {
+    std::fill_n(out, std::size_t(n_pixels) * std::size_t(run.count) * 3, 0.f);
+    const SampleRequest req{.run = run, .pixels = pixels, .n_pixels = n_pixels, .per_sample = true};
+    tile_fn_(*this, tile, req, out, counts, profile, cancel);
+    if (profile) profile->stages[int(Stage::Accumulate)].rays_in += std::uint64_t(n_pixels);
 }
 
 void StreamRenderer::describe(StreamProfile& profile, double wall_seconds, int threads) const {

@@ -10,6 +10,7 @@
 #include "parallel/parallelism.h"
 #include "render/render_stats.h"
 #include "stream/profile.h"
+#include "stream/sample_request.h"
 #include "stream/shade_mode.h"
 #include "stream/stream_scene.h"
 
@@ -39,6 +40,13 @@ class StreamRenderer {
     void render_one_tile(const Tile& tile, float* rgb, RayCounts& counts, StreamProfile* profile = nullptr,
                          const RenderProgress* cancel = nullptr) const;
 
+    /// Traces samples `run` of the listed pixels of `tile` (tile-local numbers, row by row)
+    /// and writes each sample's colour into `out`: 3 floats per sample, the samples of the
+    /// first pixel in order, then the next pixel's (adaptive sampling, render/adaptive.h).
+    void render_samples(const Tile& tile, SampleRun run, const std::uint32_t* pixels, int n_pixels, float* out,
+                        RayCounts& counts, StreamProfile* profile = nullptr,
+                        const RenderProgress* cancel = nullptr) const;
+
     /// Fills the profile's description of the run: wall time, threads, kernels and stages.
     void describe(StreamProfile& profile, double wall_seconds, int threads) const;
 
@@ -61,12 +69,12 @@ class StreamRenderer {
 
   private:
     // `cancel` (may be null) is polled between chunks, so an interrupt is seen within one chunk.
-    using TileFn = void (*)(const StreamRenderer&, const Tile&, float* accum, RayCounts&, StreamProfile*,
-                            const RenderProgress* cancel);
+    // accum: the request's slots (SampleRequest), 3 floats each, zeroed by the caller.
+    using TileFn = void (*)(const StreamRenderer&, const Tile&, const SampleRequest&, float* accum, RayCounts&,
+                            StreamProfile*, const RenderProgress* cancel);
     template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
-    static void render_tile(const StreamRenderer& self, const Tile& tile, float* accum, RayCounts& counts,
-                            StreamProfile* profile,
-                            const RenderProgress* cancel);
+    static void render_tile(const StreamRenderer& self, const Tile& tile, const SampleRequest& req, float* accum,
+                            RayCounts& counts, StreamProfile* profile, const RenderProgress* cancel);
     TileFn select_tile_fn() const;
 
     StreamScene scene_;

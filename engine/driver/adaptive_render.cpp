@@ -1,0 +1,118 @@
+#include "driver/adaptive_render.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+namespace streamrt {
+
+namespace {
+TileTallies tallies_for(const Tile& tile) {
+    return {tile, std::vector<PixelTally>(std::size_t(tile.width()) * std::size_t(tile.height()))};
+}
+}  // namespace
+
+int refine_tile(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, const RenderProgress* cancel) {
+    const SampleRun run = adaptive_round(r, prepared.adaptive.cap);
+    // Per-thread scratch: the pixels taking the round and their samples' colours.
+    static thread_local std::vector<std::uint32_t> pixels;
+    static thread_local std::vector<float> colours;
+    pixels.clear();
+    for (std::size_t p = 0; p < t.pixels.size(); ++p)
+        if (prepared.adaptive.takes_round(t.pixels[p], r)) pixels.push_back(std::uint32_t(p));
+    if (pixels.empty()) return 0;
+    colours.resize(pixels.size() * std::size_t(run.count) * 3);
+    prepared.render_samples(t.tile, run, pixels.data(), int(pixels.size()), colours.data(), counts, cancel);
+    if (cancel && cancel->cancelled()) return 0;
+    // The samples go into each tally in their order: the same sums for every schedule.
+    const float* c = colours.data();
+    for (const std::uint32_t p : pixels)
+        for (int j = 0; j < run.count; ++j, c += 3) t.pixels[p].add(c[0], c[1], c[2]);
+    return int(pixels.size());
+}
+
+void write_means(const TileTallies& t, float* rgb) {
+    for (std::size_t p = 0; p < t.pixels.size(); ++p) {
+        const ColorT<double> m = t.pixels[p].mean();
+        rgb[p * 3 + 0] = float(m.x), rgb[p * 3 + 1] = float(m.y), rgb[p * 3 + 2] = float(m.z);
+    }
+}
+
+void render_adaptive_tile(PreparedRender& prepared, const Tile& tile, float* rgb, RayCounts& counts,
+                          const RenderProgress* cancel) {
+    TileTallies t = tallies_for(tile);
+    for (int r = 0; refine_tile(prepared, r, t, counts, cancel) > 0; ++r) {
+    }
+    write_means(t, rgb);
+}
+
+Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, RenderProgress* progress) {
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    const AdaptiveStop& stop = prepared.stop;
+    const auto out_of_time = [&] {
+        return stop.time_limit > 0 &&
+               std::chrono::duration<double>(Clock::now() - start).count() >= stop.time_limit;
+    };
+    const int w = prepared.width, h = prepared.height;
+    const int nx = (w + kTileSize - 1) / kTileSize, ny = (h + kTileSize - 1) / kTileSize;
+    std::vector<TileTallies> tiles(std::size_t(nx) * std::size_t(ny));
+    for (std::size_t i = 0; i < tiles.size(); ++i) tiles[i] = tallies_for(tile_rect(w, h, int(i)));
+
+    AdaptiveSummary summary;
+    const auto estimated_rmse = [&] {  // in a fixed order: the same figure for every -j
+        double sum = 0;
+        for (const TileTallies& t : tiles)
+            for (const PixelTally& p : t.pixels) {
+                const double se = p.standard_error();
+                sum += std::isfinite(se) ? se * se : 0.0;
+            }
+        return std::sqrt(sum / (double(w) * double(h)));
+    };
+    for (int r = 0;; ++r) {
+        std::atomic<int> refined{0};
+        par.for_each_tile(w, h, kTileSize, [&](int index, Tile) {
+            if (progress && progress->cancelled()) return;
+            // The first round covers the image whatever the clock says (a picture to show); a
+        // later one may stop part-way, its pixels keeping the samples they have.
+        if (r > 0 && out_of_time()) return;
+            RayCounts counts;
+            refined += refine_tile(prepared, r, tiles[std::size_t(index)], counts, progress);
+            if (progress) r == 0 ? progress->add(counts) : progress->add_rays(counts);
+        });
+        if (refined == 0) break;
+        summary.rounds = r + 1;
+        if (progress && progress->cancelled()) break;
+        if (out_of_time()) {
+            summary.time_limited = true;
+            break;
+        }
+        if (stop.target_error > 0 && estimated_rmse() <= stop.target_error) break;
+    }
+
+    Framebuffer image = Framebuffer::uninitialized(w, h);
+    Framebuffer map(w, h);
+    double samples = 0;
+    float rgb[kTileSize * kTileSize * 3];
+    for (const TileTallies& t : tiles) {
+        write_means(t, rgb);
+        for (int y = t.tile.y0; y < t.tile.y1; ++y)
+            for (int x = t.tile.x0; x < t.tile.x1; ++x) {
+                const std::size_t p = std::size_t(y - t.tile.y0) * std::size_t(t.tile.width()) + std::size_t(x - t.tile.x0);
+                std::copy_n(&rgb[p * 3], 3, image.pixel(x, y));
+                const PixelTally& tally = t.pixels[p];
+                float* m = map.pixel(x, y);
+                m[0] = float(tally.n);
+                m[1] = float(tally.standard_error());
+                samples += tally.n;
+            }
+    }
+    summary.mean_spp = samples / (double(w) * double(h));
+    summary.estimated_rmse = estimated_rmse();
+    prepared.last_adaptive = summary;
+    prepared.sample_map = std::move(map);
+    return image;
+}
+
+}  // namespace streamrt

@@ -1,0 +1,88 @@
+#pragma once
+// Adaptive sampling's rules, shared by both engines (docs/adaptive-sampling.md): the rounds a
+// pixel's samples come in, the tally of its samples, its error estimate and the decision to
+// take another round. Every decision reads the pixel's own samples only, so the picture is
+// the same whatever renders the pixel's neighbours: any -j, tile order, shard or MPI rank.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/vec_lanes.h"
+#include "render/sampling.h"
+
+namespace streamrt {
+
+/// The cap (spp) of an adaptive render whose scene and command line say spp 1 (or nothing).
+inline constexpr int kDefaultAdaptiveCap = 64;
+
+/// Samples of every pixel's first round: enough for a first spread (3 degrees of freedom),
+/// few enough that flat pixels cost little.
+inline constexpr int kFirstRoundSamples = 4;
+
+/// Round r of a pixel whose cap is `cap` samples (--spp): the first takes
+/// min(cap, kFirstRoundSamples) samples, each later one as many as the pixel holds
+/// (doubling), the last cut at the cap. count 0: there is no round r. Each round is
+/// stratified on its own (SampleRun), so a pixel that stops after any round is evenly covered.
+inline SampleRun adaptive_round(int r, int cap) {
+    int first = 0, count = std::min(cap, kFirstRoundSamples);
+    for (int i = 0; i < r && count > 0; ++i) {
+        first += count;
+        count = std::min(first, cap - first);
+    }
+    return {first, std::max(count, 0)};
+}
+
+/// Rec. 709 luminance of linear RGB: what the error estimate measures.
+inline double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
+
+/// A pixel's samples so far: their colour sum, and their luminance's mean and sum of squared
+/// deviations kept by Welford's update (no cancellation between two large sums of squares,
+/// which in a bright flat pixel would leave rounding noise as the variance).
+struct PixelTally {
+    double r = 0, g = 0, b = 0;
+    double mean_y = 0, m2_y = 0;
+    int n = 0;
+
+    void add(float sr, float sg, float sb) {
+        r += sr, g += sg, b += sb;
+        ++n;
+        const double y = luminance(sr, sg, sb);
+        const double d = y - mean_y;
+        mean_y += d / n;
+        m2_y += d * (y - mean_y);
+    }
+    /// The pixel's value: the mean of its samples.
+    ColorT<double> mean() const { return n > 0 ? ColorT<double>{r / n, g / n, b / n} : ColorT<double>{0, 0, 0}; }
+    /// The estimated standard error of the mean luminance, sqrt(s^2 / n) with s^2 the unbiased
+    /// sample variance; infinity below 2 samples (no spread yet). Stratified samples vary
+    /// less than independent ones, so this errs on the high side.
+    double standard_error() const {
+        if (n < 2) return std::numeric_limits<double>::infinity();
+        return std::sqrt(std::max(0.0, m2_y / (n - 1)) / n);
+    }
+};
+
+/// What adaptive sampling is asked for: `image adaptive=T` or --adaptive T, --spp as the cap.
+struct AdaptiveRule {
+    double threshold = 0;  ///< T: a pixel stops once its standard_error() <= T; 0: uniform sampling
+    int cap = 1;           ///< the most samples a pixel takes
+
+    bool on() const { return threshold > 0; }
+    /// Whether a pixel with `tally` takes round r: it took every round before r, round r
+    /// exists, and (after the first) its error is still above T.
+    bool takes_round(const PixelTally& tally, int r) const {
+        const SampleRun run = adaptive_round(r, cap);
+        if (run.count == 0 || tally.n != run.first) return false;
+        return r == 0 || tally.standard_error() > threshold;
+    }
+};
+
+/// An adaptive render's outcome, for the closing line and the profile.
+struct AdaptiveSummary {
+    double mean_spp = 0;        ///< samples taken per pixel, on average
+    double estimated_rmse = 0;  ///< sqrt(mean of the pixels' standard_error()^2), luminance
+    int rounds = 0;             ///< rounds run
+    bool time_limited = false;  ///< --time-limit stopped the refinement
+};
+
+}  // namespace streamrt
