@@ -8,28 +8,48 @@
 namespace streamrt {
 
 namespace {
-TileTallies tallies_for(const Tile& tile) {
-    return {tile, std::vector<PixelTally>(std::size_t(tile.width()) * std::size_t(tile.height()))};
-}
-}  // namespace
 
-int refine_tile(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, const RenderProgress* cancel) {
+TileTallies tallies_for(const Tile& tile) {
+    const std::size_t n = std::size_t(tile.width()) * std::size_t(tile.height());
+    return {tile, std::vector<PixelTally>(n), std::vector<std::uint8_t>(n, 0)};
+}
+
+/// Runs round r on the pixels of `t` that take it; returns how many did. `counts` gets the
+/// rays traced.
+int refine(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, const RenderProgress* cancel) {
     const SampleRun run = adaptive_round(r, prepared.adaptive.cap);
     // Per-thread scratch: the pixels taking the round and their samples' colours.
     static thread_local std::vector<std::uint32_t> pixels;
     static thread_local std::vector<float> colours;
     pixels.clear();
     for (std::size_t p = 0; p < t.pixels.size(); ++p)
-        if (prepared.adaptive.takes_round(t.pixels[p], r)) pixels.push_back(std::uint32_t(p));
+        if (prepared.adaptive.takes_round(t.pixels[p], r, t.spread_near[p] != 0)) pixels.push_back(std::uint32_t(p));
     if (pixels.empty()) return 0;
     colours.resize(pixels.size() * std::size_t(run.count) * 3);
     prepared.render_samples(t.tile, run, pixels.data(), int(pixels.size()), colours.data(), counts, cancel);
     if (cancel && cancel->cancelled()) return 0;
-    // The samples go into each tally in their order: the same sums for every schedule.
+    // The samples go into each tally in their order: the same sums whatever else was traced.
     const float* c = colours.data();
     for (const std::uint32_t p : pixels)
         for (int j = 0; j < run.count; ++j, c += 3) t.pixels[p].add(c[0], c[1], c[2]);
     return int(pixels.size());
+}
+
+/// spread_near of the pixels of `inner` (inside `outer`, whose round-0 tallies are `all`,
+/// row by row): its own error or one of its neighbours' (those inside `outer`) above T.
+void mark_spread(const AdaptiveRule& rule, const Tile& outer, const std::vector<PixelTally>& all, const Tile& inner,
+                 std::vector<std::uint8_t>& spread_near) {
+    const auto above = [&](int x, int y) {
+        return rule.above(all[std::size_t(y - outer.y0) * std::size_t(outer.width()) + std::size_t(x - outer.x0)]);
+    };
+    for (int y = inner.y0; y < inner.y1; ++y)
+        for (int x = inner.x0; x < inner.x1; ++x) {
+            bool near = false;
+            for (int ny = std::max(outer.y0, y - 1); ny <= std::min(outer.y1 - 1, y + 1) && !near; ++ny)
+                for (int nx = std::max(outer.x0, x - 1); nx <= std::min(outer.x1 - 1, x + 1) && !near; ++nx)
+                    near = above(nx, ny);
+            spread_near[std::size_t(y - inner.y0) * std::size_t(inner.width()) + std::size_t(x - inner.x0)] = near;
+        }
 }
 
 void write_means(const TileTallies& t, float* rgb) {
@@ -39,10 +59,22 @@ void write_means(const TileTallies& t, float* rgb) {
     }
 }
 
+}  // namespace
+
 void render_adaptive_tile(PreparedRender& prepared, const Tile& tile, float* rgb, RayCounts& counts,
                           const RenderProgress* cancel) {
+    // Round 0 on the tile and the ring around it (inside the image): the neighbours' first
+    // samples are the ones their own tiles take, so the rule sees what a whole-image render sees.
+    const Tile ring{std::max(0, tile.x0 - 1), std::max(0, tile.y0 - 1), std::min(prepared.width, tile.x1 + 1),
+                    std::min(prepared.height, tile.y1 + 1)};
+    TileTallies outer = tallies_for(ring);
+    refine(prepared, 0, outer, counts, cancel);
     TileTallies t = tallies_for(tile);
-    for (int r = 0; refine_tile(prepared, r, t, counts, cancel) > 0; ++r) {
+    for (int y = tile.y0; y < tile.y1; ++y)
+        std::copy_n(&outer.pixels[std::size_t(y - ring.y0) * std::size_t(ring.width()) + std::size_t(tile.x0 - ring.x0)],
+                    tile.width(), &t.pixels[std::size_t(y - tile.y0) * std::size_t(tile.width())]);
+    mark_spread(prepared.adaptive, ring, outer.pixels, tile, t.spread_near);
+    for (int r = 1; refine(prepared, r, t, counts, cancel) > 0; ++r) {
     }
     write_means(t, rgb);
 }
@@ -52,8 +84,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     const auto start = Clock::now();
     const AdaptiveStop& stop = prepared.stop;
     const auto out_of_time = [&] {
-        return stop.time_limit > 0 &&
-               std::chrono::duration<double>(Clock::now() - start).count() >= stop.time_limit;
+        return stop.time_limit > 0 && std::chrono::duration<double>(Clock::now() - start).count() >= stop.time_limit;
     };
     const int w = prepared.width, h = prepared.height;
     const int nx = (w + kTileSize - 1) / kTileSize, ny = (h + kTileSize - 1) / kTileSize;
@@ -71,14 +102,30 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
         return std::sqrt(sum / (double(w) * double(h)));
     };
     for (int r = 0;; ++r) {
+        if (r == 1) {
+            // The neighbour rule reads round 0 across tiles: the tallies of a tile and the
+            // pixels around it, gathered into one rectangle.
+            par.for_each_tile(w, h, kTileSize, [&](int index, Tile tile) {
+                const Tile ring{std::max(0, tile.x0 - 1), std::max(0, tile.y0 - 1), std::min(w, tile.x1 + 1),
+                                std::min(h, tile.y1 + 1)};
+                std::vector<PixelTally> around(std::size_t(ring.width()) * std::size_t(ring.height()));
+                for (int y = ring.y0; y < ring.y1; ++y)
+                    for (int x = ring.x0; x < ring.x1; ++x) {
+                        const TileTallies& o = tiles[std::size_t((y / kTileSize) * nx + x / kTileSize)];
+                        around[std::size_t(y - ring.y0) * std::size_t(ring.width()) + std::size_t(x - ring.x0)] =
+                            o.pixels[std::size_t(y - o.tile.y0) * std::size_t(o.tile.width()) + std::size_t(x - o.tile.x0)];
+                    }
+                mark_spread(prepared.adaptive, ring, around, tile, tiles[std::size_t(index)].spread_near);
+            });
+        }
         std::atomic<int> refined{0};
         par.for_each_tile(w, h, kTileSize, [&](int index, Tile) {
             if (progress && progress->cancelled()) return;
             // The first round covers the image whatever the clock says (a picture to show); a
-        // later one may stop part-way, its pixels keeping the samples they have.
-        if (r > 0 && out_of_time()) return;
+            // later one may stop part-way, its pixels keeping the samples they have.
+            if (r > 0 && out_of_time()) return;
             RayCounts counts;
-            refined += refine_tile(prepared, r, tiles[std::size_t(index)], counts, progress);
+            refined += refine(prepared, r, tiles[std::size_t(index)], counts, progress);
             if (progress) r == 0 ? progress->add(counts) : progress->add_rays(counts);
         });
         if (refined == 0) break;

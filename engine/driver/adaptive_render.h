@@ -9,21 +9,18 @@
 
 namespace streamrt {
 
-/// One tile's pixels' tallies, row by row.
+/// The tallies of a rectangle's pixels, row by row, and (after round 0) whether each has an
+/// error above T in itself or a neighbour (AdaptiveRule::takes_round's spread_near).
 struct TileTallies {
     Tile tile{};
     std::vector<PixelTally> pixels;
+    std::vector<std::uint8_t> spread_near;
 };
 
-/// Runs round r on the pixels of `t` that take it (AdaptiveRule::takes_round); returns how
-/// many did. `counts` gets the rays traced.
-int refine_tile(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, const RenderProgress* cancel);
-
-/// Writes the tile's pixel means into rgb (tile.width() x tile.height() x 3 floats).
-void write_means(const TileTallies& t, float* rgb);
-
-/// Every round on one tile, then its means into rgb: the values an adaptive render() gives
-/// those pixels when nothing stops it early (PreparedRender::render_tile).
+/// Every round on one tile, then its means into rgb (tile.width() x tile.height() x 3):
+/// the values an adaptive render() gives those pixels when nothing stops it early
+/// (PreparedRender::render_tile). Round 0 also covers the ring of pixels around the tile, for
+/// the neighbour rule.
 void render_adaptive_tile(PreparedRender& prepared, const Tile& tile, float* rgb, RayCounts& counts,
                           const RenderProgress* cancel);
 

@@ -102,6 +102,7 @@ struct Result {
     py::dict seconds, rays;
     py::object profile = py::none();
     std::string engine;
+    py::object adaptive = py::none();  ///< adaptive sampling: its summary and sample map
 };
 
 /// Renders `job` on a worker thread while this (the Python) thread waits with the GIL
@@ -172,6 +173,15 @@ Result make_result(RenderResult&& r, const RenderJob& job, EngineKind engine, do
     out.rays["total"] = r.counts.total();
     if (job.profile && engine == EngineKind::Stream)
         out.profile = py::module_::import("json").attr("loads")(job.profile->json());
+    if (r.adaptive) {
+        py::dict a;
+        a["mean_spp"] = r.adaptive->mean_spp;
+        a["estimated_rmse"] = r.adaptive->estimated_rmse;
+        a["rounds"] = r.adaptive->rounds;
+        a["time_limited"] = r.adaptive->time_limited;
+        a["sample_map"] = to_array(std::move(r.sample_map));
+        out.adaptive = a;
+    }
     out.image = to_array(std::move(r.image));
     return out;
 }
@@ -284,6 +294,9 @@ PYBIND11_MODULE(streamrt, m) {
         .def_readonly("rays", &Result::rays, "{'primary', 'shadow', 'reflected', 'refracted', 'total'}")
         .def_readonly("profile", &Result::profile, "the content of --profile=json as a dict, or None")
         .def_readonly("engine", &Result::engine, "'stream' or 'recursive'")
+        .def_readonly("adaptive", &Result::adaptive,
+                      "adaptive sampling: {'mean_spp', 'estimated_rmse', 'rounds', 'time_limited', 'sample_map'} "
+                      "(sample_map: height x width x 3, samples taken and estimated error per pixel), or None")
         .def("__repr__", [](const Result& r) {
             return "<streamrt.Result " + r.engine + " " + std::to_string(r.image.shape(1)) + "x" +
                    std::to_string(r.image.shape(0)) + ", " + py::str(r.seconds["render"]).cast<std::string>() + " s>";

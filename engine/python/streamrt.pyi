@@ -41,6 +41,10 @@ class Result:
     @property
     def engine(self) -> str:
         """'stream' or 'recursive'."""
+    @property
+    def adaptive(self) -> Optional[dict[str, Any]]:
+        """Adaptive sampling: 'mean_spp', 'estimated_rmse', 'rounds', 'time_limited' and
+        'sample_map' (height x width x 3: samples taken, estimated standard error, 0); else None."""
 
 def render(
     scene: str | Scene,
@@ -61,6 +65,9 @@ def render(
     colorspace: Optional[str] = ...,
     tonemap: Optional[str] = ...,
     exposure: Optional[float] = ...,
+    adaptive: Optional[float] = ...,
+    target_error: Optional[float] = ...,
+    time_limit: Optional[float] = ...,
     profile: bool = ...,
     progress: Optional[Callable[[int, int], None]] = ...,
 ) -> Result:

@@ -68,12 +68,17 @@ struct AdaptiveRule {
     int cap = 1;           ///< the most samples a pixel takes
 
     bool on() const { return threshold > 0; }
+    /// Whether a pixel's error is above T (after any round).
+    bool above(const PixelTally& tally) const { return tally.standard_error() > threshold; }
     /// Whether a pixel with `tally` takes round r: it took every round before r, round r
-    /// exists, and (after the first) its error is still above T.
-    bool takes_round(const PixelTally& tally, int r) const {
+    /// exists, and: round 0 always; round 1 when `spread_near` (its own or one of its eight
+    /// neighbours' errors after round 0 is above T: a pixel whose first few samples all fell
+    /// on one side of an edge sees the edge through a neighbour); later rounds when its own
+    /// error is still above T.
+    bool takes_round(const PixelTally& tally, int r, bool spread_near) const {
         const SampleRun run = adaptive_round(r, cap);
         if (run.count == 0 || tally.n != run.first) return false;
-        return r == 0 || tally.standard_error() > threshold;
+        return r == 0 || (r == 1 ? spread_near : above(tally));
     }
 };
 

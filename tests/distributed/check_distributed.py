@@ -155,7 +155,8 @@ def group_shard(args, tmp):
 
 # Every setting of the settings token (driver/render_job.h, PixelSettings): the flag that
 # changes it and two values, or None for a setting only the scene's files give (covered by
-# the scene's content hash) or that has its own test (frames: the frames group of cli_test).
+# the scene's content hash) or that has its own test (frames: the frames group of cli_test;
+# target_error: refused with --shard and --checkpoint, cli_test's adaptive group).
 SETTING_FLAGS = {
     "width": ("--width", "64", "80"), "height": ("--height", "48", "32"), "spp": ("--spp", "2", "3"),
     "depth": ("--depth", "5", "2"), "degree": ("--degree", "5", "4"),
@@ -164,7 +165,8 @@ SETTING_FLAGS = {
     "colorspace": ("--colorspace", "srgb", "linear"), "tonemap": ("--tonemap", "clamp", "reinhard"),
     "engine": ("--engine", "stream", "recursive"), "isa": ("--isa", "sse2", "sse4.2"),
     "accel": ("--accel", "auto", "flat"), "shade": ("--shade", "simd", "scalar"),
-    "frame": None, "calibration": None, "exr": None,
+    "adaptive": ("--adaptive", "0", "0.05"),
+    "frame": None, "calibration": None, "exr": None, "target_error": None,
 }
 
 

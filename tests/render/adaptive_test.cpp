@@ -1,0 +1,188 @@
+// Adaptive sampling (render/adaptive.h, driver/adaptive_render.*; docs/adaptive-sampling.md):
+// the rounds, the error estimate against hand-computed values, and rendered pictures that
+// depend on nothing but the pixels: -j, the whole image or one tile at a time, both engines;
+// the cap, the threshold's monotonicity, the time limit and the image target.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "driver/render.h"
+#include "parallel/parallelism.h"
+#include "render/adaptive.h"
+#include "scene/parser.h"
+
+using namespace streamrt;
+
+namespace {
+
+// A mirror sphere and a glass one over a checkered floor, a point light (hard shadow edges):
+// flat pixels, edges and reflected edges.
+const char* kScene =
+    "image width=48 height=32 spp=32 depth=3 degree=5\n"
+    "camera eye=0,1.5,6 look=0,0,0\n"
+    "light point pos=4,8,5\n"
+    "sphere translate=-1,0,0 refl=0.6 diff=0.4\nsphere translate=1.2,0,0 trans=0.7 ior=1.5 diff=0.3\n"
+    "plane translate=0,-1,0 checker=0.1,0.1,0.1 cell=0.5\n";
+
+Scene adaptive_scene(double threshold, int cap = 32) {
+    Scene sc = parse_scene(kScene, "adaptive.cfg");
+    sc.settings.adaptive = threshold;
+    sc.settings.spp = cap;
+    return sc;
+}
+
+RenderResult render(const Scene& sc, EngineKind engine, int jobs, const AdaptiveStop& stop = {}) {
+    EngineOptions options;
+    options.adaptive_stop = stop;
+    Parallelism par(jobs);
+    auto prepared = prepare_render(sc, engine, options);
+    return render_prepared(*prepared, par);
+}
+
+/// Samples taken by pixel i (the sample map's first channel).
+float samples_at(const RenderResult& r, std::size_t i) { return r.sample_map.rgb[i * 3]; }
+
+}  // namespace
+
+TEST_CASE("adaptive: rounds start with 4 samples and double up to the cap") {
+    // cap 32: 4 | 4 | 8 | 16 | none (4 + 4 + 8 + 16 = 32).
+    const int firsts[] = {0, 4, 8, 16};
+    const int counts[] = {4, 4, 8, 16};
+    for (int r = 0; r < 4; ++r) {
+        CAPTURE(r);
+        CHECK(adaptive_round(r, 32).first == firsts[r]);
+        CHECK(adaptive_round(r, 32).count == counts[r]);
+    }
+    CHECK(adaptive_round(4, 32).count == 0);
+    // A cap that is not a power of two: the last round is cut (cap 11: 4 | 4 | 3).
+    CHECK(adaptive_round(1, 11).count == 4);
+    CHECK(adaptive_round(2, 11).first == 8);
+    CHECK(adaptive_round(2, 11).count == 3);
+    CHECK(adaptive_round(3, 11).count == 0);
+    // A cap below the first round's size: one round.
+    CHECK(adaptive_round(0, 2).count == 2);
+    CHECK(adaptive_round(1, 2).count == 0);
+}
+
+TEST_CASE("adaptive: the error estimate is the standard error of the mean luminance") {
+    PixelTally t;
+    CHECK(std::isinf(t.standard_error()));
+    // Grey samples (luminance = value, the Rec. 709 weights sum to 1) 1, 2, 3, 4: mean 2.5,
+    // s^2 = (2.25 + 0.25 + 0.25 + 2.25) / 3 = 5/3, standard error sqrt(5/3 / 4).
+    for (float v : {1.f, 2.f, 3.f, 4.f}) t.add(v, v, v);
+    CHECK(t.n == 4);
+    CHECK(t.mean().x == doctest::Approx(2.5).epsilon(1e-15));
+    CHECK(t.standard_error() == doctest::Approx(std::sqrt(5.0 / 12.0)).epsilon(1e-12));
+    // Pure red: luminance 0.2126 per unit. Samples 0 and 1: s^2 = 0.2126^2 / 2, se = 0.2126 / 2.
+    PixelTally red;
+    red.add(0.f, 0.f, 0.f);
+    red.add(1.f, 0.f, 0.f);
+    CHECK(red.standard_error() == doctest::Approx(0.2126 / 2).epsilon(1e-12));
+    // A bright flat pixel has no spread: exactly zero, not rounding noise of two large sums.
+    PixelTally flat;
+    for (int i = 0; i < 64; ++i) flat.add(1000.1f, 1000.1f, 1000.1f);
+    CHECK(flat.standard_error() == 0.0);
+}
+
+TEST_CASE("adaptive: round 1 follows the pixel's or a neighbour's spread, later rounds its own") {
+    const AdaptiveRule rule{0.01, 32};
+    PixelTally flat;  // four equal samples: no spread of its own
+    for (int i = 0; i < 4; ++i) flat.add(0.5f, 0.5f, 0.5f);
+    CHECK(rule.takes_round(PixelTally{}, 0, false));
+    CHECK_FALSE(rule.takes_round(flat, 0, false));  // took it already
+    CHECK_FALSE(rule.takes_round(flat, 1, false));
+    CHECK(rule.takes_round(flat, 1, true));  // a neighbour saw an edge
+    PixelTally edge = flat;
+    // 8 samples, half black: mean 0.25, s^2 = 8 x 0.0625 / 7, se = sqrt(s^2 / 8) = 0.0945 > T.
+    for (int i = 0; i < 4; ++i) edge.add(0.f, 0.f, 0.f);
+    CHECK(rule.takes_round(edge, 2, false));
+    CHECK_FALSE(rule.takes_round(edge, 3, false));  // round 2 not taken yet
+    PixelTally settled = flat;
+    for (int i = 0; i < 4; ++i) settled.add(0.5f, 0.5f, 0.5f);
+    CHECK_FALSE(rule.takes_round(settled, 2, true));  // the neighbour rule is round 1's only
+}
+
+TEST_CASE("adaptive: the same picture and sample counts for -j1, -j2 and tile by tile, both engines") {
+    const Scene sc = adaptive_scene(0.004);
+    for (EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
+        CAPTURE(engine_name(engine));
+        const RenderResult one = render(sc, engine, 1), two = render(sc, engine, 2);
+        REQUIRE(one.adaptive);
+        CHECK(one.image.rgb == two.image.rgb);
+        CHECK(one.sample_map.rgb == two.sample_map.rgb);
+        CHECK(one.counts.total() == two.counts.total());
+        // Tile by tile (shards, MPI ranks, checkpoints): each tile alone, its ring's first
+        // round taken by itself, gives the whole-image render's pixels bit for bit.
+        EngineOptions options;
+        auto prepared = prepare_render(sc, engine, options);
+        Framebuffer tiled(sc.settings.width, sc.settings.height);
+        for (int i = 0; i < tile_count(sc.settings.width, sc.settings.height); ++i) {
+            const Tile t = tile_rect(sc.settings.width, sc.settings.height, i);
+            std::vector<float> rgb(std::size_t(t.width() * t.height() * 3));
+            RayCounts counts;
+            prepared->render_tile(t, rgb.data(), counts, nullptr);
+            for (int y = t.y0; y < t.y1; ++y)
+                for (int x = t.x0; x < t.x1; ++x)
+                    std::copy_n(&rgb[std::size_t(((y - t.y0) * t.width() + (x - t.x0)) * 3)], 3, tiled.pixel(x, y));
+        }
+        CHECK(tiled.rgb == one.image.rgb);
+    }
+}
+
+TEST_CASE("adaptive: counts stay within [4, cap], flat pixels stop at 4, edges reach the cap") {
+    const Scene sc = adaptive_scene(1e-9);  // below any spread: every pixel with one goes on
+    const RenderResult r = render(sc, EngineKind::Stream, 2);
+    const std::size_t n = std::size_t(sc.settings.width * sc.settings.height);
+    int at_4 = 0, at_cap = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const float s = samples_at(r, i);
+        CHECK((s == 4 || s == 8 || s == 16 || s == 32));
+        at_4 += s == 4, at_cap += s == 32;
+    }
+    // The sky (background, top rows) is flat: pixel (24, 0) takes 4 samples.
+    CHECK(samples_at(r, 24) == 4);
+    CHECK(at_4 > 0);
+    CHECK(at_cap > 0);
+    CHECK(r.adaptive->mean_spp > 4);
+    CHECK(r.adaptive->mean_spp < 32);
+}
+
+TEST_CASE("adaptive: a smaller threshold never gives a pixel fewer samples") {
+    const std::size_t n = 48 * 32;
+    for (EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
+        CAPTURE(engine_name(engine));
+        std::vector<float> before(n, 0.f);
+        double mean_before = 0;
+        for (double t : {0.05, 0.01, 0.002, 0.0004}) {
+            CAPTURE(t);
+            const RenderResult r = render(adaptive_scene(t), engine, 2);
+            for (std::size_t i = 0; i < n; ++i) CHECK(samples_at(r, i) >= before[i]);
+            for (std::size_t i = 0; i < n; ++i) before[i] = samples_at(r, i);
+            CHECK(r.adaptive->mean_spp >= mean_before);
+            mean_before = r.adaptive->mean_spp;
+        }
+    }
+}
+
+TEST_CASE("adaptive: a spent time limit stops after the first round; an image target stops early") {
+    const Scene sc = adaptive_scene(1e-9);
+    // 1 ns: spent before the first round ends, which always covers the image.
+    const RenderResult timed = render(sc, EngineKind::Stream, 2, AdaptiveStop{.time_limit = 1e-9});
+    REQUIRE(timed.adaptive);
+    CHECK(timed.adaptive->time_limited);
+    CHECK(timed.adaptive->rounds == 1);
+    CHECK(timed.adaptive->mean_spp == 4.0);
+    // A target the first round already meets: the render stops there.
+    const RenderResult loose = render(sc, EngineKind::Stream, 2, AdaptiveStop{.target_error = 0.5});
+    CHECK(loose.adaptive->rounds == 1);
+    CHECK(loose.adaptive->estimated_rmse <= 0.5);
+    // A tighter target takes more rounds and reaches it or runs out of rounds (the cap).
+    const RenderResult first = render(sc, EngineKind::Stream, 2, AdaptiveStop{.time_limit = 1e-9});
+    const double first_rmse = first.adaptive->estimated_rmse;
+    const RenderResult tight = render(sc, EngineKind::Stream, 2, AdaptiveStop{.target_error = first_rmse * 0.6});
+    CHECK(tight.adaptive->rounds > 1);
+    CHECK(tight.adaptive->estimated_rmse < first_rmse);
+    CHECK((tight.adaptive->estimated_rmse <= first_rmse * 0.6 || tight.adaptive->rounds == 4));
+}
