@@ -1,0 +1,104 @@
+// Adaptive sampling from the command line (docs/adaptive-sampling.md): the options, the
+// closing line, the sample map file, the scene key and every refusal as one line.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <set>
+
+#include "cli/cli_support.h"
+#include "image/image_io.h"
+
+using namespace cli_support;
+
+namespace {
+const char* kScene =
+    "image width=40 height=30 spp=1 depth=2 degree=5\n"
+    "camera eye=0,1,6 look=0,0,0\n"
+    "light point pos=5,8,5\n"
+    "sphere refl=0.5\nplane translate=0,-1,0 checker=0,0,0 cell=0.5\n";
+}  // namespace
+
+TEST_CASE("cli adaptive: --adaptive renders, states its samples and error, writes the sample map") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kScene);
+    const Run r = run_streamrt("-j2 " + q(scene) + " -o " + q(d.path / "a.pfm") + " --spp 16 --adaptive 0.01 --aov samples=" +
+                               q(d.path / "n.pfm"));
+    REQUIRE(r.code == 0);
+    INFO(r.out);
+    // The scene's spp=1 is overridden by --spp 16: the cap.
+    CHECK(r.out.find(" adaptive (at most 16, estimated error ") != std::string::npos);
+    const streamrt::Framebuffer map = streamrt::read_image((d.path / "n.pfm").string());
+    REQUIRE(map.width == 40);
+    REQUIRE(map.height == 30);
+    std::set<float> counts;
+    for (int y = 0; y < 30; ++y)
+        for (int x = 0; x < 40; ++x) {
+            const float* m = map.pixel(x, y);
+            counts.insert(m[0]);
+            CHECK(m[1] >= 0.f);
+            CHECK(m[2] == 0.f);
+        }
+    // Rounds of 4, 4, 8 samples: a pixel stops at 4, 8 or 16; flat ones at 4, edges go on.
+    for (const float c : counts) CHECK((c == 4.f || c == 8.f || c == 16.f));
+    CHECK(counts.count(4.f) == 1);
+    CHECK(counts.size() >= 2);
+}
+
+TEST_CASE("cli adaptive: the scene's image adaptive= key, and spp 1 takes the default cap 64") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", std::string(kScene) + "image adaptive=0.02\n");
+    const Run r = run_streamrt("-j2 " + q(scene) + " -o " + q(d.path / "a.pfm"));
+    REQUIRE(r.code == 0);
+    CHECK(r.out.find(" adaptive (at most 64, ") != std::string::npos);
+    // Out of range: one line with the file, line and column of the value.
+    const fs::path bad = d.write("bad.cfg", "image width=8 adaptive=2\nsphere\n");
+    const Run e = run_streamrt(q(bad));
+    CHECK(e.code == 2);
+    check_one_line_error(e, bad.string() + ":1:24: ");
+}
+
+TEST_CASE("cli adaptive: refusals, one line each, nothing written") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kScene);
+    const std::string out = " -o " + q(d.path / "a.pfm");
+    const Run grid = run_streamrt(q(scene) + out + " --adaptive 0.01 --sampler grid");
+    CHECK(grid.code == 2);
+    check_one_line_error(grid, "adaptive sampling needs sampler stratified or random");
+    const Run one = run_streamrt(q(scene) + out + " --adaptive 0.01 --spp 1");
+    CHECK(one.code == 2);
+    check_one_line_error(one, "adaptive sampling needs spp >= 2");
+    const Run shard = run_streamrt(q(scene) + " -o " + q(d.path / "p.part") + " --target-error 0.01 --shard 0/2");
+    CHECK(shard.code == 2);
+    check_one_line_error(shard, "--target-error and --time-limit decide over the whole image");
+    const Run timed = run_streamrt(q(scene) + out + " --time-limit 5");
+    CHECK(timed.code == 2);
+    check_one_line_error(timed, "time_limit stops adaptive sampling");
+    const Run png = run_streamrt(q(scene) + out + " --adaptive 0.01 --aov samples=" + q(d.path / "n.png"));
+    CHECK(png.code == 2);
+    check_one_line_error(png, "the sample map is written as .pfm or .exr");
+    const Run uniform = run_streamrt(q(scene) + out + " --aov samples=" + q(d.path / "n.pfm"));
+    CHECK(uniform.code == 2);
+    check_one_line_error(uniform, "--aov samples= needs adaptive sampling");
+    CHECK(d.files().size() == 1);  // the scene alone
+}
+
+TEST_CASE("cli adaptive: --adaptive shards merge into the whole image's picture, bit for bit") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kScene);
+    const std::string common = q(scene) + " -q --spp 16 --adaptive 0.005";
+    REQUIRE(run_streamrt("-j2 " + common + " -o " + q(d.path / "whole.pfm")).code == 0);
+    REQUIRE(run_streamrt("-j1 " + common + " -o " + q(d.path / "p0.part") + " --shard 0/2").code == 0);
+    REQUIRE(run_streamrt("-j2 " + common + " -o " + q(d.path / "p1.part") + " --shard 1/2").code == 0);
+    const Run m = run_streamrt("merge " + q(d.path / "p0.part") + " " + q(d.path / "p1.part") + " -o " +
+                               q(d.path / "merged.pfm"));
+    REQUIRE(m.code == 0);
+    const streamrt::Framebuffer whole = streamrt::read_image((d.path / "whole.pfm").string());
+    const streamrt::Framebuffer merged = streamrt::read_image((d.path / "merged.pfm").string());
+    CHECK(whole.rgb == merged.rgb);
+    // A part of another threshold is refused by merge (the settings token).
+    REQUIRE(run_streamrt(q(scene) + " -q --spp 16 --adaptive 0.01 -o " + q(d.path / "q1.part") + " --shard 1/2").code == 0);
+    const Run mixed = run_streamrt("merge " + q(d.path / "p0.part") + " " + q(d.path / "q1.part") + " -o " +
+                                   q(d.path / "mixed.pfm"));
+    CHECK(mixed.code != 0);
+    CHECK(!fs::exists(d.path / "mixed.pfm"));
+}
