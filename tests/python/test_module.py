@@ -55,12 +55,28 @@ def test_image_is_the_command_lines_pfm_bit_for_bit():
         (dict(engine="recursive"), ["--engine", "recursive"]),
         (dict(isa="sse2", accel="bvh"), ["--isa", "sse2", "--accel", "bvh"]),
         (dict(accel="flat", threads=1), ["--accel", "flat", "-j", "1"]),
+        (dict(adaptive=0.01, spp=16), ["--adaptive", "0.01", "--spp", "16"]),
     ],
 )
 def test_overrides_give_the_command_lines_picture(overrides, flags):
     size = dict(width=48, height=32)
     r = streamrt.render(WHITTED, **size, **overrides)
     np.testing.assert_array_equal(r.image, cli_pfm(WHITTED, "--width", "48", "--height", "32", *flags))
+
+
+def test_adaptive_result_carries_the_sample_map_of_the_command_line():
+    r = streamrt.render(WHITTED, width=48, height=32, spp=16, adaptive=0.01)
+    assert r.adaptive is not None
+    with tempfile.TemporaryDirectory() as d:
+        out, samples = os.path.join(d, "x.pfm"), os.path.join(d, "n.pfm")
+        subprocess.run([STREAMRT, WHITTED, "-q", "-o", out, "--width", "48", "--height", "32", "--spp", "16",
+                        "--adaptive", "0.01", "--aov", "samples=" + samples], check=True)
+        np.testing.assert_array_equal(r.adaptive["sample_map"], read_pfm(samples))
+    counts = r.adaptive["sample_map"][..., 0]
+    assert set(np.unique(counts)) <= {4.0, 8.0, 16.0}
+    assert r.adaptive["mean_spp"] == pytest.approx(counts.mean())
+    assert r.rays["primary"] == int(counts.sum())
+    assert streamrt.render(WHITTED, width=48, height=32, spp=16).adaptive is None
 
 
 def test_scene_text_and_flat_colours():
