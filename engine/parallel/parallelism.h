@@ -193,7 +193,15 @@ class Parallelism {
     explicit Parallelism(int jobs)
         : jobs_(jobs > 0 ? jobs : default_jobs()),
           limit_(oneapi::tbb::global_control::max_allowed_parallelism, std::size_t(jobs_)),
+          stack_(oneapi::tbb::global_control::thread_stack_size, kWorkerStackBytes),
           arena_(jobs_) {}
+
+    /// The stack of oneTBB's worker threads (its default: 4 MiB). The recursive baseline
+    /// recurses once per bounce, up to depth 256; under AddressSanitizer its frames are several
+    /// times larger and 256 bounces overflowed 4 MiB. Reserved address space, not memory: pages
+    /// are committed only as deep as a thread goes. oneTBB reads it when it starts its workers,
+    /// which the first Parallelism of a process does.
+    static constexpr std::size_t kWorkerStackBytes = std::size_t(64) << 20;
 
     int jobs() const { return jobs_; }
 
@@ -240,6 +248,7 @@ class Parallelism {
   private:
     int jobs_;
     oneapi::tbb::global_control limit_;
+    oneapi::tbb::global_control stack_;
     oneapi::tbb::task_arena arena_;
 };
 
