@@ -23,7 +23,7 @@ int refine(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, c
     static thread_local std::vector<float> colours;
     pixels.clear();
     for (std::size_t p = 0; p < t.pixels.size(); ++p)
-        if (prepared.adaptive.takes_round(t.pixels[p], r, t.spread_near[p] != 0)) pixels.push_back(std::uint32_t(p));
+        if (prepared.adaptive.takes_round(t.pixels[p], r, run, t.spread_near[p] != 0)) pixels.push_back(std::uint32_t(p));
     if (pixels.empty()) return 0;
     colours.resize(pixels.size() * std::size_t(run.count) * 3);
     prepared.render_samples(t.tile, run, pixels.data(), int(pixels.size()), colours.data(), counts, cancel);
@@ -39,15 +39,16 @@ int refine(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, c
 /// row by row): its own error or one of its neighbours' (those inside `outer`) above T.
 void mark_spread(const AdaptiveRule& rule, const Tile& outer, const std::vector<PixelTally>& all, const Tile& inner,
                  std::vector<std::uint8_t>& spread_near) {
-    const auto above = [&](int x, int y) {
-        return rule.above(all[std::size_t(y - outer.y0) * std::size_t(outer.width()) + std::size_t(x - outer.x0)]);
-    };
+    static thread_local std::vector<std::uint8_t> above;
+    above.resize(all.size());
+    for (std::size_t i = 0; i < all.size(); ++i) above[i] = rule.above(all[i]);
+    const std::size_t ow = std::size_t(outer.width());
     for (int y = inner.y0; y < inner.y1; ++y)
         for (int x = inner.x0; x < inner.x1; ++x) {
             bool near = false;
-            for (int ny = std::max(outer.y0, y - 1); ny <= std::min(outer.y1 - 1, y + 1) && !near; ++ny)
-                for (int nx = std::max(outer.x0, x - 1); nx <= std::min(outer.x1 - 1, x + 1) && !near; ++nx)
-                    near = above(nx, ny);
+            for (int ny = std::max(outer.y0, y - 1); ny <= std::min(outer.y1 - 1, y + 1); ++ny)
+                for (int nx = std::max(outer.x0, x - 1); nx <= std::min(outer.x1 - 1, x + 1); ++nx)
+                    near |= above[std::size_t(ny - outer.y0) * ow + std::size_t(nx - outer.x0)] != 0;
             spread_near[std::size_t(y - inner.y0) * std::size_t(inner.width()) + std::size_t(x - inner.x0)] = near;
         }
 }

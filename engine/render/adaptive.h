@@ -35,30 +35,31 @@ inline SampleRun adaptive_round(int r, int cap) {
 /// Rec. 709 luminance of linear RGB: what the error estimate measures.
 inline double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
 
-/// A pixel's samples so far: their colour sum, and their luminance's mean and sum of squared
-/// deviations kept by Welford's update (no cancellation between two large sums of squares,
-/// which in a bright flat pixel would leave rounding noise as the variance).
+/// A pixel's samples so far: their colour sum, and the sums of their luminance and its square
+/// taken about the first sample's luminance (the shifted-data form: in a bright flat pixel the
+/// two sums stay small, so the variance is not lost to cancellation, and no division per sample).
 struct PixelTally {
     double r = 0, g = 0, b = 0;
-    double mean_y = 0, m2_y = 0;
+    double shift = 0, sum_y = 0, sum_yy = 0;  ///< luminance sums of y - shift
     int n = 0;
 
     void add(float sr, float sg, float sb) {
         r += sr, g += sg, b += sb;
-        ++n;
         const double y = luminance(sr, sg, sb);
-        const double d = y - mean_y;
-        mean_y += d / n;
-        m2_y += d * (y - mean_y);
+        if (n++ == 0) shift = y;
+        const double d = y - shift;
+        sum_y += d, sum_yy += d * d;
     }
     /// The pixel's value: the mean of its samples.
     ColorT<double> mean() const { return n > 0 ? ColorT<double>{r / n, g / n, b / n} : ColorT<double>{0, 0, 0}; }
-    /// The estimated standard error of the mean luminance, sqrt(s^2 / n) with s^2 the unbiased
-    /// sample variance; infinity below 2 samples (no spread yet). Stratified samples vary
-    /// less than independent ones, so this errs on the high side.
+    /// n (n - 1) s^2 with s^2 the unbiased sample variance of the luminance (n sum_yy - sum_y^2).
+    double scaled_variance() const { return std::max(0.0, n * sum_yy - sum_y * sum_y); }
+    /// The estimated standard error of the mean luminance, sqrt(s^2 / n); infinity below 2
+    /// samples (no spread yet). Stratified samples vary less than independent ones, so this
+    /// errs on the high side.
     double standard_error() const {
         if (n < 2) return std::numeric_limits<double>::infinity();
-        return std::sqrt(std::max(0.0, m2_y / (n - 1)) / n);
+        return std::sqrt(scaled_variance() / (double(n) * n * (n - 1)));
     }
 };
 
@@ -68,15 +69,23 @@ struct AdaptiveRule {
     int cap = 1;           ///< the most samples a pixel takes
 
     bool on() const { return threshold > 0; }
-    /// Whether a pixel's error is above T (after any round).
-    bool above(const PixelTally& tally) const { return tally.standard_error() > threshold; }
+    /// Whether a pixel's error is above T (after any round): standard_error() > T, squared and
+    /// multiplied out (no root, no division: it runs for every pixel of every round).
+    bool above(const PixelTally& tally) const {
+        if (tally.n < 2) return true;
+        const double n = tally.n;
+        return tally.scaled_variance() > threshold * threshold * n * n * (n - 1);
+    }
     /// Whether a pixel with `tally` takes round r: it took every round before r, round r
     /// exists, and: round 0 always; round 1 when `spread_near` (its own or one of its eight
     /// neighbours' errors after round 0 is above T: a pixel whose first few samples all fell
     /// on one side of an edge sees the edge through a neighbour); later rounds when its own
     /// error is still above T.
     bool takes_round(const PixelTally& tally, int r, bool spread_near) const {
-        const SampleRun run = adaptive_round(r, cap);
+        return takes_round(tally, r, adaptive_round(r, cap), spread_near);
+    }
+    /// The same with round r's run given (a loop over pixels works it out once).
+    bool takes_round(const PixelTally& tally, int r, SampleRun run, bool spread_near) const {
         if (run.count == 0 || tally.n != run.first) return false;
         return r == 0 || (r == 1 ? spread_near : above(tally));
     }
