@@ -42,15 +42,28 @@ struct MaterialT {
     TextureView texture{};
     T uv_scale = T(1);
 
+    /// The engine's form of a scene material; each engine then sets what depends on its
+    /// tables (texture, cell_offset).
     static MaterialT from(const Material& m) {
-        const double cutoff =
-            m.spec > 0 && m.shininess > 0 ? std::min(1.0, std::pow(std::min(1.0, 1e-5 / m.spec), 1.0 / m.shininess)) : 0.0;
-        const bool fresnel = m.fresnel && m.trans > 0 && m.ior != 1.0;
-        const double r = (m.ior - 1.0) / (m.ior + 1.0);
-        return {{T(m.checker_color.x), T(m.checker_color.y), T(m.checker_color.z)},
-                T(m.ambi), T(m.diff), T(m.spec), T(m.shininess), T(m.refl), T(m.trans),
-                T(m.ior), T(1.0 / m.cell), m.checker, T(cutoff), {T(0), T(0), T(0)},
-                fresnel, T(fresnel ? r * r : 0.0)};
+        MaterialT r{};
+        r.checker_color = {T(m.checker_color.x), T(m.checker_color.y), T(m.checker_color.z)};
+        r.ambi = T(m.ambi);
+        r.diff = T(m.diff);
+        r.spec = T(m.spec);
+        r.shininess = T(m.shininess);
+        r.refl = T(m.refl);
+        r.trans = T(m.trans);
+        r.ior = T(m.ior);
+        r.inv_cell = T(1.0 / m.cell);
+        r.checker = m.checker;
+        r.spec_cutoff = T(m.spec > 0 && m.shininess > 0
+                              ? std::min(1.0, std::pow(std::min(1.0, 1e-5 / m.spec), 1.0 / m.shininess))
+                              : 0.0);
+        r.fresnel = m.fresnel && m.trans > 0 && m.ior != 1.0;
+        const double r0 = (m.ior - 1.0) / (m.ior + 1.0);
+        r.r0 = T(r.fresnel ? r0 * r0 : 0.0);
+        r.uv_scale = T(m.uv_scale);
+        return r;
     }
 };
 
