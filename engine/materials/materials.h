@@ -10,6 +10,7 @@
 #include <functional>
 #include <string_view>
 
+#include "materials/emission_property.h"
 #include "materials/fresnel_property.h"
 #include "materials/handout_properties.h"
 #include "materials/material_property.h"
@@ -43,7 +44,8 @@ struct PropertyList {
 
 namespace property {
 /// THE registration list: every material property, in the order messages list their keys.
-using Registered = PropertyList<Ambi, Diff, Spec, Shininess, Refl, Trans, Ior, Checker, Cell, Fresnel, Texture, UvScale>;
+using Registered =
+    PropertyList<Ambi, Diff, Spec, Shininess, Refl, Trans, Ior, Checker, Cell, Fresnel, Texture, UvScale, Emission>;
 }  // namespace property
 using MaterialProperties = property::Registered;
 static_assert(MaterialProperties::distinct_keys(), "two material properties share a key");
