@@ -173,6 +173,8 @@ TEST_CASE("material registry: every property is read by material and shape state
             // Given with the default value, the key still turns the property on: another record.
             const Scene g = parse_scene("sphere " + key + "=" + colour_text(default_of<P>()) + "\nsphere\n", kScenePath);
             CHECK(g.materials.size() == 2);
+            CHECK_FALSE(g.material_of(g.objects[0]) == g.material_of(g.objects[1]));
+            CHECK(MaterialHash{}(g.material_of(g.objects[0])) != MaterialHash{}(g.material_of(g.objects[1])));
         }
         CHECK(s.material_of(s.objects[2]).*P::field == default_of<P>());
         CHECK(s.material_of(s.objects[2]) == Material{});
