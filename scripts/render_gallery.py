@@ -16,7 +16,7 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-STILLS = ["soft_shadows", "dof", "fresnel", "textured"]
+STILLS = ["soft_shadows", "dof", "fresnel", "textured", "emission"]
 STRIP_FRAMES = [0, 6, 12, 13, 18, 23]
 
 

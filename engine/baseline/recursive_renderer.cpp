@@ -52,10 +52,7 @@ RecursiveRenderer::RecursiveRenderer(const Scene& scene, const RenderSettings& s
     });
     for (const Material& m : scene.materials) {
         materials_.push_back(MaterialT<double>::from(m));
-        if (m.texture >= 0) {
-            materials_.back().texture = scene.textures[std::size_t(m.texture)]->view();
-            materials_.back().uv_scale = m.uv_scale;
-        }
+        if (m.texture >= 0) materials_.back().texture = scene.textures[std::size_t(m.texture)]->view();
     }
     for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(rendered_light(l, settings_)));
 }

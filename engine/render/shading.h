@@ -41,16 +41,35 @@ struct MaterialT {
     // each engine from Scene::textures (empty: no texture, today's code).
     TextureView texture{};
     T uv_scale = T(1);
+    /// emission=: the surface's own radiance, added at every hit from degree 1 (shade_hit);
+    /// `emits` when it is not black.
+    ColorT<T> emission{T(0), T(0), T(0)};
+    bool emits = false;
 
+    /// The engine's form of a scene material; each engine then sets what depends on its
+    /// tables (texture, cell_offset).
     static MaterialT from(const Material& m) {
-        const double cutoff =
-            m.spec > 0 && m.shininess > 0 ? std::min(1.0, std::pow(std::min(1.0, 1e-5 / m.spec), 1.0 / m.shininess)) : 0.0;
-        const bool fresnel = m.fresnel && m.trans > 0 && m.ior != 1.0;
-        const double r = (m.ior - 1.0) / (m.ior + 1.0);
-        return {{T(m.checker_color.x), T(m.checker_color.y), T(m.checker_color.z)},
-                T(m.ambi), T(m.diff), T(m.spec), T(m.shininess), T(m.refl), T(m.trans),
-                T(m.ior), T(1.0 / m.cell), m.checker, T(cutoff), {T(0), T(0), T(0)},
-                fresnel, T(fresnel ? r * r : 0.0)};
+        MaterialT r{};
+        r.checker_color = {T(m.checker_color.x), T(m.checker_color.y), T(m.checker_color.z)};
+        r.ambi = T(m.ambi);
+        r.diff = T(m.diff);
+        r.spec = T(m.spec);
+        r.shininess = T(m.shininess);
+        r.refl = T(m.refl);
+        r.trans = T(m.trans);
+        r.ior = T(m.ior);
+        r.inv_cell = T(1.0 / m.cell);
+        r.checker = m.checker;
+        r.spec_cutoff = T(m.spec > 0 && m.shininess > 0
+                              ? std::min(1.0, std::pow(std::min(1.0, 1e-5 / m.spec), 1.0 / m.shininess))
+                              : 0.0);
+        r.fresnel = m.fresnel && m.trans > 0 && m.ior != 1.0;
+        const double r0 = (m.ior - 1.0) / (m.ior + 1.0);
+        r.r0 = T(r.fresnel ? r0 * r0 : 0.0);
+        r.uv_scale = T(m.uv_scale);
+        r.emission = {T(m.emission.x), T(m.emission.y), T(m.emission.z)};
+        r.emits = m.emission != glm::dvec3(0.0);
+        return r;
     }
 };
 
@@ -356,8 +375,9 @@ template <bool kShadows, class V, class T, class M, class Sink>
 
 /// The handout's shading of one hit (or one packet of hits), written once for the recursive
 /// baseline (V = double, one ray), the stream engine's scalar path (float) and its SIMD
-/// kernels (float batches): the surface colour (checker), the local terms by degree, shadow
-/// rays, and the reflected and refracted children with their weights. What differs between
+/// kernels (float batches): the surface colour (checker), the local terms by degree (with the
+/// material's emission from degree 1), shadow rays, and the reflected and refracted children
+/// with their weights. What differs between
 /// engines is only where the results go, the Sink:
 ///   sink.local(c)                                  the ray's weighted local colour, first
 ///   sink.shadow(send, origin, to, t_max, c)        degree 5: c reaches the pixel if the
@@ -396,6 +416,9 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
         // inner faces lit).
         const Vec3T<V> n = select3(meets_outside(n_out, d), n_out, -n_out);
         ColorT<V> local = mul(ray.weight, ambient_light(rules.degree, rules.ambient, m, base));
+        // The surface's own emission (a per-material branch): seen wherever the surface is,
+        // directly or through mirrors and glass, but it lights nothing (no light source).
+        if (m.emits) local = local + mul(ray.weight, splat<V>(m.emission));
         // The shadow rays' origin, made at the first light that sends one.
         Vec3T<V> shadow_origin{};
         bool have_origin = false;

@@ -57,11 +57,7 @@ std::optional<Arg> Parser::shape(Statement& st, const std::vector<Token>& toks, 
     bool obj_materials = false;     // materials=obj: the file's own materials, a part each
     for (const Arg& a : st.args) {
         if (same(a.key, "material") || same(a.key, "name")) continue;
-        if (same(a.key, "texture")) {
-            f.look.m.texture = texture_file(st, a);
-            continue;
-        }
-        if (apply_material_key(st, a, f.look)) continue;
+        if (material_key(st, a, f.look)) continue;
         if (apply_transform_key(st, a, f.md)) continue;
         if (param.present() && same(a.key, param.key)) f.param = st.positive(a);
         else if (same(a.key, "smooth")) f.smooth = st.boolean(a);

@@ -193,9 +193,7 @@ void Parser::material(Statement& st, const std::vector<Token>& toks) {
     st.read_args(toks, 2, kMaterialStatementKeys);  // "material": a base to start from
     Appearance m;
     if (const Arg* base = st.find("material")) m = lookup_material(st, *base);
-    for (const Arg& a : st.args)
-        if (same(a.key, "texture")) m.m.texture = texture_file(st, a);
-        else apply_material_key(st, a, m);
+    for (const Arg& a : st.args) material_key(st, a, m);
     materials_.emplace(std::string(name.text), MaterialDef{m, chunked_ ? st.line() : 0});
 }
 

@@ -168,6 +168,12 @@ class Parser {
 
     void material(Statement& st, const std::vector<Token>& toks);
 
+    /// One material key of a material or shape statement into `look` (scene_keys.h,
+    /// apply_material_key), texture files read through texture_file; false for another key.
+    bool material_key(const Statement& st, const Arg& a, Appearance& look) {
+        return apply_material_key(st, a, look, [&](const Arg& file) { return texture_file(st, file); });
+    }
+
     /// What a shape statement says, before it becomes an Object (make_object).
     struct ShapeFields {
         ShapeKind kind = ShapeKind::Sphere;

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <functional>
 #include <numbers>
 
 namespace streamrt {
@@ -46,17 +45,6 @@ double Camera::focus_distance(const glm::dmat4& md) const {
 }  // namespace streamrt
 
 namespace streamrt {
-
-std::size_t MaterialHash::operator()(const Material& m) const {
-    // Equal materials have equal fields; fields are hashed by value (+0 and -0 compare equal
-    // and are both possible only for checker colours, which then hash alike through +0.0).
-    std::size_t h = 0;
-    const auto mix = [&h](double v) { h = h * 0x9E3779B97F4A7C15ull ^ std::hash<double>{}(v + 0.0); };
-    for (double v : {m.ambi, m.diff, m.spec, m.shininess, m.refl, m.trans, m.ior, m.cell, m.checker_color.x,
-                     m.checker_color.y, m.checker_color.z, double(m.texture), m.uv_scale})
-        mix(v);
-    return h ^ std::size_t(m.checker) ^ (std::size_t(m.fresnel) << 1);
-}
 
 std::uint32_t Scene::intern_material(const Material& m) {
     const auto [it, added] = material_index_.try_emplace(m, std::uint32_t(materials.size()));

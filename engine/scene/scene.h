@@ -22,6 +22,7 @@
 #include "core/transform.h"
 #include "image/display_settings.h"
 #include "lights/lights.h"
+#include "materials/materials.h"
 #include "shapes/shape_kind.h"
 
 namespace streamrt {
@@ -29,35 +30,6 @@ namespace streamrt {
 struct Mesh;
 struct Animation;  // scene/animation.h
 
-
-/// A material's optical parameters (the handout's ambi, diff, refl, trans and their
-/// companions). The colour is not here: it is the object's own (Object::color), so that
-/// scenes whose objects differ only by colour share one material record.
-struct Material {
-    double ambi = 1.0;   ///< weight of the ambient term (degree 2)
-    double diff = 1.0;   ///< weight of the Lambert term (degree 2)
-    double spec = 0.0;   ///< Phong highlight weight (degree 2, optional)
-    double shininess = 32.0;
-    double refl = 0.0;   ///< mirror reflection weight (degree 3)
-    double trans = 0.0;  ///< transmission weight (degree 4)
-    double ior = 1.0;    ///< index of refraction of the inside
-    bool checker = false;
-    glm::dvec3 checker_color{0.0, 0.0, 0.0};
-    double cell = 1.0;  ///< checker cell side, world units
-    /// Fresnel (fresnel=true): at a dielectric (trans > 0) the split between refl and trans
-    /// follows Schlick's approximation instead of the fixed weights (render/shading.h).
-    bool fresnel = false;
-    // Textures (docs/scene-format.md, "Textures and UV mapping").
-    std::int32_t texture = -1;  ///< index into Scene::textures; -1: the object's colour
-    double uv_scale = 1.0;      ///< uvscale=: multiplies (u, v) before the lookup (tiling)
-
-    bool operator==(const Material&) const = default;
-};
-
-/// Hash of a material's fields, for deduplication (equal materials hash alike).
-struct MaterialHash {
-    std::size_t operator()(const Material& m) const;
-};
 
 /// One object, compact (128 bytes; a scene may hold millions): the canonical shape, Md, the
 /// object's colour and the index of its (deduplicated) material. Mi and Mn are not stored:

@@ -15,10 +15,13 @@
 namespace streamrt::scene_reader {
 
 // ---- key vocabularies ------------------------------------------------------------------
-inline const std::vector<std::string_view> kMaterialKeys = {"color", "ambi",    "diff", "spec",
-                                                     "shininess", "refl", "trans", "ior",
-                                                     "checker", "cell", "fresnel",
-                                                     "texture", "uvscale"};  // textures
+/// The material keys: the object's colour, then every registered material property's key
+/// (materials/materials.h), in its order.
+inline const std::vector<std::string_view> kMaterialKeys = [] {
+    std::vector<std::string_view> keys{"color"};
+    MaterialProperties::for_each([&](auto p) { keys.push_back(decltype(p)::info.key); });
+    return keys;
+}();
 inline const std::vector<std::string_view> kTransformKeys = {"scale", "rotate_x", "rotate_y", "rotate_z",
                                                       "translate"};
 inline const std::vector<std::string_view> kImageKeys = {"width",  "height",  "spp",
@@ -74,26 +77,37 @@ struct Appearance {
     glm::dvec3 color{1.0, 1.0, 1.0};
 };
 
-/// Applies one material key; false when `a` is not a material key.
-inline bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap) {
-    const auto k = a.key;
-    Material& m = ap.m;
-    if (same(k, "color")) ap.color = st.color(a);
-    else if (same(k, "ambi")) m.ambi = st.at_least_zero(a);
-    else if (same(k, "diff")) m.diff = st.at_least_zero(a);
-    else if (same(k, "spec")) m.spec = st.at_least_zero(a);
-    else if (same(k, "shininess")) m.shininess = st.at_least_zero(a);
-    else if (same(k, "refl")) m.refl = st.at_least_zero(a);
-    else if (same(k, "trans")) m.trans = st.at_least_zero(a);
-    else if (same(k, "ior")) m.ior = st.positive(a);
-    else if (same(k, "checker")) {
-        m.checker_color = st.color(a);
-        m.checker = true;
-    } else if (same(k, "cell")) m.cell = st.positive(a);
-    else if (same(k, "fresnel")) m.fresnel = st.boolean(a);
-    else if (same(k, "uvscale")) m.uv_scale = st.positive(a);  // texture= is the Parser's (texture_file)
-    else return false;
-    return true;
+/// Reads a's value as property P's kind of value into m, checked (materials/material_property.h;
+/// each refusal at the value's file:line:col). An Image value is a file: `load_image(a)` reads
+/// it (once per file: the Parser's) and gives its index in Scene::textures.
+template <class P, class LoadImage>
+void read_property(const Statement& st, const Arg& a, Material& m, const LoadImage& load_image) {
+    auto& v = m.*P::field;
+    constexpr PropertyInfo info = P::info;
+    if constexpr (info.kind == ValueKind::Number) {
+        if constexpr (info.bound == Bound::AtLeastZero) v = st.at_least_zero(a);
+        else if constexpr (info.bound == Bound::Positive) v = st.positive(a);
+        else v = st.number(a);
+    } else if constexpr (info.kind == ValueKind::Colour) {
+        v = st.color(a);
+    } else if constexpr (info.kind == ValueKind::Flag) {
+        v = st.boolean(a);
+    } else {
+        static_assert(info.kind == ValueKind::Image);
+        v = load_image(a);
+    }
+    if constexpr (has_given_flag<P>()) m.*P::given = true;
+}
+
+/// Applies one material key (the colour or a registered property); false when `a` is not a
+/// material key.
+template <class LoadImage>
+bool apply_material_key(const Statement& st, const Arg& a, Appearance& ap, const LoadImage& load_image) {
+    if (same(a.key, "color")) {
+        ap.color = st.color(a);
+        return true;
+    }
+    return MaterialProperties::visit_key(a.key, [&](auto p) { read_property<decltype(p)>(st, a, ap.m, load_image); });
 }
 
 /// Applies one transform key on the left of `md` (written order = application order).

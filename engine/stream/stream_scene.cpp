@@ -75,7 +75,6 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
         mat.cell_offset = {offset.x, offset.y, offset.z};
         if (m.texture >= 0) {
             mat.texture = scene.textures[std::size_t(m.texture)]->view();
-            mat.uv_scale = float(m.uv_scale);
             features.textures = true;
         }
         materials.push_back(mat);

@@ -13,7 +13,7 @@ import sys
 LAYERS = [
     ["simd"],
     ["core", "parallel"],
-    ["image", "lights", "shapes"],
+    ["image", "lights", "materials", "shapes"],
     ["accel"],
     ["mesh"],
     ["scene"],

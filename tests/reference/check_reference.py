@@ -62,6 +62,8 @@ GROUPS = {
     # Fresnel glass (material fresnel=true), clear and coated, and beside fixed-weight glass.
     + [(_scene("fresnel"), d, (96, 64)) for d in (3, 4, 5)]
     + [(os.path.join(ROOT, "scenes", "fresnel.cfg"), 5, (96, 64))]
+    # Emission (material emission=): seen directly, in a mirror and through glass.
+    + [(os.path.join(ROOT, "scenes", "emission.cfg"), d, (96, 64)) for d in (1, 2, 5)]
     # The Cornell box's edges run along the image diagonals through its centre: with
     # width + height even, pixel centres lie exactly on them and each such pixel is a tie
     # between two walls (0.4 % of the pixels flip). An odd sum keeps the samples off them.

@@ -59,7 +59,8 @@ def _transform_step(key, val):
 
 TRANSFORM_KEYS = ("scale", "rotate_x", "rotate_y", "rotate_z", "translate")
 MATERIAL_DEFAULT = dict(color=np.ones(3), ambi=1.0, diff=1.0, spec=0.0, shininess=32.0,
-                        refl=0.0, trans=0.0, ior=1.0, checker=None, cell=1.0, fresnel=False)
+                        refl=0.0, trans=0.0, ior=1.0, checker=None, cell=1.0, fresnel=False,
+                        emission=np.zeros(3))
 SHAPES = ("sphere", "cube", "cylinder", "cone", "torus", "plane", "disk")
 
 
@@ -75,7 +76,7 @@ def _kv(args):
 
 def _material_keys(mat, pairs):
     for k, v in pairs:
-        if k in ("color", "checker"):
+        if k in ("color", "checker", "emission"):
             mat[k] = _vec(v)
         elif k == "fresnel":
             if v not in ("true", "false"):
@@ -532,7 +533,7 @@ def trace(scene, o, d, level, width0, spread):
             unsure[sel] = uns
             continue
         amb = scene.ambient * (mat["ambi"] if deg >= 2 else 1.0)
-        col = amb * C
+        col = amb * C + mat["emission"]  # the surface's own radiance, from degree 1
         for L in scene.lights:
             if L["kind"] == "directional":
                 w = np.tile(-L["dir"], (len(sel), 1))

@@ -1,0 +1,207 @@
+// The registry of material properties (materials/materials.h), property by property: every
+// registered key is read by the material and shape statements into its field, its value
+// checked at the value's line:column, named in the unknown-key message, counted by the
+// material's equality and hash, and listed with its type, default and range in the material
+// keys' table of docs/scene-format.md.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/format_number.h"
+#include "materials/materials.h"
+#include "scene/expect_error.h"
+#include "scene/parser.h"
+
+using namespace streamrt;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// The scenes' folder: Image properties read its textures/tiles.png (the scene text itself is
+/// parsed from memory under this name).
+const std::string kScenePath = std::string(STREAMRT_SOURCE_DIR) + "/scenes/registry_test.cfg";
+
+std::string colour_text(const glm::dvec3& c) { return fmt_num(c.x) + "," + fmt_num(c.y) + "," + fmt_num(c.z); }
+
+/// A value of P's kind other than its default, as written in a scene, and as read.
+template <class P>
+std::pair<std::string, ValueType<P::info.kind>> other_value() {
+    constexpr ValueKind kind = P::info.kind;
+    if constexpr (kind == ValueKind::Number) {
+        const double v = default_of<P>() + 0.5;  // every range here holds it
+        return {fmt_num(v), v};
+    } else if constexpr (kind == ValueKind::Colour) {
+        return {"0.25,0.5,0.75", glm::dvec3(0.25, 0.5, 0.75)};
+    } else if constexpr (kind == ValueKind::Flag) {
+        return {default_of<P>() ? "false" : "true", !default_of<P>()};
+    } else {
+        return {"textures/tiles.png", 0};  // the scene's first texture
+    }
+}
+
+/// A value of P's kind its check refuses, and a piece of the message.
+template <class P>
+std::pair<std::string, std::string> refused_value() {
+    constexpr PropertyInfo info = P::info;
+    if constexpr (info.kind == ValueKind::Number) {
+        if (info.bound == Bound::Positive) return {"0", "must be > 0"};
+        if (info.bound == Bound::AtLeastZero) return {"-0.5", "must be >= 0"};
+        return {"1e999", "expected a number"};
+    } else if constexpr (info.kind == ValueKind::Colour) {
+        return {"0,-1,0", "must be >= 0"};
+    } else if constexpr (info.kind == ValueKind::Flag) {
+        return {"yes", "expected true or false"};
+    } else {
+        return {"missing.png", "cannot open texture file"};
+    }
+}
+
+// What the material keys' table of docs/scene-format.md says of a property of this kind.
+std::string doc_type(ValueKind k) {
+    switch (k) {
+        case ValueKind::Number: return "number";
+        case ValueKind::Colour: return "colour";
+        case ValueKind::Flag: return "`true` or `false`";
+        case ValueKind::Image: return "path";
+    }
+    return "?";
+}
+template <class P>
+std::string doc_default() {
+    if constexpr (has_given_flag<P>() || P::info.kind == ValueKind::Image) return "—";  // off until given
+    else if constexpr (P::info.kind == ValueKind::Number) return fmt_num(default_of<P>());
+    else if constexpr (P::info.kind == ValueKind::Colour) return "`" + colour_text(default_of<P>()) + "`";
+    else return default_of<P>() ? "`true`" : "`false`";
+}
+std::string doc_range(const PropertyInfo& info) {
+    switch (info.kind) {
+        case ValueKind::Number:
+            return info.bound == Bound::Positive ? "> 0" : info.bound == Bound::AtLeastZero ? "≥ 0" : "";
+        case ValueKind::Colour: return "components ≥ 0, at most 3.4e38 (single precision)";
+        case ValueKind::Flag: return "";
+        case ValueKind::Image: return "PNG or JPEG file";
+    }
+    return "?";
+}
+
+struct DocRow {
+    std::string key, type, default_value, range;
+};
+
+/// The rows of the material keys' table (docs/scene-format.md, "Materials"), in order.
+std::vector<DocRow> documented_material_keys() {
+    std::ifstream in(fs::path(STREAMRT_SOURCE_DIR) / "docs" / "scene-format.md");
+    REQUIRE(in);
+    std::vector<DocRow> rows;
+    std::string line;
+    bool in_section = false;
+    while (std::getline(in, line)) {
+        if (line.rfind("Material keys (accepted by", 0) == 0) in_section = true;
+        else if (in_section && !rows.empty() && line.empty()) break;
+        if (!in_section || line.rfind("| `", 0) != 0) continue;
+        std::vector<std::string> cells;
+        std::stringstream s(line.substr(1));
+        for (std::string cell; std::getline(s, cell, '|');) {
+            const auto b = cell.find_first_not_of(' '), e = cell.find_last_not_of(' ');
+            cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+        }
+        REQUIRE(cells.size() >= 5);
+        rows.push_back({cells[0].substr(1, cells[0].size() - 2), cells[1], cells[2], cells[3]});
+    }
+    return rows;
+}
+
+// What the concept refuses (materials/material_property.h), at compile time.
+struct NoField {
+    static constexpr PropertyInfo info{"x", ValueKind::Number};
+    double x = 0.0;
+};
+struct WrongType {
+    static constexpr PropertyInfo info{"x", ValueKind::Colour};
+    double x = 0.0;
+    static constexpr auto field = &WrongType::x;
+};
+struct BoundOnAFlag {
+    static constexpr PropertyInfo info{"x", ValueKind::Flag, Bound::Positive};
+    bool x = false;
+    static constexpr auto field = &BoundOnAFlag::x;
+};
+static_assert(!MaterialPropertyDefinition<NoField>);
+static_assert(!MaterialPropertyDefinition<WrongType>);
+static_assert(!MaterialPropertyDefinition<BoundOnAFlag>);
+static_assert(MaterialPropertyDefinition<property::Emission>);
+static_assert(MaterialPropertyDefinition<property::Checker> && has_given_flag<property::Checker>());
+static_assert(!PropertyList<property::Refl, property::Refl>::distinct_keys());
+
+}  // namespace
+
+TEST_CASE("material registry: keys are distinct and the list is the one the reader uses") {
+    CHECK(MaterialProperties::distinct_keys());
+    CHECK(MaterialProperties::size >= 13);
+    // The unknown-key message lists the object's colour, then every registered key in order.
+    std::string keys = "color";
+    MaterialProperties::for_each([&](auto p) { keys += " " + std::string(decltype(p)::info.key); });
+    test::expect_error("material m bogus=1", 1, 12,
+                       "unknown key 'bogus' for 'material' (expected one of: " + keys + " material)");
+    test::expect_error("sphere bogus=1", 1, 8, "(expected one of: material " + keys + " scale");
+}
+
+TEST_CASE("material registry: every property is read by material and shape statements, and checked") {
+    MaterialProperties::for_each([&](auto p) {
+        using P = decltype(p);
+        const std::string key(P::info.key);
+        CAPTURE(key);
+        const auto [text, value] = other_value<P>();
+        const Scene s = parse_scene("material m " + key + "=" + text + "\nsphere material=m\nsphere " + key + "=" +
+                                        text + "\nsphere\n",
+                                    kScenePath);
+        REQUIRE(s.objects.size() == 3);
+        for (int i : {0, 1}) {
+            const Material& m = s.material_of(s.objects[std::size_t(i)]);
+            CHECK(m.*P::field == value);
+            if constexpr (has_given_flag<P>()) CHECK(m.*P::given);
+            // Equality and hash count this property: the record differs from the default one.
+            CHECK_FALSE(m == Material{});
+            CHECK(MaterialHash{}(m) != MaterialHash{}(Material{}));
+        }
+        if constexpr (has_given_flag<P>() && P::info.kind == ValueKind::Colour) {
+            // Given with the default value, the key still turns the property on: another record.
+            const Scene g = parse_scene("sphere " + key + "=" + colour_text(default_of<P>()) + "\nsphere\n", kScenePath);
+            CHECK(g.materials.size() == 2);
+            CHECK_FALSE(g.material_of(g.objects[0]) == g.material_of(g.objects[1]));
+            CHECK(MaterialHash{}(g.material_of(g.objects[0])) != MaterialHash{}(g.material_of(g.objects[1])));
+        }
+        CHECK(s.material_of(s.objects[2]).*P::field == default_of<P>());
+        CHECK(s.material_of(s.objects[2]) == Material{});
+        CHECK(s.materials.size() == 2);
+        // The property's check, at its value's column ("sphere " + key + "=").
+        const auto [bad, message] = refused_value<P>();
+        test::expect_error_in(kScenePath, "sphere " + key + "=" + bad, 1, int(8 + key.size() + 1), message);
+    });
+}
+
+TEST_CASE("material registry: docs/scene-format.md lists every property with its type, default and range") {
+    const std::vector<DocRow> rows = documented_material_keys();
+    REQUIRE(!rows.empty());
+    // The table: color (the object's own colour, not a material record's field) first, then
+    // the registered properties in the registry's order, and nothing else.
+    CHECK(rows.front().key == "color");
+    std::size_t i = 1;
+    MaterialProperties::for_each([&](auto p) {
+        using P = decltype(p);
+        const std::string key(P::info.key);
+        CAPTURE(key);
+        REQUIRE(i < rows.size());
+        const DocRow& row = rows[i++];
+        CHECK(row.key == key);
+        CHECK(row.type == doc_type(P::info.kind));
+        CHECK(row.default_value == doc_default<P>());
+        CHECK(row.range == doc_range(P::info));
+    });
+    CHECK(i == rows.size());
+}
