@@ -96,7 +96,10 @@ struct SingleRay {
 template <class A>
 inline std::uint32_t movemask_bits(const xsimd::batch_bool<float, A>& m) {
     using M = xsimd::batch_bool<float, A>;
-    if constexpr (std::is_integral_v<typename M::register_type>) {  // AVX-512: a mask register
+    // AVX-512: a mask register (an integer of at most 8 bytes; SSE/AVX registers are 16 or 32).
+    // sizeof rather than is_integral<register_type>: a vector type as a template argument
+    // loses its alignment attribute, and GCC warns.
+    if constexpr (sizeof(typename M::register_type) <= sizeof(std::uint64_t)) {
         return std::uint32_t(typename M::register_type(m));
     } else if constexpr (M::size == 8) {
         return std::uint32_t(_mm256_movemask_ps(typename M::register_type(m)));
