@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Image error against render time, both engines, three sampling patterns
-(docs/performance.md, "Error against run time").
+"""Image error against render time, both engines, three sampling patterns and adaptive
+sampling (docs/performance.md, "Error against run time").
 
 usage: /usr/bin/python3 scripts/error_vs_time.py [--quick] [--scenes a.cfg,b.cfg] [--build DIR]
 
@@ -16,6 +16,9 @@ stratified, made once and cached in BUILD/perf/reference/. Writes
 Seconds are streamrt's render clock (-j as given, default 2), median of --runs. The renders run
 in this process through the streamrt Python module (build/python, docs/python.md): the
 pictures are NumPy arrays, no image file is written but the cached references.
+Adaptive sampling (docs/adaptive-sampling.md) adds one curve per engine: --adaptive T for
+T in --thresholds, max-spp as the cap, stratified (sampler "adaptive" in the CSV, spp = the
+mean samples per pixel taken).
 Scenes with area lights (scenes/soft_shadows.cfg) also get a sweep of --light-samples
 1, 2, ... max-spp at 1 spp, stratified (sampler "light" in the CSV), and their reference
 takes min(--ref-spp, 2 x max-spp) spp (above the sweep's, so no pixel sample is shared) with
@@ -47,6 +50,8 @@ def main(argv=None):
     ap.add_argument("--ref-light-samples", type=int, help="area-light scenes: reference light samples (default 64, quick 16)")
     ap.add_argument("-j", "--jobs", type=int, default=2)
     ap.add_argument("--runs", type=int, default=1, help="timed renders per point (median)")
+    ap.add_argument("--thresholds", default="0.04,0.02,0.01,0.005,0.0025",
+                    help="adaptive sampling's thresholds T (comma-separated; empty: no adaptive curve)")
     ap.add_argument("--img", default=os.path.join(pc.ROOT, "docs", "img"), help="where the plots go")
     args = ap.parse_args(argv)
     w = args.width or (160 if args.quick else 320)
@@ -102,6 +107,17 @@ def main(argv=None):
                         e["relmse"]), flush=True)
                 d = pc.array_error(imgs["stream"], imgs["recursive"])
                 prec.append(dict(scene=base, sampler=sampler, spp=spp, **d))
+        for t in [float(v) for v in args.thresholds.split(",") if v]:
+            for engine in ENGINES:
+                runs = [rt.render(path, engine=engine, threads=args.jobs, spp=max_spp, width=w, height=h,
+                                  sampler="stratified", adaptive=t) for _ in range(args.runs)]
+                e = pc.array_error(runs[-1].image, reference)
+                mean_spp = runs[-1].adaptive["mean_spp"]
+                rows.append(dict(scene=base, engine=engine, sampler="adaptive", spp=round(mean_spp, 2),
+                                 seconds=pc.median([r.seconds["render"] for r in runs]), **e))
+                print("[%5.0fs] %-8s %-9s adaptive T=%-7g spp %5.2f %7.3f s  rmse %.5f  psnr %5.2f dB" % (
+                    time.time() - t0, base, engine, t, mean_spp, rows[-1]["seconds"], e["rmse"], e["psnr"]),
+                    flush=True)
         # Area lights: the light samples grow instead (1 spp); the CSV's spp column holds them.
         for ls in spps if area else []:
             for engine in ENGINES:

@@ -21,8 +21,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 COLORS = {"stream": "tab:blue", "recursive": "tab:red"}
-MARKERS = {"grid": "s", "stratified": "o", "random": "^", "light": "D"}
-STYLES = {"grid": ":", "stratified": "-", "random": "--", "light": "-."}
+MARKERS = {"grid": "s", "stratified": "o", "random": "^", "light": "D", "adaptive": "*"}
+STYLES = {"grid": ":", "stratified": "-", "random": "--", "light": "-.", "adaptive": (0, (5, 1))}
 
 
 def _save(fig, path):
@@ -40,16 +40,17 @@ def plot_errors(csv_path, img_dir, suffix=""):
         fig, ax = plt.subplots(figsize=(6.4, 4.2))
         for engine in ("stream", "recursive"):
             # "light": 1 spp, stratified, --light-samples growing (scenes with area lights)
-            for sampler in ("grid", "stratified", "random", "light"):
-                pts = sorted((float(r["seconds"]), float(r["rmse"]), int(r["spp"])) for r in rows
+            # "adaptive": --adaptive T at a sweep of T, cap max-spp; its spp is the mean taken
+            for sampler in ("grid", "stratified", "random", "light", "adaptive"):
+                pts = sorted((float(r["seconds"]), float(r["rmse"]), float(r["spp"])) for r in rows
                              if r["scene"] == scene and r["engine"] == engine and r["sampler"] == sampler)
                 if not pts:
                     continue
                 ax.plot([p[0] for p in pts], [p[1] for p in pts], color=COLORS[engine], marker=MARKERS[sampler],
                         linestyle=STYLES[sampler], markersize=4, label="%s, %s" % (engine, sampler))
-                if sampler in ("stratified", "light"):
+                if sampler in ("stratified", "light", "adaptive"):
                     for x, y, spp in pts:
-                        ax.annotate(str(spp), (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7,
+                        ax.annotate("%g" % round(spp, 1), (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7,
                                     color=COLORS[engine])
         ax.set_xscale("log")
         ax.set_yscale("log")
