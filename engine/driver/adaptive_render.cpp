@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 
 namespace streamrt {
 
@@ -92,6 +93,19 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     std::vector<TileTallies> tiles(std::size_t(nx) * std::size_t(ny));
     for (std::size_t i = 0; i < tiles.size(); ++i) tiles[i] = tallies_for(tile_rect(w, h, int(i)));
 
+    // Tiles in an interleaved order (a stride near n / golden ratio, prime to n): the work of
+    // later rounds sits in a few regions (edges, penumbrae), and a loop that hands out halves
+    // of its range left one thread holding a whole region while the other ran out
+    // (scenes/soft_shadows.cfg at 640x480, T = 0.0025: -j2 was 1.25x faster than -j1 with the
+    // tiles in order, 1.84x interleaved).
+    std::vector<int> order(tiles.size());
+    {
+        const std::size_t n = tiles.size();
+        std::size_t stride = std::max<std::size_t>(1, std::size_t(double(n) * 0.618));
+        while (std::gcd(stride, n) != 1) ++stride;
+        for (std::size_t k = 0; k < n; ++k) order[k] = int((k * stride) % n);
+    }
+
     AdaptiveSummary summary;
     const auto estimated_rmse = [&] {  // in a fixed order: the same figure for every -j
         double sum = 0;
@@ -120,17 +134,29 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
             });
         }
         std::atomic<int> refined{0};
-        par.for_each_tile(w, h, kTileSize, [&](int index, Tile) {
+        // Without an image target or a clock, nothing after round 1 looks beyond its own
+        // pixel: each tile then runs all its remaining rounds in one go, without waiting at
+        // the end of every round for the tile that holds the most work (same picture).
+        const bool to_the_end = r == 1 && stop.target_error <= 0 && stop.time_limit <= 0;
+        std::atomic<int> last_round{r};
+        par.for_each_index(order.size(), 1, [&](std::size_t k) {
+            const int index = order[k];
             if (progress && progress->cancelled()) return;
             // The first round covers the image whatever the clock says (a picture to show); a
             // later one may stop part-way, its pixels keeping the samples they have.
             if (r > 0 && out_of_time()) return;
             RayCounts counts;
-            refined += refine(prepared, r, tiles[std::size_t(index)], counts, progress);
+            for (int q = r; refine(prepared, q, tiles[std::size_t(index)], counts, progress) > 0; ++q) {
+                ++refined;
+                for (int seen = last_round.load(); seen < q && !last_round.compare_exchange_weak(seen, q);) {
+                }
+                if (!to_the_end) break;
+            }
             if (progress) r == 0 ? progress->add(counts) : progress->add_rays(counts);
         });
         if (refined == 0) break;
-        summary.rounds = r + 1;
+        summary.rounds = last_round + 1;
+        if (to_the_end) break;
         if (progress && progress->cancelled()) break;
         if (out_of_time()) {
             summary.time_limited = true;
