@@ -62,7 +62,7 @@ def main(argv=None):
     ap.add_argument("--height", type=int, default=240)
     ap.add_argument("--ref-spp", type=int, default=256)
     ap.add_argument("--cap", type=int, default=64)
-    ap.add_argument("--thresholds", default="0.04,0.02,0.01,0.005,0.0025")
+    ap.add_argument("--thresholds", default="0.04,0.02,0.01,0.005,0.0025,0.00125")
     ap.add_argument("-j", "--jobs", type=int, default=2)
     ap.add_argument("--runs", type=int, default=3)
     args = ap.parse_args(argv)
