@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "reader_bench_args.h"
 #include "scene/parser.h"
 
 using namespace streamrt;
@@ -66,25 +67,13 @@ bool run_child(const std::string& path, int jobs, Run& out) {
     return true;
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::string path = "/tmp/reader_s1e6.cfg";
-    int runs = 5;
-    std::vector<int> jobs;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "-r" && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-        else if (a == "-j" && i + 1 < argc) jobs.push_back(std::max(1, std::atoi(argv[++i])));
-        else path = a;
-    }
-    if (jobs.empty()) jobs = {1, 2};
+    const ReaderBenchArgs args = parse_reader_bench_args(argc, argv, "/tmp/reader_s1e6.cfg");
+    const std::string& path = args.path;
+    const int runs = args.runs;
+    const std::vector<int>& jobs = args.jobs;
     struct stat st{};
     if (stat(path.c_str(), &st) != 0) {
         const std::string cmd = "python3 -B " STREAMRT_SOURCE_DIR "/scripts/perf_common.py spheres 1000000 '" + path +
