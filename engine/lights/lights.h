@@ -63,7 +63,7 @@ inline auto visit_light(LightKind k, F&& f) {
     return [&]<std::size_t... I>(std::index_sequence<I...>) {
         using R = decltype(f(LightKinds::at<0>{}));
         R r{};
-        ((std::size_t(k) == I ? (r = f(LightKinds::at<I>{}), true) : false) || ...);
+        (void)((std::size_t(k) == I ? (r = f(LightKinds::at<I>{}), true) : false) || ...);  // stops at the match
         return r;
     }(std::make_index_sequence<LightKinds::size>{});
 }

@@ -62,7 +62,9 @@ std::string format_value(const py::handle& v) {
 
 std::string statement(const std::string& word, const py::kwargs& kw) {
     std::string s = word;
-    for (const auto& [k, v] : kw) s += " " + py::str(k).cast<std::string>() + "=" + format_value(v);
+    // Appended piece by piece: GCC 12 reads `" " + std::string&&` as a possible overlapping
+    // copy (a false -Wrestrict).
+    for (const auto& [k, v] : kw) s.append(" ").append(py::str(k).cast<std::string>()).append("=").append(format_value(v));
     return s;
 }
 
