@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "image/image_io.h"
+#include "render/adaptive.h"
 #include "stream/stream_renderer.h"
 
 namespace streamrt {
@@ -50,7 +51,13 @@ MemoryEstimate estimate_render_memory(const Scene& scene, const RenderSettings& 
     } else {
         e.per_thread_bytes = (double(s.depth) + 2) * kRecursiveFrameBytes;
     }
-    e.total_bytes = e.framebuffer_bytes + e.output_bytes + double(e.threads) * e.per_thread_bytes;
+    if (s.adaptive > 0) {
+        e.adaptive_bytes = pixels * (sizeof(PixelTally) + sizeof(std::uint8_t) + 3 * sizeof(float));
+        // A tile's round is traced whole: its pixels' samples' colours, at most half the cap each.
+        const double largest_round = double(std::max(adaptive_round(0, s.spp).count, s.spp / 2));
+        e.per_thread_bytes += double(kTileSize) * kTileSize * largest_round * 3 * sizeof(float);
+    }
+    e.total_bytes = e.framebuffer_bytes + e.output_bytes + e.adaptive_bytes + double(e.threads) * e.per_thread_bytes;
     return e;
 }
 
@@ -84,6 +91,7 @@ void check_render_memory(const Scene& scene, const RenderSettings& s, bool strea
     std::string msg = "image " + std::to_string(s.width) + "x" + std::to_string(s.height) + ", spp " +
                       std::to_string(s.spp) + ", depth " + std::to_string(s.depth) + " would need about " +
                       format_bytes(e.total_bytes) + " of memory (framebuffer " + format_bytes(e.framebuffer_bytes) +
+                      (e.adaptive_bytes > 0 ? ", adaptive tallies " + format_bytes(e.adaptive_bytes) : std::string()) +
                       ", output " + format_bytes(e.output_bytes) + ", " + std::to_string(e.threads) + " thread" +
                       (e.threads > 1 ? "s" : "") + " x " + format_bytes(e.per_thread_bytes) +
                       (stream_engine ? " of ray streams" : " of stack");

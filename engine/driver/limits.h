@@ -13,8 +13,11 @@ struct MemoryEstimate {
     double framebuffer_bytes = 0;  ///< width*height*3 floats
     double output_bytes = 0;       ///< the image writer's band buffers (image_write_buffer_bytes)
     double per_thread_bytes = 0;   ///< ray streams of one worker (stream engine) or its stack
+    /// Adaptive sampling (render/adaptive.h): a tally, a neighbour flag and a sample-map pixel
+    /// per pixel; per thread, the colours of one tile's largest round (in per_thread_bytes).
+    double adaptive_bytes = 0;
     int threads = 1;
-    double total_bytes = 0;        ///< framebuffer + output + threads * per_thread
+    double total_bytes = 0;        ///< framebuffer + output + adaptive + threads * per_thread
     double slice_rays = 0;         ///< stream engine: most rays of a generation traced at once
     int generations = 0;           ///< stream engine: generations whose rays may be held at once
 };

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "driver/limits.h"
+#include "render/adaptive.h"
 #include "scene/parser.h"
 #include "stream/child_peak_rss.h"
 
@@ -29,6 +30,22 @@ TEST_CASE("limits: the estimate counts the framebuffer, the output and the per-t
     // spp above the slice size: one pixel's samples are one chunk and one slice.
     sc.settings.spp = 65536;
     CHECK(estimate_render_memory(sc, true, 1).slice_rays == 65536);
+}
+
+TEST_CASE("limits: adaptive sampling adds its tallies per pixel and a round's colours per thread") {
+    Scene sc = parse_scene("image width=3840 height=2160 spp=64 depth=5 degree=5\nsphere\n", "t.cfg");
+    const MemoryEstimate uniform = estimate_render_memory(sc, true, 2);
+    CHECK(uniform.adaptive_bytes == 0);
+    sc.settings.adaptive = 0.01;
+    const MemoryEstimate adaptive = estimate_render_memory(sc, true, 2);
+    // A tally is 6 doubles and a count (56 bytes with padding), a flag byte, a sample-map
+    // pixel of 3 floats: 69 bytes for each of 3840 x 2160 = 8294400 pixels.
+    REQUIRE(sizeof(PixelTally) == 56);
+    CHECK(adaptive.adaptive_bytes == 8294400.0 * 69);
+    // The largest round of a cap of 64 is 32 samples (4, 4, 8, 16, 32): a 16 x 16 tile's
+    // colours are 256 x 32 x 3 floats = 98304 bytes per thread.
+    CHECK(adaptive.per_thread_bytes - uniform.per_thread_bytes == 98304.0);
+    CHECK(adaptive.total_bytes == doctest::Approx(uniform.total_bytes + 8294400.0 * 69 + 2 * 98304.0));
 }
 
 TEST_CASE("limits: the stream engine's memory grows linearly with depth, never as 2^depth") {
