@@ -356,6 +356,9 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
     for (const PlyElement& e : h.elements)
         if (e.name == "vertex") vertex_count = e.count;
     for (const PlyElement& e : h.elements) {
+        // An element without properties holds nothing and takes no bytes, whatever its count
+        // (a count the header check cannot bound: looping over 4e9 empty items took minutes).
+        if (e.props.empty()) continue;
         const bool vertex = e.name == "vertex", face = e.name == "face";
         // Per property: where a vertex keeps it (0-2 position, 3-5 normal, -1 skipped).
         std::vector<int> slot(e.props.size(), -1);

@@ -181,6 +181,13 @@ TEST_CASE("ply: absurd counts are refused from the header, before anything is al
     std::string body(36 + 20, '\0');
     CHECK(error_of("ply\nformat binary_little_endian 1.0\n" + replaced(kGoodElements, "face 1", "face 2") + body) ==
           "t.ply:7:14: element 'face' declares 2 items, more than the 56 bytes after the header can hold");
+    // An element without properties takes no bytes: any count is read at once, and the mesh
+    // after it is read whole (the fuzzer's 4000100000 empty items ran past its time-out; a
+    // loop over these 1e18 would not end before the test's).
+    const PlyData empty_items =
+        parse_ply(kHeadAscii + "element nothing 1000000000000000000\n" + kGoodElements + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "t.ply");
+    CHECK(empty_items.positions == std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0});
+    CHECK(empty_items.triangles == std::vector<std::uint32_t>{0, 1, 2});
     // A skipped element's count is checked too.
     CHECK(error_of(kHeadAscii + "element junk 99999999\nproperty uchar a\n" + kGoodElements + "0 0 0\n") ==
           "t.ply:3:14: element 'junk' declares 99999999 items, more than the 6 bytes after the header can hold");
