@@ -51,12 +51,13 @@ struct PipelineStages {
         for (int q = first; q < first + n_pixels; ++q) {
             const int p = req.pixel(q);
             const float x = float(tile.x0 + p % tile.width()), y = float(tile.y0 + p / tile.width());
+            const std::uint32_t key_pixel = image_pixel(p);  // once per pixel, not per sample
             int cx = 0, cy = 0;
             for (int j = 0; j < count; ++j, ++i) {
                 g.px[i] = x;
                 g.py[i] = y;
                 if constexpr (kJitter) {
-                    g.key_pixel[i] = image_pixel(p);
+                    g.key_pixel[i] = key_pixel;
                     g.key_sample[i] = std::uint32_t(req.run.first + j);
                     g.cell_x[i] = float(cx);
                     g.cell_y[i] = float(cy);
