@@ -316,7 +316,7 @@ TEST_CASE("cli: .exr output, the display colour flags and their bad values") {
     }
 }
 
-TEST_CASE("cli: the summary line gives the process's phases; releasing the scene's records changes no pixel") {
+TEST_CASE("cli: the summary line gives the process's phases, releasing the scene's records changes no pixel") {
     // Enough objects for the hierarchy, so the stream engine renders from its own records
     // after the command line has released the scene's.
     Dir d;
@@ -334,7 +334,7 @@ TEST_CASE("cli: the summary line gives the process's phases; releasing the scene
     check_same_as_in_process_stream(scene, out);
 }
 
-TEST_CASE("cli: --compare writes the stream engine's picture and honours --profile; the profile JSON is written whole") {
+TEST_CASE("cli: --compare writes the stream engine's picture and honours --profile, the profile JSON is written whole") {
     Dir d;
     const fs::path scene = d.write("s.cfg", kSmallScene);
     const fs::path out = d.path / "cmp.pfm", json = d.path / "prof.json";

@@ -115,7 +115,7 @@ TEST_CASE("immutable scene: frame 2 then frame 0 gives frame 0's picture, bit fo
     CHECK(scene_at_frame(scene, 2) != scene);  // another frame is a new scene
 }
 
-TEST_CASE("immutable scene: a job lets go of its scene; the set-up holds what it reads, nothing dangles") {
+TEST_CASE("immutable scene: a job lets go of its scene, the set-up holds what it reads, nothing dangles") {
     // Meshes and textures: the stream engine holds them itself, the recursive engine the scene.
     const std::string path = std::string(STREAMRT_SOURCE_DIR) + "/scenes/textured.cfg";
     RenderOverrides o;

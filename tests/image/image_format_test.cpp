@@ -98,7 +98,7 @@ TEST_CASE("hdr: values read back within half a code of the brightest channel, ev
     }
 }
 
-TEST_CASE("hdr: values with no RGBE code are written as black; damaged files are refused") {
+TEST_CASE("hdr: values with no RGBE code are written as black, damaged files are refused") {
     Framebuffer fb = filled(8, 1, 1.f, 1.f, 1.f);
     fb.pixel(0, 0)[0] = -2.f;
     fb.pixel(1, 0)[1] = std::numeric_limits<float>::quiet_NaN();

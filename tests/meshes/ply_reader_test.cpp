@@ -221,7 +221,7 @@ TEST_CASE("ply: body errors carry their line and column (ASCII) or item and byte
           "t.ply:3:16: element 'vertex' declares 3 items, more than the 30 bytes after the header can hold");
 }
 
-TEST_CASE("ply: a mesh keeps the file's normals; a scene renders a PLY mesh as the same OBJ mesh") {
+TEST_CASE("ply: a mesh keeps the file's normals, a scene renders a PLY mesh as the same OBJ mesh") {
     const fs::path dir = fs::temp_directory_path() / ("streamrt_ply_test_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     std::ofstream(dir / "quad.ply", std::ios::binary) << binary_ply(false, true);

@@ -55,7 +55,7 @@ const Vec3d kConvex[3] = {{-0.6, 0, 0.8}, {0.6, 0, 0.8}, {0, 0.6, 0.8}};
 // Proven against: the projection applied to points above the planes too (max(0, .) dropped:
 // the inside, concave and mixed cases fail), the side ignored (the inside case), the weights
 // of p1 and p2 swapped (the unequal-weights and the shared-edge cases), no shift at all.
-TEST_CASE("terminator: the shift equals hand-computed values; zero for flat normals and above the planes") {
+TEST_CASE("terminator: the shift equals hand-computed values, zero for flat normals and above the planes") {
     // At barycentrics (b0, b1, b2) = (0.5, 0.25, 0.25), p = (0.25, 0.25, 0). Heights over the
     // corners' tangent planes: (p - p0).n0 = -0.15, (p - p1).n1 = -0.45, (p - p2).n2 = -0.45,
     // all below, so q_i = p + depth_i n_i and the shift is sum b_i depth_i n_i

@@ -88,7 +88,7 @@ TEST_CASE("animation: rotation halfway, by the shortest arc") {
     }
 }
 
-TEST_CASE("animation: each quantity is its own track; lights and the camera") {
+TEST_CASE("animation: each quantity is its own track, lights and the camera") {
     const std::string text =
         "camera name=cam eye=0,0,5 look=0,0,0 fov=40\n"
         "light point name=l pos=0,5,0 color=1,1,1\n"

@@ -65,7 +65,7 @@ TEST_CASE("texture reader: texels are decoded from sRGB to linear") {
 
 // Proven against: textures not shared (read_once's lookup of a known file removed: each
 // statement loaded its own, 2 textures).
-TEST_CASE("texture reader: texture= and uvscale= on materials and shapes; one image per file") {
+TEST_CASE("texture reader: texture= and uvscale= on materials and shapes, one image per file") {
     Dir d;
     const Scene s = d.parse(
         "material tiled texture=quad.png uvscale=4\n"
@@ -103,7 +103,7 @@ TEST_CASE("texture reader: missing, unreadable and too large images at the path'
 
 // Proven against: the mesh read without its coordinates whatever the texture (mesh_file
 // passing with_uv = false: no error, and the textured mesh had no uv).
-TEST_CASE("texture reader: a textured mesh needs vt; coordinates kept only when a texture uses them") {
+TEST_CASE("texture reader: a textured mesh needs vt, coordinates kept only when a texture uses them") {
     Dir d;
     d.expect_error("mesh file=tri.obj texture=quad.png\n", 1, 11, "face without texture coordinates (vt)");
     const Scene s = d.parse(

@@ -43,7 +43,7 @@ TEST_CASE("uv: cube, one image per face") {
     check_uv<CubeMath>(-0.5, 0.5, -1, 0.25, 0.75);
 }
 
-TEST_CASE("uv: cylinder and cone, angle and height; caps planar") {
+TEST_CASE("uv: cylinder and cone, angle and height, caps planar") {
     check_uv<CylinderMath>(0, 0.5, 1, 0.5, 0.75);      // side: (0.5 + 0, (0.5 + 1) / 2)
     check_uv<CylinderMath>(1, -1 + 0.5, 0, 0.75, 0.25);
     check_uv<CylinderMath>(0.5, 1, -0.5, 0.75, 0.25);  // top cap: ((x + 1) / 2, (z + 1) / 2)
