@@ -198,7 +198,7 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
 ColorT<double> RecursiveRenderer::render_sample(int x, int y, SampleRun run, int j, RayCounts& counts) const {
     const RenderSettings& s = settings_;
     const CameraRays<double>& cam = camera_;
-    const std::uint64_t pixel = std::uint64_t(y) * std::uint64_t(s.width) + std::uint64_t(x);
+    const std::uint64_t pixel = sample_key(run, x, y, s.width);
     const PixelSample ps = pixel_sample(s.pattern, run, pixel, j);
     RayD ray{cam.origin, {}, 0.0};
     if (cam.has_lens()) {  // thin lens: the sample's point on the lens (render/sampling.h)

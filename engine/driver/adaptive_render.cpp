@@ -36,6 +36,32 @@ int refine(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, c
     return int(pixels.size());
 }
 
+/// Traces the corner samples (corner_run) of the corners in `corners`, a rectangle of the
+/// (width + 1) x (height + 1) lattice of pixel corners, into `out` (3 floats each, row by row).
+void trace_corners(PreparedRender& prepared, const Tile& corners, float* out, RayCounts& counts,
+                   const RenderProgress* cancel) {
+    static thread_local std::vector<std::uint32_t> all;
+    const std::size_t n = std::size_t(corners.width()) * std::size_t(corners.height());
+    if (all.size() < n) {
+        all.resize(n);
+        std::iota(all.begin(), all.end(), 0u);
+    }
+    prepared.render_samples(corners, corner_run(), all.data(), int(n), out, counts, cancel);
+}
+
+/// Round 0 from traced corners: each pixel of t.tile takes its four corners, in a fixed order
+/// (top left, top right, bottom left, bottom right), from `rgb`, the corners of the rectangle
+/// `corners` of the corner lattice (3 floats each, row by row).
+void tally_corners(const float* rgb, const Tile& corners, TileTallies& t) {
+    const std::size_t row = std::size_t(corners.width());
+    for (int y = t.tile.y0; y < t.tile.y1; ++y)
+        for (int x = t.tile.x0; x < t.tile.x1; ++x) {
+            PixelTally& p = t.pixels[std::size_t(y - t.tile.y0) * std::size_t(t.tile.width()) + std::size_t(x - t.tile.x0)];
+            const std::size_t c = std::size_t(y - corners.y0) * row + std::size_t(x - corners.x0);
+            for (const std::size_t k : {c, c + 1, c + row, c + row + 1}) p.add(rgb[k * 3], rgb[k * 3 + 1], rgb[k * 3 + 2]);
+        }
+}
+
 /// spread_near of the pixels of `inner` (inside `outer`, whose round-0 tallies are `all`,
 /// row by row): its own error or one of its neighbours' (those inside `outer`) above T.
 void mark_spread(const AdaptiveRule& rule, const Tile& outer, const std::vector<PixelTally>& all, const Tile& inner,
@@ -70,7 +96,15 @@ void render_adaptive_tile(PreparedRender& prepared, const Tile& tile, float* rgb
     const Tile ring{std::max(0, tile.x0 - 1), std::max(0, tile.y0 - 1), std::min(prepared.width, tile.x1 + 1),
                     std::min(prepared.height, tile.y1 + 1)};
     TileTallies outer = tallies_for(ring);
-    refine(prepared, 0, outer, counts, cancel);
+    if (prepared.adaptive.corner_round()) {
+        // The ring's corners: the same corner samples the neighbouring tiles trace.
+        const Tile corners{ring.x0, ring.y0, ring.x1 + 1, ring.y1 + 1};
+        std::vector<float> rgb_corners(std::size_t(corners.width()) * std::size_t(corners.height()) * 3);
+        trace_corners(prepared, corners, rgb_corners.data(), counts, cancel);
+        tally_corners(rgb_corners.data(), corners, outer);
+    } else {
+        refine(prepared, 0, outer, counts, cancel);
+    }
     TileTallies t = tallies_for(tile);
     for (int y = tile.y0; y < tile.y1; ++y)
         std::copy_n(&outer.pixels[std::size_t(y - ring.y0) * std::size_t(ring.width()) + std::size_t(tile.x0 - ring.x0)],
@@ -106,6 +140,13 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
         for (std::size_t k = 0; k < n; ++k) order[k] = int((k * stride) % n);
     }
 
+    // The corner lattice of a corner round 0, (w + 1) x (h + 1) corners, each traced once: a
+    // tile traces the corners at its pixels' top left, and those of the image's last column
+    // and row when it borders them.
+    const bool corners_first = prepared.adaptive.corner_round();
+    const Tile lattice{0, 0, w + 1, h + 1};
+    std::vector<float> corner_rgb(corners_first ? std::size_t(w + 1) * std::size_t(h + 1) * 3 : 0);
+
     AdaptiveSummary summary;
     const auto estimated_rmse = [&] {  // in a fixed order: the same figure for every -j
         double sum = 0;
@@ -117,6 +158,30 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
         return std::sqrt(sum / (double(w) * double(h)));
     };
     for (int r = 0;; ++r) {
+        if (r == 0 && corners_first) {
+            par.for_each_index(order.size(), 1, [&](std::size_t k) {
+                if (progress && progress->cancelled()) return;
+                const Tile& tile = tiles[std::size_t(order[k])].tile;
+                const Tile own{tile.x0, tile.y0, tile.x1 + (tile.x1 == w), tile.y1 + (tile.y1 == h)};
+                static thread_local std::vector<float> rgb;
+                rgb.resize(std::size_t(own.width()) * std::size_t(own.height()) * 3);
+                RayCounts counts;
+                trace_corners(prepared, own, rgb.data(), counts, progress);
+                for (int y = own.y0; y < own.y1; ++y)
+                    std::copy_n(&rgb[std::size_t(y - own.y0) * std::size_t(own.width()) * 3], std::size_t(own.width()) * 3,
+                                &corner_rgb[(std::size_t(y) * std::size_t(w + 1) + std::size_t(own.x0)) * 3]);
+                if (progress) progress->add(counts);
+            });
+            par.for_each_index(tiles.size(), 1, [&](std::size_t i) { tally_corners(corner_rgb.data(), lattice, tiles[i]); });
+            summary.rounds = 1;
+            if (progress && progress->cancelled()) break;
+            if (out_of_time()) {
+                summary.time_limited = true;
+                break;
+            }
+            if (stop.target_error > 0 && estimated_rmse() <= stop.target_error) break;
+            continue;
+        }
         if (r == 1) {
             // The neighbour rule reads round 0 across tiles: the tallies of a tile and the
             // pixels around it, gathered into one rectangle.
@@ -167,7 +232,8 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
 
     Framebuffer image = Framebuffer::uninitialized(w, h);
     Framebuffer map(w, h);
-    double samples = 0;
+    double samples = 0;  // camera rays: a corner is traced once for the four pixels it bounds
+    if (corners_first) samples = double(w + 1) * double(h + 1) - double(kFirstRoundSamples) * double(w) * double(h);
     float rgb[kTileSize * kTileSize * 3];
     for (const TileTallies& t : tiles) {
         write_means(t, rgb);

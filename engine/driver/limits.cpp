@@ -53,6 +53,9 @@ MemoryEstimate estimate_render_memory(const Scene& scene, const RenderSettings& 
     }
     if (s.adaptive > 0) {
         e.adaptive_bytes = pixels * (sizeof(PixelTally) + sizeof(std::uint8_t) + 3 * sizeof(float));
+        // The first round's corners, (width + 1) x (height + 1) colours (render/adaptive.h).
+        if (AdaptiveRule{s.adaptive, s.spp}.corner_round())
+            e.adaptive_bytes += (double(s.width) + 1) * (double(s.height) + 1) * 3 * sizeof(float);
         // A tile's round is traced whole: its pixels' samples' colours, at most half the cap each.
         const double largest_round = double(std::max(adaptive_round(0, s.spp).count, s.spp / 2));
         e.per_thread_bytes += double(kTileSize) * kTileSize * largest_round * 3 * sizeof(float);

@@ -16,7 +16,7 @@ namespace streamrt::STREAMRT_ISA_NAMESPACE {
 /// render/sampling.h's pixel_sample for rays [i, i + W) of the job.
 template <class B, class U>
 inline PixelSampleT<B> job_pixel_sample(const GenerateJob& job, std::size_t i) {
-    if (!job.jitter) return {B(0.5f), B(0.5f)};
+    if (!job.jitter) return {B(job.fixed_offset), B(job.fixed_offset)};
     U h1, h2;
     sample_hashes(U::load_aligned(job.key_pixel + i), U::load_aligned(job.key_sample + i), h1, h2);
     return lattice_sample(SamplePattern(job.pattern), B::load_aligned(job.cell_x + i), B::load_aligned(job.cell_y + i),

@@ -81,7 +81,7 @@ struct GenerateJob {
     const float *px, *py, *cell_x, *cell_y;
     const std::uint32_t *key_pixel, *key_sample;
     int pattern;  ///< SamplePattern
-    bool jitter;  ///< false: pixel centres (spp = 1)
+    bool jitter;  ///< false: every ray at fixed_offset in its pixel
     float cols, rows;
     const CameraRays<float>* camera;
     float weight;
@@ -89,6 +89,9 @@ struct GenerateJob {
     /// Thin lens only (generate_lens): per ray, the sample's lattice cell on the lens
     /// (render/sampling.h's LensCells). Keys are then filled even at spp = 1.
     const float *lens_cell_x = nullptr, *lens_cell_y = nullptr;
+    /// Without jitter, every ray's offset in its pixel: 0.5, the centre (spp = 1); 0, the
+    /// pixel's corner (a corner run, render/sampling.h).
+    float fixed_offset = 0.5f;
 };
 using GenerateFn = void (*)(const GenerateJob& job);
 

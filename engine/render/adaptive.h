@@ -16,7 +16,8 @@ namespace streamrt {
 inline constexpr int kDefaultAdaptiveCap = 64;
 
 /// Samples of every pixel's first round: enough for a first spread (3 degrees of freedom),
-/// few enough that flat pixels cost little.
+/// few enough that flat pixels cost little. With a cap of at least 4 they are the pixel's
+/// four corners (corner_rounds), each shared with the neighbours: about one ray per pixel.
 inline constexpr int kFirstRoundSamples = 4;
 
 /// Round r of a pixel whose cap is `cap` samples (--spp): the first takes
@@ -69,6 +70,11 @@ struct AdaptiveRule {
     int cap = 1;           ///< the most samples a pixel takes
 
     bool on() const { return threshold > 0; }
+    /// Whether round 0 takes the pixels' corners (render/sampling.h's corner_run): each
+    /// corner is traced once and counts as a sample of each pixel it bounds, so the first
+    /// round costs about one ray per pixel instead of four. A cap below 4 cannot hold the
+    /// four corners; its first round is min(cap, 4) stratified samples.
+    bool corner_round() const { return cap >= kFirstRoundSamples; }
     /// Whether a pixel's error is above T (after any round): standard_error() > T, squared and
     /// multiplied out (no root, no division: it runs for every pixel of every round).
     bool above(const PixelTally& tally) const {

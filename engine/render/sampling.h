@@ -74,11 +74,29 @@ inline PixelSampleT<V> lattice_sample(SamplePattern pattern, const V& cx, const 
 struct SampleRun {
     int first = 0;
     int count = 1;
+    /// A pixel-corner sample (adaptive sampling's first round, corner_run()): the one sample
+    /// at offset (0, 0) of "pixel" (x, y), x in [0, width] and y in [0, height], the corner
+    /// that up to four pixels share. Its hash key is the corner's own number (sample_key),
+    /// so it is the same sample whichever render of which neighbour takes it.
+    bool corner = false;
 };
+
+/// The sample number of a corner sample: apart from any pixel's own sample numbers (at most
+/// the largest spp), so its lens point and light samples have hashes of their own.
+inline constexpr int kCornerSampleNumber = 1 << 30;
+inline constexpr SampleRun corner_run() { return {kCornerSampleNumber, 1, true}; }
+
+/// The hash key of pixel (x, y) of a `width`-pixel-wide image (its row-major index), or for
+/// a corner run the corner's row-major index on the (width + 1)-wide lattice of corners.
+inline std::uint32_t sample_key(SampleRun run, int x, int y, int width) {
+    const std::uint64_t row = std::uint64_t(width) + (run.corner ? 1u : 0u);
+    return std::uint32_t(std::uint64_t(y) * row + std::uint64_t(x));
+}
 
 /// Sample j (in [0, run.count)) of `run` in pixel `pixel` (row-major index). The run {0, 1}
 /// (spp = 1) takes the pixel centre.
 inline PixelSample pixel_sample(SamplePattern pattern, SampleRun run, std::uint64_t pixel, int j) {
+    if (run.corner) return {0.f, 0.f};
     if (run.first == 0 && run.count == 1) return {0.5f, 0.5f};
     std::uint32_t h1, h2;
     sample_hashes(std::uint32_t(pixel), std::uint32_t(run.first + j), h1, h2);

@@ -43,9 +43,8 @@ struct PipelineStages {
         // Integer bookkeeping (pixel of each ray, sample number, lattice cell) in scalar code;
         // the hashing, jitter and camera directions in the SIMD kernel.
         const int cols = grid_columns(count);
-        const auto image_pixel = [&](int p) {
-            const int x = tile.x0 + p % tile.width(), y = tile.y0 + p / tile.width();
-            return std::uint32_t(std::uint64_t(y) * std::uint64_t(sc.settings.width) + std::uint64_t(x));
+        const auto image_pixel = [&](int p) {  // the hash key (a corner's, for a corner run)
+            return sample_key(req.run, tile.x0 + p % tile.width(), tile.y0 + p / tile.width(), sc.settings.width);
         };
         std::size_t i = 0;
         for (int q = first; q < first + n_pixels; ++q) {
@@ -91,14 +90,15 @@ struct PipelineStages {
                               .key_pixel = g.key_pixel.data(),
                               .key_sample = g.key_sample.data(),
                               .pattern = int(sc.settings.pattern),
-                              .jitter = kJitter,
+                              .jitter = kJitter && !req.run.corner,
                               .cols = float(cols),
                               .rows = float(count / cols),
                               .camera = &sc.camera,
                               .weight = req.weight(),
                               .out = append_view(rays),
                               .lens_cell_x = g.lens_x.data(),
-                              .lens_cell_y = g.lens_y.data()};
+                              .lens_cell_y = g.lens_y.data(),
+                              .fixed_offset = req.run.corner ? 0.f : 0.5f};
         (lens ? kt.generate_lens : kt.generate)(job);
         if (sc.features.area_lights) {
             // Each camera ray's light-sampling key (render/sampling.h light_key), from its

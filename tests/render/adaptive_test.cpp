@@ -66,6 +66,47 @@ TEST_CASE("adaptive: rounds start with 4 samples and double up to the cap") {
     CHECK(adaptive_round(1, 2).count == 0);
 }
 
+TEST_CASE("adaptive: the first round is the pixels' corners, each traced once") {
+    // The hash key of a corner counts on the (width + 1)-wide corner lattice; a pixel's on the image.
+    CHECK(sample_key(corner_run(), 3, 2, 10) == 2u * 11u + 3u);
+    CHECK(sample_key(SampleRun{0, 4}, 3, 2, 10) == 2u * 10u + 3u);
+    CHECK(pixel_sample(SamplePattern::Stratified, corner_run(), 25, 0).x == 0.f);
+    CHECK(pixel_sample(SamplePattern::Stratified, corner_run(), 25, 0).y == 0.f);
+    // The canonical camera (eye (0, 0, 1), screen [-1, 1]^2 in z = 0) before a white sphere of
+    // radius 1.5 centred 4 away on the axis, flat colour: corner (i, j) of a 24 x 24 image,
+    // at screen (-1 + 2i/24, 1 - 2j/24), sees the sphere when its distance to the centre of
+    // the screen is below tan(asin(1.5 / 4)), so tan^2 = 0.140625 / 0.859375. With T above any
+    // spread, every pixel stops after the first round at k/4, k its corners on the sphere
+    // (four stratified samples would land at random across the silhouette).
+    const char* sphere = "image width=24 height=24 spp=16 degree=0\ncamera\nsphere scale=1.5 translate=0,0,-3\n";
+    Scene sc = parse_scene(sphere, "corners.cfg");
+    sc.settings.adaptive = 10;
+    const double tan2 = 0.140625 / 0.859375;
+    const auto on_sphere = [&](int i, int j) {
+        const double x = -1 + 2.0 * i / 24, y = 1 - 2.0 * j / 24, d = x * x + y * y - tan2;
+        REQUIRE(std::abs(d) > 1e-3);  // no corner on the silhouette itself
+        return d < 0;
+    };
+    for (EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
+        CAPTURE(engine_name(engine));
+        const RenderResult r = render(sc, engine, 2);
+        REQUIRE(r.adaptive);
+        CHECK(r.counts.primary == 25u * 25u);  // (24 + 1)^2 corners, not 4 per pixel
+        int straddling = 0;
+        for (int j = 0; j < 24; ++j)
+            for (int i = 0; i < 24; ++i) {
+                CAPTURE(i);
+                CAPTURE(j);
+                const int k = on_sphere(i, j) + on_sphere(i + 1, j) + on_sphere(i, j + 1) + on_sphere(i + 1, j + 1);
+                straddling += k > 0 && k < 4;
+                const std::size_t p = std::size_t(j * 24 + i);
+                CHECK(samples_at(r, p) == 4);
+                CHECK(r.image.rgb[p * 3] == doctest::Approx(k / 4.0).epsilon(1e-6));
+            }
+        CHECK(straddling > 20);
+    }
+}
+
 TEST_CASE("adaptive: the error estimate is the standard error of the mean luminance") {
     PixelTally t;
     CHECK(std::isinf(t.standard_error()));
@@ -166,14 +207,15 @@ TEST_CASE("adaptive: a smaller threshold never gives a pixel fewer samples") {
     }
 }
 
-TEST_CASE("adaptive: a spent time limit stops after the first round; an image target stops early") {
+TEST_CASE("adaptive: a spent time limit stops after the first round, an image target stops early") {
     const Scene sc = adaptive_scene(1e-9);
     // 1 ns: spent before the first round ends, which always covers the image.
     const RenderResult timed = render(sc, EngineKind::Stream, 2, AdaptiveStop{.time_limit = 1e-9});
     REQUIRE(timed.adaptive);
     CHECK(timed.adaptive->time_limited);
     CHECK(timed.adaptive->rounds == 1);
-    CHECK(timed.adaptive->mean_spp == 4.0);
+    // The first round's corners, (48 + 1) x (32 + 1), each traced once for its pixels.
+    CHECK(timed.adaptive->mean_spp == doctest::Approx(49.0 * 33.0 / (48.0 * 32.0)).epsilon(1e-12));
     // A target the first round already meets: the render stops there.
     const RenderResult loose = render(sc, EngineKind::Stream, 2, AdaptiveStop{.target_error = 0.5});
     CHECK(loose.adaptive->rounds == 1);
