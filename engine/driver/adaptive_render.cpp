@@ -62,13 +62,14 @@ void tally_corners(const float* rgb, const Tile& corners, TileTallies& t) {
         }
 }
 
-/// spread_near of the pixels of `inner` (inside `outer`, whose round-0 tallies are `all`,
-/// row by row): its own error or one of its neighbours' (those inside `outer`) above T.
-void mark_spread(const AdaptiveRule& rule, const Tile& outer, const std::vector<PixelTally>& all, const Tile& inner,
-                 std::vector<std::uint8_t>& spread_near) {
-    static thread_local std::vector<std::uint8_t> above;
-    above.resize(all.size());
-    for (std::size_t i = 0; i < all.size(); ++i) above[i] = rule.above(all[i]);
+/// Whether each tally's error is above T, in order.
+void mark_above(const AdaptiveRule& rule, const std::vector<PixelTally>& tallies, std::uint8_t* above) {
+    for (std::size_t i = 0; i < tallies.size(); ++i) above[i] = rule.above(tallies[i]);
+}
+
+/// spread_near of the pixels of `inner` (inside `outer`, whose round-0 above-T flags are
+/// `above`, row by row): its own error or one of its neighbours' (those inside `outer`) above T.
+void mark_spread(const Tile& outer, const std::uint8_t* above, const Tile& inner, std::vector<std::uint8_t>& spread_near) {
     const std::size_t ow = std::size_t(outer.width());
     for (int y = inner.y0; y < inner.y1; ++y)
         for (int x = inner.x0; x < inner.x1; ++x) {
@@ -109,7 +110,9 @@ void render_adaptive_tile(PreparedRender& prepared, const Tile& tile, float* rgb
     for (int y = tile.y0; y < tile.y1; ++y)
         std::copy_n(&outer.pixels[std::size_t(y - ring.y0) * std::size_t(ring.width()) + std::size_t(tile.x0 - ring.x0)],
                     tile.width(), &t.pixels[std::size_t(y - tile.y0) * std::size_t(tile.width())]);
-    mark_spread(prepared.adaptive, ring, outer.pixels, tile, t.spread_near);
+    std::vector<std::uint8_t> above(outer.pixels.size());
+    mark_above(prepared.adaptive, outer.pixels, above.data());
+    mark_spread(ring, above.data(), tile, t.spread_near);
     for (int r = 1; refine(prepared, r, t, counts, cancel) > 0; ++r) {
     }
     write_means(t, rgb);
@@ -124,8 +127,10 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     };
     const int w = prepared.width, h = prepared.height;
     const int nx = (w + kTileSize - 1) / kTileSize, ny = (h + kTileSize - 1) / kTileSize;
+    // 56 bytes a pixel, first touched by the threads that use them (17 MB at 640x480: zeroing
+    // them on one thread took a fifth of a corners-only render).
     std::vector<TileTallies> tiles(std::size_t(nx) * std::size_t(ny));
-    for (std::size_t i = 0; i < tiles.size(); ++i) tiles[i] = tallies_for(tile_rect(w, h, int(i)));
+    par.for_each_index(tiles.size(), 1, [&](std::size_t i) { tiles[i] = tallies_for(tile_rect(w, h, int(i))); });
 
     // Tiles in an interleaved order (a stride near n / golden ratio, prime to n): the work of
     // later rounds sits in a few regions (edges, penumbrae), and a loop that hands out halves
@@ -183,19 +188,19 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
             continue;
         }
         if (r == 1) {
-            // The neighbour rule reads round 0 across tiles: the tallies of a tile and the
-            // pixels around it, gathered into one rectangle.
-            par.for_each_tile(w, h, kTileSize, [&](int index, Tile tile) {
-                const Tile ring{std::max(0, tile.x0 - 1), std::max(0, tile.y0 - 1), std::min(w, tile.x1 + 1),
-                                std::min(h, tile.y1 + 1)};
-                std::vector<PixelTally> around(std::size_t(ring.width()) * std::size_t(ring.height()));
-                for (int y = ring.y0; y < ring.y1; ++y)
-                    for (int x = ring.x0; x < ring.x1; ++x) {
-                        const TileTallies& o = tiles[std::size_t((y / kTileSize) * nx + x / kTileSize)];
-                        around[std::size_t(y - ring.y0) * std::size_t(ring.width()) + std::size_t(x - ring.x0)] =
-                            o.pixels[std::size_t(y - o.tile.y0) * std::size_t(o.tile.width()) + std::size_t(x - o.tile.x0)];
-                    }
-                mark_spread(prepared.adaptive, ring, around, tile, tiles[std::size_t(index)].spread_near);
+            // The neighbour rule reads round 0 across tiles: each pixel's above-T flag, in an
+            // image of bytes, then each tile's pixels look at their eight neighbours there.
+            std::vector<std::uint8_t> above_image(std::size_t(w) * std::size_t(h));
+            par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
+                const TileTallies& t = tiles[i];
+                std::uint8_t flags[kTileSize * kTileSize];
+                mark_above(prepared.adaptive, t.pixels, flags);
+                for (int y = t.tile.y0; y < t.tile.y1; ++y)
+                    std::copy_n(&flags[std::size_t(y - t.tile.y0) * std::size_t(t.tile.width())], t.tile.width(),
+                                &above_image[std::size_t(y) * std::size_t(w) + std::size_t(t.tile.x0)]);
+            });
+            par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
+                mark_spread({0, 0, w, h}, above_image.data(), tiles[i].tile, tiles[i].spread_near);
             });
         }
         std::atomic<int> refined{0};
@@ -231,12 +236,13 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     }
 
     Framebuffer image = Framebuffer::uninitialized(w, h);
-    Framebuffer map(w, h);
-    double samples = 0;  // camera rays: a corner is traced once for the four pixels it bounds
-    if (corners_first) samples = double(w + 1) * double(h + 1) - double(kFirstRoundSamples) * double(w) * double(h);
-    float rgb[kTileSize * kTileSize * 3];
-    for (const TileTallies& t : tiles) {
+    Framebuffer map = Framebuffer::uninitialized(w, h);
+    std::vector<double> tile_samples(tiles.size());  // summed in tile order after: the same for any -j
+    par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
+        const TileTallies& t = tiles[i];
+        float rgb[kTileSize * kTileSize * 3];
         write_means(t, rgb);
+        double n = 0;
         for (int y = t.tile.y0; y < t.tile.y1; ++y)
             for (int x = t.tile.x0; x < t.tile.x1; ++x) {
                 const std::size_t p = std::size_t(y - t.tile.y0) * std::size_t(t.tile.width()) + std::size_t(x - t.tile.x0);
@@ -245,9 +251,14 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                 float* m = map.pixel(x, y);
                 m[0] = float(tally.n);
                 m[1] = float(tally.standard_error());
-                samples += tally.n;
+                m[2] = 0.f;
+                n += tally.n;
             }
-    }
+        tile_samples[i] = n;
+    });
+    double samples = 0;  // camera rays: a corner is traced once for the four pixels it bounds
+    if (corners_first) samples = double(w + 1) * double(h + 1) - double(kFirstRoundSamples) * double(w) * double(h);
+    for (const double n : tile_samples) samples += n;
     summary.mean_spp = samples / (double(w) * double(h));
     summary.estimated_rmse = estimated_rmse();
     prepared.last_adaptive = summary;
