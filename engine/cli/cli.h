@@ -67,6 +67,7 @@ struct Options {
     std::string profile_json;
     bool compare = false;
     std::string shade = "simd";
+    std::optional<int> mesh_hybrid;
     std::string sampler;
     bool quiet = false;
     bool check_only = false;

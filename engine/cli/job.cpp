@@ -56,7 +56,7 @@ RenderOverrides overrides_of(const Options& opt) {
     o.adaptive = opt.adaptive, o.target_error = opt.target_error, o.time_limit = opt.time_limit;
     const auto text = [](const std::string& v) { return v.empty() ? std::nullopt : std::optional<std::string>(v); };
     o.sampler = text(opt.sampler), o.colorspace = text(opt.colorspace), o.tonemap = text(opt.tonemap);
-    o.engine = opt.engine, o.accel = opt.accel, o.shade = opt.shade;
+    o.engine = opt.engine, o.accel = opt.accel, o.shade = opt.shade, o.mesh_hybrid = opt.mesh_hybrid;
     o.threads = opt.jobs;
     return o;
 }

@@ -65,6 +65,7 @@ const Field kFields[] = {
     {"tonemap", [](RenderOverrides& o, const std::string& v) { o.tonemap = one_of("tonemap", v, kTonemapNames); }},
     {"exposure", [](RenderOverrides& o, const std::string& v) { o.exposure = to_double("exposure", v); }},
     {"shade", [](RenderOverrides& o, const std::string& v) { o.shade = one_of("shade", v, kShadeModeNames); }},
+    {"mesh_hybrid", [](RenderOverrides& o, const std::string& v) { o.mesh_hybrid = to_int("mesh_hybrid", v); }},
     {"adaptive", [](RenderOverrides& o, const std::string& v) { o.adaptive = to_double("adaptive", v); }},
     {"target_error", [](RenderOverrides& o, const std::string& v) { o.target_error = to_double("target_error", v); }},
     {"time_limit", [](RenderOverrides& o, const std::string& v) { o.time_limit = to_double("time_limit", v); }},
@@ -177,6 +178,10 @@ RenderJob build_render_job(std::shared_ptr<const Scene> scene, const RenderOverr
         if (!isa_supported(job.options.isa)) throw UsageError("isa " + *o.isa + ": this CPU does not support it");
     }
     if (o.shade) job.options.shade = named("shade", *o.shade, kShadeModeNames);
+    if (o.mesh_hybrid) {
+        if (*o.mesh_hybrid < 0 || *o.mesh_hybrid > 64) throw UsageError("mesh_hybrid must be in [0, 64]");
+        job.options.accel.mesh_hybrid_lanes = std::uint32_t(*o.mesh_hybrid);
+    }
     if (profile) {
         job.profile = std::make_unique<StreamProfile>();
         job.options.profile = job.profile.get();
@@ -190,6 +195,7 @@ RenderJob build_render_job(std::shared_ptr<const Scene> scene, const RenderOverr
     p.sampler = s.pattern, p.calibration = s.calibration, p.colorspace = s.colorspace, p.tonemap = s.tonemap;
     p.exr = s.exr;
     p.engine = job.engine, p.isa = job.options.isa, p.accel = job.options.accel.mode, p.shade = job.options.shade;
+    p.mesh_hybrid = int(job.options.accel.mesh_hybrid_lanes);
     return job;
 }
 

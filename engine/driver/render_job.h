@@ -17,7 +17,7 @@ namespace streamrt {
 
 /// What a front end may override of a scene's settings (each unset: the scene's own).
 struct RenderOverrides {
-    std::optional<int> width, height, spp, depth, degree, light_samples, threads, frame;
+    std::optional<int> width, height, spp, depth, degree, light_samples, threads, frame, mesh_hybrid;
     std::optional<double> cutoff, exposure;
     /// Adaptive sampling (docs/adaptive-sampling.md): the pixels' threshold, the image's
     /// target error, the seconds after which refinement stops.
@@ -46,6 +46,7 @@ struct PixelSettings {
     Isa isa{};  ///< stream engine only
     accel::AccelMode accel{};
     ShadeMode shade{};
+    int mesh_hybrid = 0;  ///< AccelConfig::mesh_hybrid_lanes (--mesh-hybrid)
 
     /// f(name, value) for every field, in declaration order: the one list of them.
     template <class F>
@@ -55,11 +56,12 @@ struct PixelSettings {
         f("adaptive", adaptive), f("target_error", target_error);
         f("sampler", sampler), f("calibration", calibration), f("colorspace", colorspace), f("tonemap", tonemap);
         f("exr", exr), f("engine", engine), f("isa", isa), f("accel", accel), f("shade", shade);
+        f("mesh_hybrid", mesh_hybrid);
     }
-    static constexpr int kFields = 20;  ///< for_each_field's count (checked by the tests)
+    static constexpr int kFields = 21;  ///< for_each_field's count (checked by the tests)
 };
 // Adding a field: list it in for_each_field and kFields, and update this size.
-static_assert(sizeof(PixelSettings) == 80, "PixelSettings changed: list every field in for_each_field");
+static_assert(sizeof(PixelSettings) == 88, "PixelSettings changed: list every field in for_each_field");
 
 /// "width=640,height=480,spp=4,...": every field of PixelSettings, enums by their names,
 /// numbers exactly (%.17g), the stream kernels' level as "none" for the recursive engine.

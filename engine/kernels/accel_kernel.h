@@ -91,7 +91,8 @@ inline void mesh_leaf_closest(const RayView& rays, std::size_t base, const Objec
                          {B::load_aligned(rays.dx + base), B::load_aligned(rays.dy + base), B::load_aligned(rays.dz + base)}};
     const RayPacket<B> c = to_canonical<B, float>(r, ob);
     mesh_closest_packet(*ob.mesh, c.o, c.d, best, rays.prim ? rays.prim + base : nullptr,
-                        rays.bu ? rays.bu + base : nullptr, rays.bv ? rays.bv + base : nullptr);
+                        rays.bu ? rays.bu + base : nullptr, rays.bv ? rays.bv + base : nullptr,
+                        std::max(ob.mesh->single_ray_lanes, rays.single_ray_lanes));
 }
 
 /// One ray in a mesh object's canonical space (computed on a broadcast batch, so exactly as
@@ -261,7 +262,8 @@ void bvh_any_packet(const AccelView& bvh, RayView rays) {
                                              {B::load_aligned(rays.dx + i), B::load_aligned(rays.dy + i),
                                               B::load_aligned(rays.dz + i)}};
                         const RayPacket<B> c = to_canonical<B, float>(r, ob.xf);
-                        open = open && !mesh_any_packet(*ob.xf.mesh, c.o, c.d, t_max, open);
+                        open = open && !mesh_any_packet(*ob.xf.mesh, c.o, c.d, t_max, open,
+                                                        std::max(ob.xf.mesh->single_ray_lanes, rays.single_ray_lanes));
                         t_max = xsimd::select(open, t_max, B(0.f));
                         continue;
                     }

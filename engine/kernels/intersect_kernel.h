@@ -163,7 +163,8 @@ void mesh_closest_hit(RayView rays, std::int32_t* object, const ObjectXf* objs, 
             const RayPacket<B> c = to_canonical<B, float>(r, objs[k]);
             const B before = best;
             mesh_closest_packet(*objs[k].mesh, c.o, c.d, best, rays.prim ? rays.prim + i : nullptr,
-                                rays.bu ? rays.bu + i : nullptr, rays.bv ? rays.bv + i : nullptr);
+                                rays.bu ? rays.bu + i : nullptr, rays.bv ? rays.bv + i : nullptr,
+                                std::max(objs[k].mesh->single_ray_lanes, rays.single_ray_lanes));
             best_id = xsimd::select(best < before, B(float(objs[k].id)), best_id);
         }
         if (xsimd::any(best < start)) store_closest(rays, object, i, best, best_id);
@@ -184,7 +185,8 @@ void mesh_any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
         for (std::size_t k = 0; k < n_objs && xsimd::any(open); ++k) {
             if (!objs[k].mesh) continue;
             const RayPacket<B> c = to_canonical<B, float>(r, objs[k]);
-            open = open && !mesh_any_packet(*objs[k].mesh, c.o, c.d, t_max, open);
+            open = open && !mesh_any_packet(*objs[k].mesh, c.o, c.d, t_max, open,
+                                            std::max(objs[k].mesh->single_ray_lanes, rays.single_ray_lanes));
             t_max = xsimd::select(open, t_max, B(0.f));
         }
         alignas(64) float out[W];

@@ -2,8 +2,10 @@
 // The SIMD mesh kernels: a packet of rays (already in the mesh's canonical space, as for the
 // canonical shapes) walks the mesh's 8-wide BVH together; leaves run the watertight triangle
 // test (shapes/triangle_math.h) on the whole packet, one broadcast triangle at a time.
-// Hybrid: a stack entry that at most MeshView::single_ray_lanes lanes reached is finished
-// by the single-ray walk (mesh_single_kernel.h), one lane after the other.
+// Hybrid: a stack entry that at most `single_lanes` lanes reached is finished by the
+// single-ray walk (mesh_single_kernel.h), one lane after the other. The caller chooses the
+// threshold: the larger of the mesh's (MeshView::single_ray_lanes, for measurements) and the
+// stream's (RayView::single_ray_lanes, set per ray generation by the stream engine).
 // Included only by kernels/isa_*.cpp through intersect_kernel.h, inside their own namespace.
 #include <xsimd/xsimd.hpp>
 
@@ -90,10 +92,10 @@ inline float lanes_min_where(const B& v, const decltype(B(0.f) < B(0.f))& m) {
 
 /// Closest hit of the canonical packet (o, d) with the mesh for t in (0, best): shrinks best
 /// per lane and, for the lanes it shrank, writes triangle number and barycentrics into
-/// prim/u/v[0 .. W) (when prim is not null).
+/// prim/u/v[0 .. W) (when prim is not null). single_lanes: see the hybrid above (0: packet only).
 template <class B>
 inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, B& best, std::int32_t* prim,
-                                float* u, float* v) {
+                                float* u, float* v, std::uint32_t single_lanes) {
     using namespace mesh_detail;
     using I = xsimd::batch<std::int32_t, typename B::arch_type>;
     using Archs = SingleRayArchs<typename B::arch_type>;
@@ -135,7 +137,7 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
     while (sp > 0) {
         const PacketEntry e = stack[--sp];
         if (e.t > best_max) continue;
-        if (std::uint32_t(std::popcount(e.lanes)) <= m.single_ray_lanes) {
+        if (std::uint32_t(std::popcount(e.lanes)) <= single_lanes) {
             hand_over(e);
             best_max = lanes_max(best);
             continue;
@@ -163,7 +165,7 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
             if (!xsimd::any(hit)) continue;
             // farthest first, so the nearest is popped first
             const PacketEntry en{n.child[j], n.count[j], lanes_min_where(tn, hit),
-                                 m.single_ray_lanes > 0 ? movemask_bits(hit) : ~0u};
+                                 single_lanes > 0 ? movemask_bits(hit) : ~0u};
             int k = nh++;
             while (k > 0 && hits[k - 1].t < en.t) {
                 hits[k] = hits[k - 1];
@@ -191,8 +193,10 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
 }
 
 /// Any hit for t in (0, t_max) of the lanes in `open`: the lanes the mesh blocks.
+/// single_lanes: see the hybrid above (0: packet only).
 template <class B, class M>
-inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, const B& t_max, M open) {
+inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, const B& t_max, M open,
+                         std::uint32_t single_lanes) {
     using namespace mesh_detail;
     using Archs = SingleRayArchs<typename B::arch_type>;
     constexpr std::size_t W = B::size;
@@ -219,7 +223,7 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
     stack[sp++] = {0, 0, 0.f, movemask_bits(open)};
     while (sp > 0) {
         const PacketEntry e = stack[--sp];
-        if (m.single_ray_lanes > 0 && std::uint32_t(std::popcount(e.lanes & movemask_bits(open))) <= m.single_ray_lanes) {
+        if (single_lanes > 0 && std::uint32_t(std::popcount(e.lanes & movemask_bits(open))) <= single_lanes) {
             hand_over(e);
             if (!xsimd::any(open)) break;
             continue;
@@ -240,7 +244,7 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
             B tn;
             const auto hit = robust_box(n, j, o, inv, t_max, tn) && open;
             if (xsimd::any(hit))
-                stack[sp++] = {n.child[j], n.count[j], 0.f, m.single_ray_lanes > 0 ? movemask_bits(hit) : ~0u};
+                stack[sp++] = {n.child[j], n.count[j], 0.f, single_lanes > 0 ? movemask_bits(hit) : ~0u};
         }
     }
     return blocked;

@@ -113,7 +113,7 @@ struct PipelineStages {
     }
 
     /// intersect: closest hit of every ray, one SIMD kernel per shape kind present.
-    static void intersect(const StreamScene& sc, const KernelTable& kt, RayStream& rays,
+    static void intersect(const StreamScene& sc, const KernelTable& kt, int depth, RayStream& rays,
                           AlignedVec<std::int32_t>& object, MeshHits& mesh_hits, StageFigures* fig) {
         rays.pad_tail();
         if (object.size() < rays.capacity()) object.resize(rays.capacity());
@@ -124,6 +124,7 @@ struct PipelineStages {
             view.prim = mesh_hits.prim.data();
             view.bu = mesh_hits.u.data();
             view.bv = mesh_hits.v.data();
+            view.single_ray_lanes = depth >= accel::kMeshHybridFromDepth ? sc.mesh_hybrid_lanes : 0;
         }
         if (sc.accel) {  // the object hierarchy (stream/stream_accel.h)
             sc.accel->closest(kt, view, object.data(), rays.count > 0 && rays.kind[0] == std::uint8_t(RayKind::Primary));
@@ -192,7 +193,7 @@ struct PipelineStages {
         std::swap(ws.next, spawned);  // the shade stage appends to ws.next
         {
             StageTimer timer(c.fig(Stage::Intersect));
-            intersect(sc, c.kt, rays, ws.object, ws.mesh_hits, c.fig(Stage::Intersect));
+            intersect(sc, c.kt, depth, rays, ws.object, ws.mesh_hits, c.fig(Stage::Intersect));
             if (c.profile) c.fig(Stage::Intersect)->rays_in += rays.count, c.fig(Stage::Intersect)->rays_out += rays.count;
         }
         {

@@ -56,6 +56,7 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
     meshes = scene.meshes;
     textures = scene.textures;
     has_meshes = !meshes.empty();
+    mesh_hybrid_lanes = has_meshes ? accel_config_.mesh_hybrid_lanes : 0;
 
     accel = StreamAccel::build_for(scene, accel_config_, eye);
     const std::size_t n = scene.objects.size();

@@ -58,6 +58,8 @@ struct StreamScene {
     /// The meshes the objects use (kept alive here: the objects' records point into them).
     std::vector<std::shared_ptr<const Mesh>> meshes;
     bool has_meshes = false;
+    /// AccelConfig::mesh_hybrid_lanes (0 without meshes).
+    std::uint32_t mesh_hybrid_lanes = 0;
     /// The images the materials' textures point into (kept alive here).
     std::vector<std::shared_ptr<const Texture>> textures;
 
