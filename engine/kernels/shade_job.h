@@ -62,14 +62,15 @@ struct ShadeJob {
     // ... and the rays it spawns.
     RayAppend next;
     ShadowAppend shadows;
-    // Mesh objects only: the hit triangle and its barycentrics per ray (same indexing).
+    // Mesh objects only: the hit triangle and its barycentrics per ray (same indexing); the
+    // mesh and its smooth flag are the run's object's, or (gathered) each ray's object's.
     const std::int32_t* prim = nullptr;
     const float* bu = nullptr;
     const float* bv = nullptr;
     const std::int32_t* ids = nullptr;         ///< gathered: per ray, its object's id
     const KernelObject* objects = nullptr;     ///< gathered: every object's record, by id
     const SurfaceRecord* surfaces = nullptr;   ///< gathered: every object's colour, by id
-    ShapeKind kind = ShapeKind::Sphere;        ///< gathered: the run's shape kind (never Mesh)
+    ShapeKind kind = ShapeKind::Sphere;        ///< gathered: the run's shape kind
     const std::uint32_t* key = nullptr;        ///< area lights: per ray, its light-sampling key
 };
 

@@ -41,21 +41,31 @@ inline Vec3T<B> canonical_normal(ShapeKind kind, const Vec3T<B>& p, const B& par
     return visit_shape(kind, [&](auto shape) { return shape.template normal<B>(p, param); });
 }
 
-/// Canonical normals of a mesh's hits, gathered lane by lane from the hit triangles: the face
-/// normal, or the vertex normals interpolated at the barycentrics (mesh/mesh_trace.h's
+/// The record of lane l's object in the packet starting at ray i: the run's object, or
+/// (kGathered) the lane's own, read through its id. Lanes past the run must not ask (their
+/// ids belong to the next run, perhaps not a mesh).
+template <bool kGathered>
+inline const ObjectXf& lane_object(const ShadeJob& job, std::size_t i, std::size_t l) {
+    if constexpr (kGathered) return job.objects[std::size_t(job.ids[i + l])].xf;
+    else return job.object->xf;
+}
+
+/// Canonical normals of a mesh's hits, gathered lane by lane from the hit triangles of each
+/// lane's object (lane_object: one mesh per run, or each lane its own mesh and smooth flag):
+/// the face normal, or the vertex normals interpolated at the barycentrics (mesh/mesh_trace.h's
 /// mesh_normal, the same float expressions). Lanes past the run get +z.
-template <class B>
+template <class B, bool kGathered>
 inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
     constexpr std::size_t W = B::size;
-    const MeshView& m = *job.object->xf.mesh;
-    const bool smooth = job.object->xf.param != 0.f;
     alignas(64) float nx[W], ny[W], nz[W];
     for (std::size_t l = 0; l < W; ++l) {
         nx[l] = ny[l] = 0.f;
         nz[l] = 1.f;
         if (i + l >= job.end) continue;
+        const ObjectXf& ob = lane_object<kGathered>(job, i, l);
+        const MeshView& m = *ob.mesh;
         const std::size_t k = std::size_t(job.prim[i + l]);
-        if (!smooth) {
+        if (ob.param == 0.f) {  // flat
             const float* p = m.tri + 9 * k;
             const float e1x = p[3] - p[0], e1y = p[4] - p[1], e1z = p[5] - p[2];
             const float e2x = p[6] - p[0], e2y = p[7] - p[1], e2z = p[8] - p[2];
@@ -76,16 +86,16 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
 }
 
 /// The shift of each lane's shadow origin on a smooth mesh (mesh/terminator.h): the hit
-/// triangles' corners, vertex normals and barycentrics gathered lane by lane (the floats
-/// smooth_corners reads), the formula in SIMD. Lanes past the run get a flat triangle at
-/// (0, 0): no shift.
-template <class B, class Rows, class M>
+/// triangles' corners, vertex normals and barycentrics gathered lane by lane from each lane's
+/// object (lane_object; the floats smooth_corners reads), the formula in SIMD. Lanes past the
+/// run, and (gathered) lanes of a flat mesh, get a flat triangle at (0, 0): no shift.
+template <class B, bool kGathered, class Rows, class M>
 inline Vec3T<B> terminator_shifts(const ShadeJob& job, std::size_t i, const Rows& rows, const M& outside) {
     constexpr std::size_t W = B::size;
-    const MeshView& m = *job.object->xf.mesh;
     alignas(64) float corner[2][3][3][W], us[W], vs[W];  // [position / normal][corner][axis][lane]
     for (std::size_t l = 0; l < W; ++l) {
-        if (i + l >= job.end) {
+        const ObjectXf* ob = i + l < job.end ? &lane_object<kGathered>(job, i, l) : nullptr;
+        if (!ob || ob->param == 0.f) {
             for (int j = 0; j < 3; ++j)
                 for (int a = 0; a < 3; ++a) {
                     corner[0][j][a][l] = j == a + 1 ? 1.f : 0.f;
@@ -94,6 +104,7 @@ inline Vec3T<B> terminator_shifts(const ShadeJob& job, std::size_t i, const Rows
             us[l] = vs[l] = 0.f;
             continue;
         }
+        const MeshView& m = *ob->mesh;
         const std::size_t k = std::size_t(job.prim[i + l]);
         for (int j = 0; j < 3; ++j) {
             const float* p = m.tri + 9 * k + 3 * std::size_t(j);
@@ -118,10 +129,10 @@ inline Vec3T<B> terminator_shifts(const ShadeJob& job, std::size_t i, const Rows
 /// the weights and the texel offsets in SIMD, the texels gathered; the same operations as the
 /// scalar shade path lane by lane, so the picture is the same bits at every ISA level (the
 /// angles come from simd/stable_math.h, not xsimd's atan2, which rounds differently per
-/// level). Meshes read their triangles' vt lane by lane. `scale`: the run's
-/// canonical_per_world, or (gathered, scale < 0) each lane's, from its rows (a cube root per
-/// lane, in scalar float).
-template <class B, class Rows>
+/// level). Meshes read their triangles' vt and their uv density lane by lane, from each lane's
+/// object (lane_object). `scale`: the run's canonical_per_world, or (gathered, scale < 0)
+/// each lane's, from its rows (a cube root per lane, in scalar float).
+template <class B, bool kGathered, class Rows>
 inline ColorT<B> texture_colors(const ShadeJob& job, std::size_t i, const MaterialT<float>& m, ShapeKind kind,
                                 bool mesh, const Vec3T<B>& pc, const B& param, const Rows& rows, float scale,
                                 const B& footprint) {
@@ -138,17 +149,19 @@ inline ColorT<B> texture_colors(const ShadeJob& job, std::size_t i, const Materi
         sc = B::load_aligned(lanes);
     }
     if (!mesh) return texture_color(m, kind, pc, param, sc, footprint);
-    const MeshView& mv = *job.object->xf.mesh;
-    alignas(64) float us[W], vs[W];
+    alignas(64) float us[W], vs[W], density[W];
     for (std::size_t l = 0; l < W; ++l) {
-        // Lanes past the run have no triangle; meshes without vt read (0, 0), as the scalar path.
-        const UvT<float> uv = i + l < job.end && mv.uv
-                                  ? mesh_uv(mv, std::uint32_t(job.prim[i + l]), job.bu[i + l], job.bv[i + l])
-                                  : UvT<float>{0.f, 0.f};
+        // Lanes past the run have no triangle (their colour is never used); meshes without vt
+        // read (0, 0), as the scalar path.
+        const MeshView* mv = i + l < job.end ? lane_object<kGathered>(job, i, l).mesh : nullptr;
+        const UvT<float> uv = mv && mv->uv ? mesh_uv(*mv, std::uint32_t(job.prim[i + l]), job.bu[i + l], job.bv[i + l])
+                                           : UvT<float>{0.f, 0.f};
         us[l] = uv.u;
         vs[l] = uv.v;
+        density[l] = mv ? mv->uv_density : 1.f;
     }
-    return texture_color_at(m, UvT<B>{B::load_aligned(us), B::load_aligned(vs)}, B(mv.uv_density), sc, footprint);
+    return texture_color_at(m, UvT<B>{B::load_aligned(us), B::load_aligned(vs)}, B::load_aligned(density), sc,
+                            footprint);
 }
 
 /// Appends the active lanes' rays to the next generation's stream, compacted.
@@ -243,7 +256,9 @@ void shade_run(const ShadeJob& job) {
     // Textures: the object's canonical units per world unit, once per run (gathered: per lane).
     const float run_scale = m.texture && !kGathered ? canonical_per_world<float>(ob.m) : -1.f;
     const B lanes = B::load_aligned(lane_index);
-    const bool smooth_mesh = !kGathered && kind == ShapeKind::Mesh && ob.param != 0.f;
+    // Shadow origins move off the flat triangles only on smooth meshes: the run's object, or
+    // (gathered) the packet's smooth lanes.
+    const bool smooth_mesh = kind == ShapeKind::Mesh && (kGathered || ob.param != 0.f);
 
     for (std::size_t i = job.begin; i < job.end; i += W) {
         // The last packet may be partial: its extra lanes read padding and are never stored
@@ -276,21 +291,28 @@ void shade_run(const ShadeJob& job) {
         const Vec3T<B> p = o + d * t;
         Vec3T<B> n_out{};
         if (kLit || m.checker || m.texture)
-            n_out = apply_normal(rows, kind == ShapeKind::Mesh && !kGathered ? mesh_normals<B>(job, i)
-                                                                              : canonical_normal(kind, pc, param));
+            n_out = apply_normal(rows, kind == ShapeKind::Mesh ? mesh_normals<B, kGathered>(job, i)
+                                                                : canonical_normal(kind, pc, param));
         const ArrivingRay<B> arriving{o, d, t, B::load_unaligned(job.cone + i), w, w};
         if (m.texture) {  // one branch per run: the texture replaces the object's colour
             const B footprint = footprint_width(arriving.cone, B(job.rules.spread), t, dot(d, n_out));
-            color = texture_colors(job, i, m, kind, kind == ShapeKind::Mesh && !kGathered, pc, param, rows,
-                                   run_scale, footprint);
+            color = texture_colors<B, kGathered>(job, i, m, kind, kind == ShapeKind::Mesh, pc, param, rows, run_scale,
+                                                 footprint);
         }
         SimdSink<B> sink{job, i};
         // A smooth mesh's shadow rays start from its curved patch, not the flat triangle (one
-        // branch per run).
+        // branch per run; gathered, the flat lanes keep their point and a packet with no
+        // smooth lane skips the shift).
         const auto shadow_point = [&](const Vec3T<B>& at) {
-            if constexpr (!kGathered)
-                if (smooth_mesh) return at + terminator_shifts<B>(job, i, rows, meets_outside(n_out, d));
-            return at;
+            if (!smooth_mesh) return at;
+            if constexpr (kGathered) {
+                const auto smooth = (param != B(0.f)) & active;  // the lanes on a smooth mesh
+                if (!xsimd::any(smooth)) return at;
+                const Vec3T<B> shift = terminator_shifts<B, true>(job, i, rows, meets_outside(n_out, d));
+                return select3(smooth, at + shift, at);
+            } else {
+                return at + terminator_shifts<B, false>(job, i, rows, meets_outside(n_out, d));
+            }
         };
         shade_hit<kLit, kShadows, kReflect, kRefract>(job.rules, m, job.lights, job.n_lights, arriving, p, n_out, color,
                                                       active, sink, shadow_point);
