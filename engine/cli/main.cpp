@@ -42,9 +42,9 @@ int run(int argc, char** argv) {
         ->check(CLI::IsMember(names_vector(kShadeModeNames)))
         ->group("");  // a measuring switch (docs/performance.md), not in the user's --help
     app.add_option("--mesh-hybrid", opt.mesh_hybrid,
-                   "Stream engine, meshes: reflected and refracted rays from the second bounce on walk a mesh's "
-                   "tree as packets until at most N of them reach a node, then one by one (0, the default: packets "
-                   "only; 12-16 pays in scanned glass meshes)")
+                   "Stream engine, meshes: packets of reflected and refracted rays that have scattered (from the "
+                   "second bounce on) walk a mesh's tree as packets until at most N rays reach a node, then one "
+                   "by one (default 16; 0: packets only)")
         ->check(CLI::Range(0, 64));
     app.add_option("--colorspace", opt.colorspace, "8-bit output encoding: srgb (default) or linear (the handout's)")
         ->check(CLI::IsMember(names_vector(kColorSpaceNames)));

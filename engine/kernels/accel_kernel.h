@@ -92,7 +92,8 @@ inline void mesh_leaf_closest(const RayView& rays, std::size_t base, const Objec
     const RayPacket<B> c = to_canonical<B, float>(r, ob);
     mesh_closest_packet(*ob.mesh, c.o, c.d, best, rays.prim ? rays.prim + base : nullptr,
                         rays.bu ? rays.bu + base : nullptr, rays.bv ? rays.bv + base : nullptr,
-                        std::max(ob.mesh->single_ray_lanes, rays.single_ray_lanes));
+                        std::max(ob.mesh->single_ray_lanes,
+                                 scattered_packet_lanes(c.d, best > B(0.f), rays.single_ray_lanes)));
 }
 
 /// One ray in a mesh object's canonical space (computed on a broadcast batch, so exactly as

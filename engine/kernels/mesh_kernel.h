@@ -10,6 +10,7 @@
 #include <xsimd/xsimd.hpp>
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -89,6 +90,28 @@ inline float lanes_min_where(const B& v, const decltype(B(0.f) < B(0.f))& m) {
 }
 
 }  // namespace mesh_detail
+
+/// A packet whose live rays' directions all lie within about 73 degrees of their mean keeps
+/// the packet walk: measured (docs/performance.md, "A switch per ray generation"), the hybrid
+/// pays only on packets scattered wider than that (rays refracted by a scanned mesh's facets)
+/// and costs on the narrower ones (rays through a smooth lens).
+inline constexpr float kScatteredPacketCos = 0.3f;
+
+/// The stream's hybrid threshold (RayView::single_ray_lanes) for the canonical packet with
+/// directions d and live lanes `live`: `lanes` when the packet is scattered (some live
+/// direction is more than acos(kScatteredPacketCos) from their mean), 0 otherwise.
+template <class B, class M>
+inline std::uint32_t scattered_packet_lanes(const Vec3T<B>& d, const M& live, std::uint32_t lanes) {
+    if (lanes == 0) return 0;
+    const B inv_len = B(1.f) / xsimd::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    const B nx = xsimd::select(live, d.x * inv_len, B(0.f)), ny = xsimd::select(live, d.y * inv_len, B(0.f)),
+            nz = xsimd::select(live, d.z * inv_len, B(0.f));
+    const float mx = xsimd::hadd(nx), my = xsimd::hadd(ny), mz = xsimd::hadd(nz);  // xsimd 8: hadd sums the lanes
+    const float m = std::sqrt(mx * mx + my * my + mz * mz);
+    if (!(m > 0.f)) return lanes;  // no live lane, or directions that cancel out
+    const B cos_to_mean = (nx * B(mx) + ny * B(my) + nz * B(mz)) * B(1.f / m);
+    return xsimd::any(live && (cos_to_mean < B(kScatteredPacketCos))) ? lanes : 0u;
+}
 
 /// Closest hit of the canonical packet (o, d) with the mesh for t in (0, best): shrinks best
 /// per lane and, for the lanes it shrank, writes triangle number and barycentrics into

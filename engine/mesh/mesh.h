@@ -15,10 +15,11 @@
 
 namespace streamrt {
 
-/// MeshView::single_ray_lanes of every built mesh. Measured (docs/performance.md "### Meshes",
+/// MeshView::single_ray_lanes of every built mesh: a threshold for every packet, whatever its
+/// rays (for measurements and tests). Measured (docs/performance.md "### Meshes",
 /// perf/mesh_walk_bench): the packet walk alone is fastest for primary, shadow, mirror and
-/// glass rays in the engine's tile order; the hybrid gains only on incoherent (diffuse) rays,
-/// which the renderer does not trace.
+/// glass rays in the engine's tile order. The stream engine hands only packets that have
+/// scattered to the single-ray walk (AccelConfig::mesh_hybrid_lanes, --mesh-hybrid).
 inline constexpr std::uint32_t kDefaultSingleRayLanes = 0;
 
 struct Mesh {

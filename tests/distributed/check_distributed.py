@@ -165,7 +165,7 @@ SETTING_FLAGS = {
     "colorspace": ("--colorspace", "srgb", "linear"), "tonemap": ("--tonemap", "clamp", "reinhard"),
     "engine": ("--engine", "stream", "recursive"), "isa": ("--isa", "sse2", "sse4.2"),
     "accel": ("--accel", "auto", "flat"), "shade": ("--shade", "simd", "scalar"),
-    "adaptive": ("--adaptive", "0", "0.05"), "mesh_hybrid": ("--mesh-hybrid", "0", "16"),
+    "adaptive": ("--adaptive", "0", "0.05"), "mesh_hybrid": ("--mesh-hybrid", "16", "0"),
     "frame": None, "calibration": None, "exr": None, "target_error": None,
 }
 

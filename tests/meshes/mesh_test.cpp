@@ -357,12 +357,22 @@ TEST_CASE("meshes: an OBJ file through the parser, both engines agree, errors ca
 }
 
 TEST_CASE("meshes: the hybrid walk of deep rays (--mesh-hybrid) gives the packet walk's picture, byte for byte") {
-    // Glass and mirror meshes at depth 6: from the second bounce on, rays walk the meshes as
-    // packets until at most N of them reach a node, then one by one (N = 64: one by one from
-    // the root). Both walks run the same watertight test, so every hit, and every pixel, is
-    // the same; a lane dropped or mixed up in the hand-over changes the picture.
+    // Glass and mirror meshes at depth 6: from the second bounce on, packets of rays that
+    // have scattered walk the meshes as packets until at most N of them reach a node, then one
+    // by one (N = 64: one by one from the root). Both walks run the same watertight test, so
+    // every hit, and every pixel, is the same; a lane dropped or mixed up in the hand-over
+    // changes the picture. A lumpy, flat-shaded glass ball scatters the rays as a scanned
+    // mesh does; a smooth one keeps them together (the packet walk).
     const fs::path dir = fs::temp_directory_path() / ("streamrt_hybrid_test_" + std::to_string(::getpid()));
     fs::create_directories(dir);
+    MeshData lumpy = icosphere(3);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> radius(0.8f, 1.2f);
+    for (std::size_t v = 0; v < lumpy.positions.size(); v += 3) {
+        const float r = radius(rng);
+        for (int k = 0; k < 3; ++k) lumpy.positions[v + k] *= r;
+    }
+    REQUIRE(write_obj((dir / "lumpy.obj").string(), lumpy));
     REQUIRE(write_obj((dir / "ball.obj").string(), icosphere(3)));
     REQUIRE(write_obj((dir / "box.obj").string(), cube_mesh(3)));
     const std::string text =
@@ -370,7 +380,8 @@ TEST_CASE("meshes: the hybrid walk of deep rays (--mesh-hybrid) gives the packet
         "camera eye=0,1.5,5 look=0,0.6,0\n"
         "light point pos=3,6,4\n"
         "plane color=0.5,0.5,0.5 checker=0.2,0.2,0.2\n"
-        "mesh file=ball.obj smooth=true color=1,1,1 diff=0.1 trans=0.8 ior=1.5 translate=-0.6,0.8,0\n"
+        "mesh file=lumpy.obj color=1,1,1 diff=0.1 trans=0.8 ior=1.5 translate=-0.6,0.8,0\n"
+        "mesh file=ball.obj smooth=true color=1,1,1 diff=0.1 trans=0.8 ior=1.5 scale=0.4 translate=-0.2,0.4,1.5\n"
         "mesh file=box.obj color=0.9,0.9,0.9 diff=0.1 trans=0.8 ior=1.33 scale=0.5 rotate_y=30 translate=0.8,0.5,0.5\n"
         "mesh file=ball.obj color=0.9,0.9,0.9 refl=0.9 scale=0.6 translate=0.4,0.6,-1.5\n";
     const Scene s = parse_scene(text, (dir / "scene.cfg").string());
@@ -378,6 +389,7 @@ TEST_CASE("meshes: the hybrid walk of deep rays (--mesh-hybrid) gives the packet
     for (accel::AccelMode mode : {accel::AccelMode::Flat, accel::AccelMode::Bvh}) {
         EngineOptions packet;
         packet.accel.mode = mode;
+        packet.accel.mesh_hybrid_lanes = 0;
         const RenderResult base = render_scene(s, EngineKind::Stream, par, nullptr, packet);
         REQUIRE(base.counts.refracted > 4000);  // rays through the glass: generations 1 to 6
         for (std::uint32_t lanes : {1u, 8u, 16u, 64u}) {
