@@ -4,7 +4,8 @@
 
 usage: /usr/bin/python3 scripts/adaptive_bench.py [--scenes a.cfg,b.cfg] [--build DIR] [--runs N]
 
-For each scene (default whitted, textured, soft_shadows) at --width x --height: a reference
+For each scene (default whitted, textured, soft_shadows) at its own size (the scene's `image`
+statement; --width/--height override it): a reference
 (the recursive engine, uniform, --ref-spp samples, stratified; cached in BUILD/perf/reference/),
 then uniform renders at 4, 8, 16 and 32 spp and adaptive renders with --spp --cap as the cap
 and each threshold of --thresholds, all with the streamrt command at -jJOBS, timed whole
@@ -32,12 +33,28 @@ import perf_common as pc  # noqa: E402
 ADAPTIVE_RE = re.compile(r"spp ([0-9.]+) adaptive \(at most (\d+), estimated error ([0-9.e+-]+)")
 
 
-def run(exe, scene, args, extra):
+def scene_size(path):
+    """The width and height of a scene's `image` statement (the renderer's defaults when absent)."""
+    width, height = 640, 480
+    with open(path) as f:
+        for line in f:
+            words = line.split("#")[0].split()
+            if words and words[0] == "image":
+                for w in words[1:]:
+                    key, _, value = w.partition("=")
+                    if key == "width":
+                        width = int(value)
+                    elif key == "height":
+                        height = int(value)
+    return width, height
+
+
+def run(exe, scene, args, size, extra):
     """Whole-process seconds (median of args.runs), the last picture and its closing line."""
     times, line = [], ""
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "out.pfm")
-        cmd = [exe, scene, "-j", str(args.jobs), "--width", str(args.width), "--height", str(args.height),
+        cmd = [exe, scene, "-j", str(args.jobs), "--width", str(size[0]), "--height", str(size[1]),
                "-o", out, *extra]
         for _ in range(args.runs):
             t0 = time.perf_counter()
@@ -58,8 +75,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scenes", default="scenes/whitted.cfg,scenes/textured.cfg,scenes/soft_shadows.cfg")
     ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"))
-    ap.add_argument("--width", type=int, default=320)
-    ap.add_argument("--height", type=int, default=240)
+    ap.add_argument("--width", type=int, help="picture width (default: the scene's own)")
+    ap.add_argument("--height", type=int, help="picture height (default: the scene's own)")
     ap.add_argument("--ref-spp", type=int, default=256)
     ap.add_argument("--cap", type=int, default=64)
     ap.add_argument("--thresholds", default="0.04,0.02,0.01,0.005,0.0025,0.00125")
@@ -76,22 +93,24 @@ def main(argv=None):
     for name in args.scenes.split(","):
         path = name if os.path.isabs(name) else os.path.join(pc.ROOT, name)
         base = os.path.splitext(os.path.basename(path))[0]
-        ref_path = os.path.join(ref_dir, "%s_%dx%d_%dspp_uniform.pfm" % (base, args.width, args.height, args.ref_spp))
+        own = scene_size(path)
+        size = (args.width or own[0], args.height or own[1])
+        ref_path = os.path.join(ref_dir, "%s_%dx%d_%dspp_uniform.pfm" % (base, size[0], size[1], args.ref_spp))
         if not os.path.exists(ref_path):
             print("reference: %s, recursive engine, %d spp..." % (base, args.ref_spp), flush=True)
             subprocess.run([exe, path, "-q", "-j", str(args.jobs), "--engine", "recursive", "--spp", str(args.ref_spp),
-                            "--sampler", "stratified", "--width", str(args.width), "--height", str(args.height),
+                            "--sampler", "stratified", "--width", str(size[0]), "--height", str(size[1]),
                             "-o", ref_path + ".tmp.pfm"], check=True)
             os.replace(ref_path + ".tmp.pfm", ref_path)
         w, h, vals = pc.read_pfm(ref_path)
         ref = pc.np.asarray(vals, pc.np.float64).reshape(h, w, 3)
         scene_rows = []
         for spp in (4, 8, 16, 32):
-            secs, img, _ = run(exe, path, args, ["--spp", str(spp)])
+            secs, img, _ = run(exe, path, args, size, ["--spp", str(spp)])
             scene_rows.append(dict(scene=base, sampler="uniform", threshold="", spp=spp, seconds=secs,
                                    rmse=pc.array_error(img, ref)["rmse"], estimated="", measured_luminance=""))
         for t in args.thresholds.split(","):
-            secs, img, line = run(exe, path, args, ["--spp", str(args.cap), "--adaptive", t])
+            secs, img, line = run(exe, path, args, size, ["--spp", str(args.cap), "--adaptive", t])
             m = ADAPTIVE_RE.search(line)
             if not m:
                 sys.exit("no adaptive summary in: " + line)
@@ -100,7 +119,7 @@ def main(argv=None):
                                    seconds=secs, rmse=pc.array_error(img, ref)["rmse"],
                                    estimated=float(m.group(3)), measured_luminance=lum))
         print("\n%s, %dx%d, -j%d, whole process, median of %d (reference: recursive, %d spp)" % (
-            base, args.width, args.height, args.jobs, args.runs, args.ref_spp))
+            base, size[0], size[1], args.jobs, args.runs, args.ref_spp))
         print("| sampling | spp | seconds | RMSE | estimated / measured (luminance) |")
         print("|---|---|---|---|---|")
         for r in scene_rows:
