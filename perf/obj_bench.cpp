@@ -32,6 +32,7 @@
 #include "mesh/mesh.h"
 #include "mesh/obj_reader.h"
 #include "parallel/parallelism.h"
+#include "reader_bench_args.h"
 
 using namespace streamrt;
 
@@ -81,12 +82,6 @@ void tinyobj_read(const std::string& path, std::vector<float>& positions, std::v
         for (const tinyobj::index_t& ix : s.mesh.indices) tris.push_back(std::uint32_t(ix.vertex_index));
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 /// The process's CPU time (user + system, all threads), seconds.
 double cpu_seconds() {
     rusage ru{};
@@ -119,16 +114,10 @@ void print(const char* what, int j, const Timing& t, double mb) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::string path = "/tmp/streamrt_obj_bench.obj";
-    int runs = 5;
-    std::vector<int> jobs;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "-r" && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-        else if (a == "-j" && i + 1 < argc) jobs.push_back(std::max(1, std::atoi(argv[++i])));
-        else path = a;
-    }
-    if (jobs.empty()) jobs = {1, 2};
+    const ReaderBenchArgs args = parse_reader_bench_args(argc, argv, "/tmp/streamrt_obj_bench.obj");
+    const std::string& path = args.path;
+    const int runs = args.runs;
+    const std::vector<int>& jobs = args.jobs;
     if (!std::filesystem::exists(path)) {
         std::printf("writing %s\n", path.c_str());
         if (!write_sphere(path, 501, 1000)) {
