@@ -224,6 +224,9 @@ std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& pr
             profile->counts += f[0].counts;
         }
     }
+    // The per-generation rows are not sent between ranks: rank 0's alone would not add up
+    // to the stage table, so with more than one rank there are none.
+    if (profile && mpi.size() > 1) profile->generations.clear();
     mine.idle_seconds = std::max(0.0, since(start) - mine.busy_seconds);
     if (profile) profile->wall_seconds = since(start);
     return stats;

@@ -48,6 +48,28 @@ std::string StreamProfile::text() const {
                   (unsigned long long)counts.total(), wall_seconds > 0 ? double(counts.total()) / wall_seconds / 1e6 : 0.0);
     out += line;
     out += "(stage times are thread CPU time, summed over threads; Mrays/s = rays in / cpu s)\n";
+    bool any_generation = false;
+    for (const auto& g : generations) any_generation = any_generation || g.rays > 0 || g.shadow_rays > 0;
+    if (any_generation) {
+        std::snprintf(line, sizeof line, "%-10s %10s  %-32s %11s %9s %12s %11s %9s\n", "generation", "rays",
+                      "(primary/reflected/refracted)", "intersect s", "Mrays/s", "shadow rays", "occlusion s", "Mrays/s");
+        out += line;
+        for (std::size_t d = 0; d < generations.size(); ++d) {
+            const GenerationFigures& g = generations[d];
+            if (g.rays == 0 && g.shadow_rays == 0) continue;
+            const double isec = double(g.intersect_ns) * 1e-9, osec = double(g.occlusion_ns) * 1e-9;
+            char kinds[80];
+            std::snprintf(kinds, sizeof kinds, "(%llu/%llu/%llu)", (unsigned long long)g.primary,
+                          (unsigned long long)g.reflected, (unsigned long long)g.refracted);
+            std::snprintf(line, sizeof line, "%-10zu %10llu  %-32s %11.4f %9.2f %12llu %11.4f %9.2f\n", d,
+                          (unsigned long long)g.rays, kinds, isec, isec > 0 ? double(g.rays) / isec / 1e6 : 0.0,
+                          (unsigned long long)g.shadow_rays, osec,
+                          osec > 0 ? double(g.shadow_rays) / osec / 1e6 : 0.0);
+            out += line;
+        }
+        out += "(the intersect and occlusion rows by ray generation, 0 = camera rays; shadow rays by the "
+               "generation that cast them)\n";
+    }
     return out;
 }
 
@@ -71,6 +93,23 @@ std::string StreamProfile::json() const {
                       first ? "" : ",\n", stage_name(Stage(i)), (unsigned long long)s.rays_in,
                       (unsigned long long)s.rays_out, sec, sec > 0 ? double(s.rays_in) / sec / 1e6 : 0.0,
                       s.lanes_total ? double(s.lanes_used) / double(s.lanes_total) : 1.0);
+        out += buf;
+        first = false;
+    }
+    out += "\n  ],\n  \"generations\": [\n";
+    first = true;
+    for (std::size_t d = 0; d < generations.size(); ++d) {
+        const GenerationFigures& g = generations[d];
+        if (g.rays == 0 && g.shadow_rays == 0) continue;
+        const double isec = double(g.intersect_ns) * 1e-9, osec = double(g.occlusion_ns) * 1e-9;
+        std::snprintf(buf, sizeof buf,
+                      "%s    {\"generation\": %zu, \"rays\": %llu, \"primary\": %llu, \"reflected\": %llu, "
+                      "\"refracted\": %llu, \"intersect_cpu_seconds\": %.6f, \"intersect_mrays_per_s\": %.3f, "
+                      "\"shadow_rays\": %llu, \"occlusion_cpu_seconds\": %.6f, \"occlusion_mrays_per_s\": %.3f}",
+                      first ? "" : ",\n", d, (unsigned long long)g.rays, (unsigned long long)g.primary,
+                      (unsigned long long)g.reflected, (unsigned long long)g.refracted, isec,
+                      isec > 0 ? double(g.rays) / isec / 1e6 : 0.0, (unsigned long long)g.shadow_rays, osec,
+                      osec > 0 ? double(g.shadow_rays) / osec / 1e6 : 0.0);
         out += buf;
         first = false;
     }

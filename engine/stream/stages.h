@@ -191,11 +191,21 @@ struct PipelineStages {
         const StreamScene& sc = c.sc;
         Workspace& ws = c.ws;
         std::swap(ws.next, spawned);  // the shade stage appends to ws.next
+        // This generation's row of the profile (a slice holds one generation only).
+        GenerationFigures* const gen = c.profile ? &c.profile->generation(depth) : nullptr;
         {
-            StageTimer timer(c.fig(Stage::Intersect));
+            StageTimer timer(c.fig(Stage::Intersect), gen ? &gen->intersect_ns : nullptr);
             intersect(sc, c.kt, depth, rays, ws.object, ws.mesh_hits, c.fig(Stage::Intersect));
-            if (c.profile) c.fig(Stage::Intersect)->rays_in += rays.count, c.fig(Stage::Intersect)->rays_out += rays.count;
+            if (c.profile) {
+                c.fig(Stage::Intersect)->rays_in += rays.count, c.fig(Stage::Intersect)->rays_out += rays.count;
+                gen->rays += rays.count;
+            }
         }
+        if (c.profile)  // by kind, outside the stage's time
+            for (std::size_t i = 0; i < rays.count; ++i) {
+                const RayKind kind = RayKind(rays.kind[i]);
+                (kind == RayKind::Primary ? gen->primary : kind == RayKind::Reflected ? gen->reflected : gen->refracted) += 1;
+            }
         {
             StageTimer timer(c.fig(Stage::Shade));
             // Room for every ray spawning both children and a shadow ray per light.
@@ -215,11 +225,12 @@ struct PipelineStages {
             }
         }
         if constexpr (kShadows) {
-            StageTimer timer(c.fig(Stage::Occlusion));
+            StageTimer timer(c.fig(Stage::Occlusion), gen ? &gen->occlusion_ns : nullptr);
             c.counts.shadow += ws.shadows.count;
             occlusion(sc, c.kt, ws.shadows, c.accum, c.fig(Stage::Occlusion));
             if (c.profile) {
                 c.fig(Stage::Occlusion)->rays_in += ws.shadows.count;
+                gen->shadow_rays += ws.shadows.count;
                 for (std::size_t i = 0; i < ws.shadows.count; ++i) c.fig(Stage::Occlusion)->rays_out += ws.shadows.t_max[i] > 0.f;
             }
         }

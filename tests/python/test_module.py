@@ -109,6 +109,12 @@ def test_profile_is_the_json_of_the_command_line():
     r = streamrt.render(WHITTED, width=32, height=32, profile=True)
     assert r.profile is not None
     assert r.profile["isa"]
+    # the per-generation rows split the intersect and occlusion stages
+    gens = r.profile["generations"]
+    stages = {s["stage"]: s for s in r.profile["stages"]}
+    assert gens[0]["generation"] == 0 and gens[0]["rays"] == gens[0]["primary"] == r.profile["rays"]["primary"]
+    assert sum(g["rays"] for g in gens) == stages["intersect"]["rays_in"]
+    assert sum(g["shadow_rays"] for g in gens) == r.profile["rays"]["shadow"]
     assert streamrt.render(WHITTED, width=32, height=32).profile is None
 
 
