@@ -482,19 +482,34 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
                 return;
             }
         }
+        // Fixed weights (the handout's): a reflected child of weight refl and a refracted one
+        // of weight trans. On total internal reflection the refracted ray would leave from the
+        // same point in the same mirror direction as the reflected one (reflect() is the same
+        // about n and -n): with a reflected child, it joins it, one ray of weight refl + trans
+        // instead of two identical subtrees (inside a glass mesh, where light bounces between
+        // faces, that halves the rays at every total reflection).
+        const bool refracts = kRefract && rules.degree >= 4 && m.trans > T(0);
+        const bool reflects = kReflect && rules.degree >= 3 && (m.refl > T(0) || refracts);
+        MaskOf<V> tir = V(0) != V(0);
+        Vec3T<V> t = d;
+        if (refracts) {
+            const Refraction<V> rf = refraction(d, n_out, m.ior);
+            t = rf.dir;
+            if (reflects) tir = rf.tir;
+        }
         if constexpr (kReflect) {
-            if (rules.degree >= 3 && m.refl > T(0)) {
-                const ColorT<V> throughput = ray.throughput * V(m.refl);
-                sink.child(kept(throughput), offset_ray_origin(p, n, ray.origin), reflect(d, n),
-                           ray.weight * V(m.refl), throughput, cone, RayKind::Reflected);
+            if (reflects) {
+                const V w = V(m.refl) + select(tir, V(m.trans), V(0));
+                const ColorT<V> throughput = ray.throughput * w;
+                sink.child(kept(throughput) && (w > V(0)), offset_ray_origin(p, n, ray.origin), reflect(d, n),
+                           ray.weight * w, throughput, cone, RayKind::Reflected);
             }
         }
         if constexpr (kRefract) {
-            if (rules.degree >= 4 && m.trans > T(0)) {
-                const Vec3T<V> t = refract(d, n_out, m.ior);
+            if (refracts) {
                 const Vec3T<V> side = select3(dot(t, n_out) > V(0), n_out, -n_out);
                 const ColorT<V> throughput = ray.throughput * V(m.trans);
-                sink.child(kept(throughput), offset_ray_origin(p, side, ray.origin), t, ray.weight * V(m.trans),
+                sink.child(kept(throughput) && !tir, offset_ray_origin(p, side, ray.origin), t, ray.weight * V(m.trans),
                            throughput, cone, RayKind::Refracted);
             }
         }
