@@ -22,7 +22,7 @@ depth (max_trace_level = depth + 1: POV-Ray counts the camera ray), the checker 
 POV-Ray runs with +WT2 -A -J (2 threads, no anti-aliasing: one ray through each pixel centre),
 streamrt with -j2; the time is the whole process's wall time (reading, set-up, rendering and
 writing a PPM), the median of --runs runs, the two programs alternated. Modes:
-  default     each program's defaults (POV-Ray's adc_bailout is 1/255; streamrt's --cutoff is 0)
+  default     each program's defaults (POV-Ray's adc_bailout is 1/255; streamrt's --cutoff is 0.001)
   nopruning   nothing pruned: POV-Ray `global_settings { adc_bailout 0 }`, streamrt --cutoff 0
   matched     both prune rays worth less than 1/255: POV-Ray's default, streamrt --cutoff 1/255
 Then streamrt's two engines (--engine recursive against stream, -j2, defaults) on the same
@@ -188,7 +188,7 @@ TRANSFORM_KEYS = {"scale", "rotate_x", "rotate_y", "rotate_z", "translate"}
 def read_cfg(path):
     """The scene as a dict (image, ambient, background, camera, lights, objects) for the
     statements the peer scenes use; anything else raises Unsupported (file:line)."""
-    scene = dict(image=dict(width=640, height=480, spp=1, depth=5, degree=5, cutoff=0.0), ambient=0.1,
+    scene = dict(image=dict(width=640, height=480, spp=1, depth=5, degree=5, cutoff=0.001), ambient=0.1,
                  background=[0.0, 0.0, 0.0], camera=dict(eye=[0.0, 0.0, 5.0], look=[0.0, 0.0, 0.0],
                                                           up=[0.0, 1.0, 0.0], fov=45.0),
                  lights=[], objects=[])
