@@ -263,8 +263,7 @@ void bvh_any_packet(const AccelView& bvh, RayView rays) {
                                              {B::load_aligned(rays.dx + i), B::load_aligned(rays.dy + i),
                                               B::load_aligned(rays.dz + i)}};
                         const RayPacket<B> c = to_canonical<B, float>(r, ob.xf);
-                        open = open && !mesh_any_packet(*ob.xf.mesh, c.o, c.d, t_max, open,
-                                                        std::max(ob.xf.mesh->single_ray_lanes, rays.single_ray_lanes));
+                        open = open && !mesh_any_packet(*ob.xf.mesh, c.o, c.d, t_max, open, ob.xf.mesh->single_ray_lanes);
                         t_max = xsimd::select(open, t_max, B(0.f));
                         continue;
                     }

@@ -186,8 +186,7 @@ void mesh_any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
         for (std::size_t k = 0; k < n_objs && xsimd::any(open); ++k) {
             if (!objs[k].mesh) continue;
             const RayPacket<B> c = to_canonical<B, float>(r, objs[k]);
-            open = open && !mesh_any_packet(*objs[k].mesh, c.o, c.d, t_max, open,
-                                            std::max(objs[k].mesh->single_ray_lanes, rays.single_ray_lanes));
+            open = open && !mesh_any_packet(*objs[k].mesh, c.o, c.d, t_max, open, objs[k].mesh->single_ray_lanes);
             t_max = xsimd::select(open, t_max, B(0.f));
         }
         alignas(64) float out[W];

@@ -4,8 +4,8 @@
 // test (shapes/triangle_math.h) on the whole packet, one broadcast triangle at a time.
 // Hybrid: a stack entry that at most `single_lanes` lanes reached is finished by the
 // single-ray walk (mesh_single_kernel.h), one lane after the other. The caller chooses the
-// threshold: the larger of the mesh's (MeshView::single_ray_lanes, for measurements) and the
-// stream's (RayView::single_ray_lanes, set per ray generation by the stream engine).
+// threshold: the mesh's (MeshView::single_ray_lanes, for measurements), and for closest hits
+// the larger of that and the stream's for scattered packets (scattered_packet_lanes).
 // Included only by kernels/isa_*.cpp through intersect_kernel.h, inside their own namespace.
 #include <xsimd/xsimd.hpp>
 

@@ -88,9 +88,10 @@ struct RayView {
     std::int32_t* prim = nullptr;
     float* bu = nullptr;
     float* bv = nullptr;
-    /// Mesh walks hand a stack entry that at most this many live lanes reached to the
-    /// single-ray walk (kernels/mesh_kernel.h; 0: packet walk only). The stream engine sets it
-    /// per generation (stream/stages.h): deep rays in glass have scattered, primary ones not.
+    /// Closest-hit mesh walks of packets that have scattered hand a stack entry that at most
+    /// this many live lanes reached to the single-ray walk (kernels/mesh_kernel.h,
+    /// scattered_packet_lanes; 0: packet walk only). The stream engine sets it per generation
+    /// (stream/stages.h); shadow rays keep the packet walk (measured: the hybrid lost there).
     std::uint32_t single_ray_lanes = 0;
 };
 
