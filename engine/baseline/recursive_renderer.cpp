@@ -173,7 +173,12 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
 
     const Object& object = scene_->objects[std::size_t(hit.object)];
     const ShadeRules<double> rules{
-        .degree = s.degree, .ambient = s.ambient, .spawn = depth < s.depth, .cutoff = s.cutoff, .spread = camera_.spread};
+        .degree = s.degree,
+        .ambient = s.ambient,
+        .spawn = depth < s.depth,
+        .cutoff = s.cutoff,
+        .spread = camera_.spread,
+        .eye = camera_.origin};  // offsets measured from the eye, as the stream engine's
     // Weight 1: the caller multiplies what this ray brings back by its weight.
     const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
     const MaterialT<double>& material = materials_[object.material];

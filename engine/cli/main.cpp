@@ -21,7 +21,7 @@ int run(int argc, char** argv) {
     app.add_option("--depth", opt.depth, "Maximum bounces")->check(CLI::Range(0, 256));
     app.add_option("--cutoff", opt.cutoff,
                    "Weight cut-off: reflected and refracted rays worth less than this in every channel are not "
-                   "traced (default 0: all; overrides the scene's image cutoff=)")
+                   "traced (default 0.001; 0 traces every ray; overrides the scene's image cutoff=)")
         ->check(CLI::Range(0.0, 1.0));
     app.add_option("--light-samples", opt.light_samples,
                    "Shadow rays per shaded point of every area light (overrides the lights' samples=)")

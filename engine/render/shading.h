@@ -238,12 +238,13 @@ inline V schlick_reflectance(T r0, const Refraction<V>& r) {
 }
 
 namespace detail {
-/// Relative size of the ray-origin offset: 2^-17 of the magnitude (64 float ulps) in float,
-/// 2^-36 (65536 ulps) in double.
+/// Relative size of the ray-origin offset: 2^-17 of the magnitude (64 float ulps). The same in
+/// double: the offset is part of what is rendered (a ray leaving a smooth glass mesh can meet
+/// the same triangle again a few offsets away), so the recursive engine takes the stream
+/// engine's, and the two agree on glass meshes (docs/performance.md, "Glass meshes: both
+/// engines render the same picture").
 template <class S>
 inline constexpr S kOffsetRelative = S(1.0 / 131072.0);
-template <>
-inline constexpr double kOffsetRelative<double> = 1.0 / 68719476736.0;
 template <class V>
 inline V max_abs(const Vec3T<V>& a) {
     return simd::max(simd::abs(a.x), simd::max(simd::abs(a.y), simd::abs(a.z)));
@@ -260,17 +261,21 @@ inline MaskOf<V> meets_outside(const Vec3T<V>& n_out, const Vec3T<V>& d) {
 /// Moves a hit point p off its surface along n (unit, the side the new ray leaves on) by an
 /// amount proportional to the magnitude of the numbers it was computed from: the point
 /// itself and the origin `from` of the ray that found it (p = from + t d carries an error of a
-/// few ulps of the larger of the two). In the spirit of Waechter & Binder ("A Fast and Robust
-/// Method for Avoiding Self-Intersection", Ray Tracing Gems ch. 6), but with no absolute
-/// constant at all: their fixed 1/65536 step near the origin (below 1/32) was 15% of the
-/// scene at 1e-4 units, and the offset of a component ignored the size of the others (a
-/// y = 0 floor hit from 10 units away kept an error of ulps of 10 in y). Scale-free, so the
-/// picture is the same at 1e-4, 1 and 1e5 units; one template for double, float and batches.
-template <class V>
-inline Vec3T<V> offset_ray_origin(const Vec3T<V>& p, const Vec3T<V>& n, const Vec3T<V>& from) {
+/// few ulps of the larger of the two), both measured from the eye `eye` (the stream engine
+/// renders relative to the eye and passes 0; the recursive engine passes its eye, so both
+/// move a point by the same amount wherever the scene sits in the world). In the spirit of
+/// Waechter & Binder ("A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing
+/// Gems ch. 6), but with no absolute constant at all: their fixed 1/65536 step near the origin
+/// (below 1/32) was 15% of the scene at 1e-4 units, and the offset of a component ignored the
+/// size of the others (a y = 0 floor hit from 10 units away kept an error of ulps of 10 in y).
+/// Scale-free, so the picture is the same at 1e-4, 1 and 1e5 units; one template for double,
+/// float and batches.
+template <class V, class E>
+inline Vec3T<V> offset_ray_origin(const Vec3T<V>& p, const Vec3T<V>& n, const Vec3T<V>& from, const Vec3T<E>& eye) {
     using S = simd::scalar_t<V>;
-    const V m = simd::max(detail::max_abs(p), detail::max_abs(from));
-    // Floor: the smallest normal number, so a point at the exact origin still moves.
+    const Vec3T<V> e{V(eye.x), V(eye.y), V(eye.z)};
+    const V m = simd::max(detail::max_abs(p - e), detail::max_abs(from - e));
+    // Floor: the smallest normal number, so a point at the exact eye still moves.
     const V step = simd::max(m, V(std::numeric_limits<S>::min())) * V(detail::kOffsetRelative<S>);
     return p + n * step;
 }
@@ -294,6 +299,9 @@ struct ShadeRules {
     /// (image cutoff=, --cutoff); 0 traces every child, as the handout does.
     T cutoff;
     T spread;  ///< ray-cone spread per unit of distance (checker filtering)
+    /// Where ray-origin offsets are measured from (offset_ray_origin): the eye; (0, 0, 0) in
+    /// the stream engine, which renders relative to it.
+    Vec3T<T> eye{T(0), T(0), T(0)};
 };
 
 /// The ray that found a hit, at the hit.
@@ -424,7 +432,7 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
         bool have_origin = false;
         [[maybe_unused]] const auto make_origin = [&] {
             if (have_origin) return;
-            shadow_origin = offset_ray_origin(shadow_point(p), n, ray.origin);
+            shadow_origin = offset_ray_origin(shadow_point(p), n, ray.origin, rules.eye);
             have_origin = true;
         };
         for (std::size_t li = 0; li < n_lights; ++li) {
@@ -473,11 +481,11 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
                 const V R = schlick_reflectance(m.r0, rf);
                 const V w_refl = V(m.refl) + V(m.trans) * R, w_trans = V(m.trans) * (V(T(1)) - R);
                 const ColorT<V> through_refl = ray.throughput * w_refl;
-                sink.child(kept(through_refl), offset_ray_origin(p, n, ray.origin), reflect(d, n),
+                sink.child(kept(through_refl), offset_ray_origin(p, n, ray.origin, rules.eye), reflect(d, n),
                            ray.weight * w_refl, through_refl, cone, RayKind::Reflected);
                 const Vec3T<V> side = select3(dot(rf.dir, n_out) > V(0), n_out, -n_out);
                 const ColorT<V> through_trans = ray.throughput * w_trans;
-                sink.child(kept(through_trans) && !rf.tir, offset_ray_origin(p, side, ray.origin), rf.dir,
+                sink.child(kept(through_trans) && !rf.tir, offset_ray_origin(p, side, ray.origin, rules.eye), rf.dir,
                            ray.weight * w_trans, through_trans, cone, RayKind::Refracted);
                 return;
             }
@@ -501,7 +509,7 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
             if (reflects) {
                 const V w = V(m.refl) + select(tir, V(m.trans), V(0));
                 const ColorT<V> throughput = ray.throughput * w;
-                sink.child(kept(throughput) && (w > V(0)), offset_ray_origin(p, n, ray.origin), reflect(d, n),
+                sink.child(kept(throughput) && (w > V(0)), offset_ray_origin(p, n, ray.origin, rules.eye), reflect(d, n),
                            ray.weight * w, throughput, cone, RayKind::Reflected);
             }
         }
@@ -509,7 +517,7 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
             if (refracts) {
                 const Vec3T<V> side = select3(dot(t, n_out) > V(0), n_out, -n_out);
                 const ColorT<V> throughput = ray.throughput * V(m.trans);
-                sink.child(kept(throughput) && !tir, offset_ray_origin(p, side, ray.origin), t, ray.weight * V(m.trans),
+                sink.child(kept(throughput) && !tir, offset_ray_origin(p, side, ray.origin, rules.eye), t, ray.weight * V(m.trans),
                            throughput, cone, RayKind::Refracted);
             }
         }

@@ -72,7 +72,8 @@ struct ShadeStage {
                 .ambient = float(s.ambient),
                 .spawn = kSecondary && depth < s.depth,
                 .cutoff = float(s.cutoff / s.spp),
-                .spread = sc.camera.spread};
+                .spread = sc.camera.spread,
+                .eye = {0.f, 0.f, 0.f}};  // the engine's origin is the eye (stream_scene.cpp)
     }
 
     /// Where shade_hit's results go on the scalar path: the local colour into the tile,

@@ -116,21 +116,32 @@ TEST_CASE("Snell's law and total internal reflection") {
     CHECK(s.y == doctest::Approx(-1.0));
 }
 
-TEST_CASE("ray origin offset scales with the magnitude of the point and of the ray origin") {
+TEST_CASE("ray origin offset scales with the magnitude of the point and of the ray origin, seen from the eye") {
     const Vec3f n{0, 1, 0};
+    const Vec3f world_origin{0.f, 0.f, 0.f};
     for (float scale : {1e-4f, 1.f, 1e5f, 1e6f}) {
         CAPTURE(scale);
         const Vec3f p{scale, 0.f, scale};  // on a y = 0 floor
-        const Vec3f eye{0.f, scale, 3 * scale};
-        const Vec3f q = offset_ray_origin(p, n, eye);
+        const Vec3f from{0.f, scale, 3 * scale};
+        const Vec3f q = offset_ray_origin(p, n, from, world_origin);
         CHECK(q.y > p.y);
         CHECK(q.x == p.x);
         // Scale-free: the same fraction of the scene at every scale, and at most a few
         // hundred ulps of the largest coordinate (never a fixed epsilon).
         CHECK((q.y - p.y) / (3 * scale) == doctest::Approx(1.0 / 131072));
-        const Vec3d qd = offset_ray_origin(Vec3d{scale, 0, scale}, Vec3d{0, 1, 0}, Vec3d{0, scale, 3.0 * scale});
-        CHECK(qd.y / (3.0 * scale) == doctest::Approx(1.0 / 68719476736.0));
+        // The same step in double: both engines render the same picture.
+        const Vec3d qd = offset_ray_origin(Vec3d{scale, 0, scale}, Vec3d{0, 1, 0}, Vec3d{0, scale, 3.0 * scale},
+                                           Vec3d{0, 0, 0});
+        CHECK(qd.y / (3.0 * scale) == doctest::Approx(1.0 / 131072));
     }
+    // Measured from the eye: the scene and its eye moved 1000 units away keep their step
+    // (the stream engine renders relative to the eye; the recursive engine passes it).
+    const Vec3d shift{1000, -2000, 500};
+    const Vec3d p{1, 0, 1}, from{0, 1, 3}, eye{0, 1, 3};
+    const Vec3d near = offset_ray_origin(p, Vec3d{0, 1, 0}, from, eye);
+    const Vec3d far = offset_ray_origin(p + shift, Vec3d{0, 1, 0}, from + shift, eye + shift);
+    CHECK(near.y - p.y == doctest::Approx(2.0 / 131072));  // p - eye = (1, -1, -2), from = eye
+    CHECK(far.y - (p + shift).y == doctest::Approx(near.y - p.y).epsilon(1e-6));
     // A point at the exact origin still moves.
-    CHECK(offset_ray_origin(Vec3f{0, 0, 0}, n, Vec3f{0, 0, 0}).y > 0.f);
+    CHECK(offset_ray_origin(Vec3f{0, 0, 0}, n, Vec3f{0, 0, 0}, Vec3f{0, 0, 0}).y > 0.f);
 }
