@@ -111,13 +111,25 @@ inline std::uint32_t movemask_bits(const xsimd::batch_bool<float, A>& m) {
 
 namespace mesh_detail {
 
+/// Starts loading a child the single-ray walk will visit: an inner node's boxes (the first
+/// 192 of its 256 bytes) or a leaf's first block (144 bytes). The walk is a chain of dependent
+/// loads (pop, node, child, leaf), so without this it waits on memory at every step; the
+/// packet walk, which spends longer on each node, measured no gain from the same.
+inline void prefetch_child(const MeshView& m, const Entry& e) {
+    const char* p = e.count == 0 ? reinterpret_cast<const char*>(m.nodes + e.child)
+                                 : reinterpret_cast<const char*>(m.blocks + m.block_of[e.child]);
+    __builtin_prefetch(p);
+    __builtin_prefetch(p + 64);
+    __builtin_prefetch(p + 128);
+}
+
 /// The children of node n the ray enters with t in [0, t_max] (far distance widened by
 /// kWiden; boxes are conservative, accel::conservative_box): written to hits[] nearest
 /// last, so pushing them in order pops the nearest first. A NaN slab distance (0 * inf: the
 /// ray lies in a slab plane) does not limit the interval, so such a ray is kept.
 template <class NodeArch, class LeafArch>
-inline int single_node_hits(const accel::WideNode& n, const SingleRay<NodeArch, LeafArch>& r, float t_max,
-                            Entry* hits) {
+inline int single_node_hits(const MeshView& m, const accel::WideNode& n, const SingleRay<NodeArch, LeafArch>& r,
+                            float t_max, Entry* hits) {
     using NB = typename SingleRay<NodeArch, LeafArch>::NB;
     constexpr std::size_t NW = NB::size;
     const float* base = reinterpret_cast<const float*>(&n);
@@ -142,6 +154,7 @@ inline int single_node_hits(const accel::WideNode& n, const SingleRay<NodeArch, 
         const int j = std::countr_zero(hit_bits);
         if (n.child[j] < 0) continue;
         const Entry e{n.child[j], n.count[j], t_out[j]};
+        prefetch_child(m, e);
         int k = nh++;
         while (k > 0 && hits[k - 1].t < e.t) {  // farthest first
             hits[k] = hits[k - 1];
@@ -221,7 +234,7 @@ inline void walk_single(const MeshView& m, const SingleRay<NodeArch, LeafArch>& 
             if (leaf(std::uint32_t(e.child), e.count)) return;
             continue;
         }
-        sp += single_node_hits(m.nodes[e.child], r, t_max, stack + sp);
+        sp += single_node_hits(m, m.nodes[e.child], r, t_max, stack + sp);
     }
 }
 
