@@ -22,15 +22,16 @@ inline constexpr int kFirstRoundSamples = 4;
 
 /// Round r of a pixel whose cap is `cap` samples (--spp): the first takes
 /// min(cap, kFirstRoundSamples) samples, each later one as many as the pixel holds
-/// (doubling), the last cut at the cap. count 0: there is no round r. Each round is
-/// stratified on its own (SampleRun), so a pixel that stops after any round is evenly covered.
+/// (doubling), the last cut at the cap. count 0: there is no round r. The rounds are runs of
+/// the pixel's sequence (SampleRun::sequence): round r >= 1 of a cap of at least 8 is the
+/// aligned block [2^(r+1), 2^(r+2)), so a pixel that stops after any round is evenly covered.
 inline SampleRun adaptive_round(int r, int cap) {
     int first = 0, count = std::min(cap, kFirstRoundSamples);
     for (int i = 0; i < r && count > 0; ++i) {
         first += count;
         count = std::min(first, cap - first);
     }
-    return {first, std::max(count, 0)};
+    return {.first = first, .count = std::max(count, 0), .sequence = true};
 }
 
 /// Rec. 709 luminance of linear RGB: what the error estimate measures.

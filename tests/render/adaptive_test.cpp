@@ -66,6 +66,58 @@ TEST_CASE("adaptive: rounds start with 4 samples and double up to the cap") {
     CHECK(adaptive_round(1, 2).count == 0);
 }
 
+namespace {
+
+/// Whether points [first, first + 2^m) of pixel `pixel`'s sequence put exactly one point in
+/// every elementary interval of area 2^-m: each box [i / 2^a, (i + 1) / 2^a) x [j / 2^(m-a),
+/// (j + 1) / 2^(m-a)), for every a in [0, m] (the definition of a (0,m,2)-net).
+bool is_net(std::uint32_t pixel, std::uint32_t first, int m) {
+    const std::uint32_t n = 1u << m;
+    for (int a = 0; a <= m; ++a) {
+        std::vector<int> filled(n, 0);
+        for (std::uint32_t k = first; k < first + n; ++k) {
+            const PixelSample s = sequence_sample(pixel, k);
+            if (!(s.x >= 0.f && s.x < 1.f && s.y >= 0.f && s.y < 1.f)) return false;
+            const auto i = std::uint32_t(s.x * float(1u << a)), j = std::uint32_t(s.y * float(1u << (m - a)));
+            ++filled[(j << a) | i];
+        }
+        for (int c : filled)
+            if (c != 1) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+TEST_CASE("adaptive: each round is a block of the pixel's (0,2)-sequence, stratified alone and with the rounds before") {
+    // Rounds after the corners double what a pixel holds: samples [4, 8), [8, 16), [16, 32),
+    // [32, 64), each an aligned block of the sequence, taken from it with the stratified pattern.
+    for (int r = 1; r <= 4; ++r) {
+        CAPTURE(r);
+        CHECK(adaptive_round(r, 64).first == 1 << (r + 1));
+        CHECK(adaptive_round(r, 64).sequence);
+        CHECK(uses_sequence(SamplePattern::Stratified, adaptive_round(r, 64)));
+    }
+    CHECK_FALSE(uses_sequence(SamplePattern::Random, adaptive_round(1, 64)));
+    CHECK_FALSE(uses_sequence(SamplePattern::Stratified, SampleRun{0, 16}));  // uniform sampling
+    CHECK_FALSE(uses_sequence(SamplePattern::Stratified, corner_run()));
+    for (std::uint32_t pixel : {0u, 1u, 7u, 640u * 479u + 639u, 123456789u}) {
+        CAPTURE(pixel);
+        // Each round alone, and every prefix the rounds build (corners apart, [0, 2^m)).
+        for (int m = 2; m <= 6; ++m) {
+            CAPTURE(m);
+            CHECK(is_net(pixel, 1u << m, m));  // the round [2^m, 2^(m+1))
+            CHECK(is_net(pixel, 0, m));        // the prefix [0, 2^m)
+        }
+        // Neighbouring pixels scramble differently: their first points differ.
+        CHECK(sequence_sample(pixel, 5).x != sequence_sample(pixel + 1, 5).x);
+    }
+    // pixel_sample draws an adaptive round from the sequence, and a uniform run from its lattice.
+    const SampleRun round = adaptive_round(2, 64);
+    CHECK(pixel_sample(SamplePattern::Stratified, round, 42, 3).x == sequence_sample(42, 11).x);
+    CHECK(pixel_sample(SamplePattern::Stratified, round, 42, 3).y == sequence_sample(42, 11).y);
+}
+
 TEST_CASE("adaptive: the first round is the pixels' corners, each traced once") {
     // The hash key of a corner counts on the (width + 1)-wide corner lattice; a pixel's on the image.
     CHECK(sample_key(corner_run(), 3, 2, 10) == 2u * 11u + 3u);
