@@ -31,8 +31,10 @@ int refine(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, c
     if (cancel && cancel->cancelled()) return 0;
     // The samples go into each tally in their order: the same sums whatever else was traced.
     const float* c = colours.data();
-    for (const std::uint32_t p : pixels)
+    for (const std::uint32_t p : pixels) {
+        t.pixels[p].begin_round();
         for (int j = 0; j < run.count; ++j, c += 3) t.pixels[p].add(c[0], c[1], c[2]);
+    }
     return int(pixels.size());
 }
 
@@ -127,7 +129,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     };
     const int w = prepared.width, h = prepared.height;
     const int nx = (w + kTileSize - 1) / kTileSize, ny = (h + kTileSize - 1) / kTileSize;
-    // 56 bytes a pixel, first touched by the threads that use them (17 MB at 640x480: zeroing
+    // 64 bytes a pixel, first touched by the threads that use them (20 MB at 640x480: zeroing
     // them on one thread took a fifth of a corners-only render).
     std::vector<TileTallies> tiles(std::size_t(nx) * std::size_t(ny));
     par.for_each_index(tiles.size(), 1, [&](std::size_t i) { tiles[i] = tallies_for(tile_rect(w, h, int(i))); });
@@ -156,10 +158,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     const auto estimated_rmse = [&] {  // in a fixed order: the same figure for every -j
         double sum = 0;
         for (const TileTallies& t : tiles)
-            for (const PixelTally& p : t.pixels) {
-                const double se = p.standard_error();
-                sum += std::isfinite(se) ? se * se : 0.0;
-            }
+            for (const PixelTally& p : t.pixels) sum += p.image_error_squared();
         return std::sqrt(sum / (double(w) * double(h)));
     };
     for (int r = 0;; ++r) {

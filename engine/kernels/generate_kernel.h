@@ -17,7 +17,7 @@ namespace streamrt::STREAMRT_ISA_NAMESPACE {
 template <class B, class U>
 inline PixelSampleT<B> job_pixel_sample(const GenerateJob& job, std::size_t i) {
     if (!job.jitter) return {B(job.fixed_offset), B(job.fixed_offset)};
-    if (job.given_offsets) return {B::load_aligned(job.cell_x + i), B::load_aligned(job.cell_y + i)};
+    if (job.sequence) return sequence_sample(U::load_aligned(job.key_pixel + i), U::load_aligned(job.key_sample + i));
     U h1, h2;
     sample_hashes(U::load_aligned(job.key_pixel + i), U::load_aligned(job.key_sample + i), h1, h2);
     return lattice_sample(SamplePattern(job.pattern), B::load_aligned(job.cell_x + i), B::load_aligned(job.cell_y + i),

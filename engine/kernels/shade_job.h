@@ -93,9 +93,9 @@ struct GenerateJob {
     /// Without jitter, every ray's offset in its pixel: 0.5, the centre (spp = 1); 0, the
     /// pixel's corner (a corner run, render/sampling.h).
     float fixed_offset = 0.5f;
-    /// cell_x, cell_y hold each ray's offset in its pixel itself, worked out by the driver
-    /// (adaptive rounds: render/sampling.h's sequence_sample); keys and lattice are unused.
-    bool given_offsets = false;
+    /// Adaptive rounds (render/sampling.h's uses_sequence): the offset is point key_sample of
+    /// the pixel's sequence (sequence_sample); the lattice is unused.
+    bool sequence = false;
 };
 using GenerateFn = void (*)(const GenerateJob& job);
 

@@ -43,7 +43,13 @@ inline double luminance(double r, double g, double b) { return 0.2126 * r + 0.71
 struct PixelTally {
     double r = 0, g = 0, b = 0;
     double shift = 0, sum_y = 0, sum_yy = 0;  ///< luminance sums of y - shift
+    double sum_y_before = 0;  ///< sum_y before the latest round (begin_round)
     int n = 0;
+    int n_before = 0;  ///< n before the latest round; 0 while in the first
+
+    /// Marks the start of a round: its samples are compared with those before it
+    /// (image_error_squared).
+    void begin_round() { n_before = n, sum_y_before = sum_y; }
 
     void add(float sr, float sg, float sb) {
         r += sr, g += sg, b += sb;
@@ -62,6 +68,22 @@ struct PixelTally {
     double standard_error() const {
         if (n < 2) return std::numeric_limits<double>::infinity();
         return std::sqrt(scaled_variance() / (double(n) * n * (n - 1)));
+    }
+    /// The pixel's share of the image's estimated squared error (AdaptiveSummary's
+    /// estimated_rmse). After a round that doubled the pixel's samples, the two halves are two
+    /// estimates of the pixel of equal weight, and (mean of the round - mean before)^2 / 4
+    /// estimates the squared error of their mean: the same as standard_error()^2 for
+    /// independent samples, but it also sees what stratification gains (the sequence's halves
+    /// fill each other's gaps, so the pixel's mean varies far less than s^2 / n on an edge)
+    /// and a first round's corners reading beyond the pixel. It is one degree of freedom per
+    /// pixel: too noisy to decide a pixel's rounds, sound summed over an image. Otherwise
+    /// (the first round, a round cut at the cap): standard_error()^2, 0 below 2 samples.
+    double image_error_squared() const {
+        if (n_before >= 2 && n == 2 * n_before) {
+            const double d = (sum_y - sum_y_before) / (n - n_before) - sum_y_before / n_before;
+            return 0.25 * d * d;
+        }
+        return n < 2 ? 0.0 : scaled_variance() / (double(n) * n * (n - 1));
     }
 };
 
@@ -101,7 +123,7 @@ struct AdaptiveRule {
 /// An adaptive render's outcome, for the closing line and the profile.
 struct AdaptiveSummary {
     double mean_spp = 0;        ///< samples taken per pixel, on average
-    double estimated_rmse = 0;  ///< sqrt(mean of the pixels' standard_error()^2), luminance
+    double estimated_rmse = 0;  ///< sqrt(mean of the pixels' image_error_squared()), luminance
     int rounds = 0;             ///< rounds run
     bool time_limited = false;  ///< --time-limit stopped the refinement
 };

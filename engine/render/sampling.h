@@ -111,46 +111,56 @@ inline std::uint32_t sample_key(SampleRun run, int x, int y, int width) {
 // Laine and Karras 2011 as tuned by Burley 2020), which keeps every elementary interval
 // full and makes the points of neighbouring pixels unrelated.
 
-/// The bits of x in reverse order.
-inline std::uint32_t reverse_bits(std::uint32_t x) {
+/// The bits of x in reverse order. U is std::uint32_t or an xsimd batch of it (the generate
+/// kernel runs these in SIMD lanes, bit for bit the same).
+template <class U>
+inline U reverse_bits(U x) {
     x = (x << 16) | (x >> 16);
-    x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
-    x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
-    x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
-    return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+    x = ((x & U(0x00ff00ffu)) << 8) | ((x >> 8) & U(0x00ff00ffu));
+    x = ((x & U(0x0f0f0f0fu)) << 4) | ((x >> 4) & U(0x0f0f0f0fu));
+    x = ((x & U(0x33333333u)) << 2) | ((x >> 2) & U(0x33333333u));
+    return ((x & U(0x55555555u)) << 1) | ((x >> 1) & U(0x55555555u));
 }
 
 /// A permutation of 32-bit words in which bit k of the result depends on bits 0..k of x
 /// only (additions and multiplications by even constants carry upwards only). Applied to a
 /// coordinate's reversed bits it is a nested scramble: each digit after the binary point is
 /// flipped according to the digits before it.
-inline std::uint32_t nested_scramble_reversed(std::uint32_t x, std::uint32_t seed) {
-    x += seed;
-    x ^= x * 0x6c50b47cu;
-    x ^= x * 0xb82f1e52u;
-    x ^= x * 0xc7afe638u;
-    x ^= x * 0x8d22f6e6u;
+template <class U>
+inline U nested_scramble_reversed(U x, const U& seed) {
+    x = x + seed;
+    x = x ^ (x * U(0x6c50b47cu));
+    x = x ^ (x * U(0xb82f1e52u));
+    x = x ^ (x * U(0xc7afe638u));
+    x = x ^ (x * U(0x8d22f6e6u));
     return x;
 }
 
 /// Sobol's second dimension of point i, as a 32-bit fraction: the generator matrix is
 /// Pascal's triangle mod 2, column k being the direction number v_k = v_(k-1) ^ (v_(k-1) >> 1).
-inline std::uint32_t sobol_second_dimension(std::uint32_t i) {
-    std::uint32_t y = 0;
-    for (std::uint32_t v = 1u << 31; i != 0; i >>= 1, v ^= v >> 1)
-        if (i & 1u) y ^= v;
+/// Without branches on the bits of i, so lanes of different indices run together.
+template <class U>
+inline U sobol_second_dimension(U i) {
+    U y(0u);
+    std::uint32_t v = 1u << 31;
+    for (int k = 0; k < 32; ++k, v ^= v >> 1) {
+        y = y ^ (U(v) & (U(0u) - (i & U(1u))));  // v where bit k of i is set
+        i = i >> 1;
+        if (simd::none_set(i)) break;  // every lane's higher bits are 0
+    }
     return y;
 }
 
 /// Point `index` of pixel `pixel`'s (row-major index) scrambled (0,2)-sequence: an offset in
 /// [0, 1)^2 with 24 significant bits, as unit_from_hash.
-inline PixelSample sequence_sample(std::uint32_t pixel, std::uint32_t index) {
-    const std::uint32_t seed_x = hash32(pixel * 0x2545f491u + 0x9e3779b9u);
-    const std::uint32_t seed_y = hash32(seed_x ^ 0x6a09e667u);
+template <class U>
+inline auto sequence_sample(const U& pixel, const U& index) {
+    const U seed_x = hash32(pixel * U(0x2545f491u) + U(0x9e3779b9u));
+    const U seed_y = hash32(seed_x ^ U(0x6a09e667u));
     // The first dimension is the radical inverse of the index: its reversed bits are the index.
-    const std::uint32_t x = reverse_bits(nested_scramble_reversed(index, seed_x));
-    const std::uint32_t y = reverse_bits(nested_scramble_reversed(reverse_bits(sobol_second_dimension(index)), seed_y));
-    return {unit_from_hash(x), unit_from_hash(y)};
+    const U x = reverse_bits(nested_scramble_reversed(index, seed_x));
+    const U y = reverse_bits(nested_scramble_reversed(reverse_bits(sobol_second_dimension(index)), seed_y));
+    return PixelSampleT<decltype(unit_from_hash(x))>{unit_from_hash(x), unit_from_hash(y)};
 }
 
 /// Whether sample j of `run` comes from the pixel's sequence (sequence_sample) rather than a

@@ -62,6 +62,13 @@ template <class B>
     requires is_batch<B>
 inline B max(const B& a, const B& b) { return xsimd::max(a, b); }
 
+/// Whether every lane of an unsigned integer is 0.
+inline bool none_set(std::uint32_t x) { return x == 0; }
+template <class A>
+inline bool none_set(const xsimd::batch<std::uint32_t, A>& x) {
+    return xsimd::all(x == xsimd::batch<std::uint32_t, A>(0u));
+}
+
 /// An unsigned integer below 2^31 as a float (exact below 2^24).
 inline float to_float(std::uint32_t h) { return float(h); }
 template <class A>

@@ -46,9 +46,6 @@ struct PipelineStages {
         const auto image_pixel = [&](int p) {  // the hash key (a corner's, for a corner run)
             return sample_key(req.run, tile.x0 + p % tile.width(), tile.y0 + p / tile.width(), sc.settings.width);
         };
-        // Adaptive rounds: offsets from the pixel's sequence, worked out here (a short loop
-        // of integer operations per sample); the kernel takes them as they are.
-        const bool sequence = kJitter && uses_sequence(sc.settings.pattern, req.run);
         std::size_t i = 0;
         for (int q = first; q < first + n_pixels; ++q) {
             const int p = req.pixel(q);
@@ -61,15 +58,9 @@ struct PipelineStages {
                 if constexpr (kJitter) {
                     g.key_pixel[i] = key_pixel;
                     g.key_sample[i] = std::uint32_t(req.run.first + j);
-                    if (sequence) {
-                        const PixelSample s = sequence_sample(key_pixel, std::uint32_t(req.run.first + j));
-                        g.cell_x[i] = s.x;
-                        g.cell_y[i] = s.y;
-                    } else {
-                        g.cell_x[i] = float(cx);
-                        g.cell_y[i] = float(cy);
-                        if (++cx == cols) cx = 0, ++cy;
-                    }
+                    g.cell_x[i] = float(cx);
+                    g.cell_y[i] = float(cy);
+                    if (++cx == cols) cx = 0, ++cy;
                 }
                 rays.pixel[i] = req.slot_of(q - first, j, p);
                 rays.kind[i] = std::uint8_t(RayKind::Primary);
@@ -108,7 +99,7 @@ struct PipelineStages {
                               .lens_cell_x = g.lens_x.data(),
                               .lens_cell_y = g.lens_y.data(),
                               .fixed_offset = req.run.corner ? 0.f : 0.5f,
-                              .given_offsets = sequence};
+                              .sequence = kJitter && uses_sequence(sc.settings.pattern, req.run)};
         (lens ? kt.generate_lens : kt.generate)(job);
         if (sc.features.area_lights) {
             // Each camera ray's light-sampling key (render/sampling.h light_key), from its

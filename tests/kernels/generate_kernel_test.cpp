@@ -6,6 +6,7 @@
 
 #include "kernels/shade_job.h"
 #include "kernels/kernel_table.h"
+#include "render/adaptive.h"
 #include "render/camera_rays.h"
 #include "render/sampling.h"
 #include "scene/parser.h"
@@ -63,6 +64,49 @@ TEST_CASE("generate kernel: same sample positions and directions as the scalar f
                     CHECK(rays.ox[i] == cam.origin.x);
                     CHECK(rays.wr[i] == 1.f / float(spp));
                 }
+            }
+        }
+    }
+}
+
+TEST_CASE("generate kernel: adaptive rounds take the scalar sequence's points, every ISA") {
+    const Scene scene = parse_scene("image width=37 height=23 spp=64 adaptive=0.01\n"
+                                    "camera eye=1,2,6 look=0,0.5,0 up=0,1,0 fov=50\nsphere\n",
+                                    "gen.cfg");
+    const auto cam = CameraRays<float>::from(scene);
+    for (int r = 1; r <= 4; ++r) {
+        CAPTURE(r);
+        const SampleRun run = adaptive_round(r, 64);
+        // Rays of pixels 5..9 of row 3: the round's samples of each, indices up to 63.
+        std::vector<float> px, py;
+        std::vector<std::uint32_t> kp, ks;
+        for (int x = 5; x < 10; ++x)
+            for (int k = 0; k < run.count; ++k) {
+                px.push_back(float(x));
+                py.push_back(3.f);
+                kp.push_back(std::uint32_t(3 * 37 + x));
+                ks.push_back(std::uint32_t(run.first + k));
+            }
+        const std::size_t n = px.size(), cap = simd::round_up_lanes(n);
+        px.resize(cap, 0.f), py.resize(cap, 0.f), kp.resize(cap, 0), ks.resize(cap, 0);
+        AlignedVec<float> a_px(px.begin(), px.end()), a_py(py.begin(), py.end()), unused(cap, 0.f);
+        AlignedVec<std::uint32_t> a_kp(kp.begin(), kp.end()), a_ks(ks.begin(), ks.end());
+        for (int level = 0; level < kIsaCount; ++level) {
+            const Isa isa = Isa(level);
+            if (!isa_supported(isa)) continue;
+            CAPTURE(isa_name(isa));
+            RayStream rays;
+            rays.reserve(n);
+            GenerateJob job{n, a_px.data(), a_py.data(), unused.data(), unused.data(), a_kp.data(), a_ks.data(),
+                            int(SamplePattern::Stratified), true, 1.f, 1.f, &cam, 1.f, append_view(rays)};
+            job.sequence = true;
+            kernel_table(isa).generate(job);
+            for (std::size_t i = 0; i < n; ++i) {
+                const PixelSample ps = pixel_sample(SamplePattern::Stratified, run, kp[i], int(ks[i]) - run.first);
+                const Vec3f d = cam.direction(px[i] + ps.x, py[i] + ps.y);
+                CHECK(rays.dx[i] == d.x);
+                CHECK(rays.dy[i] == d.y);
+                CHECK(rays.dz[i] == d.z);
             }
         }
     }
