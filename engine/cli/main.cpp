@@ -43,7 +43,7 @@ int run(int argc, char** argv) {
         ->group("");  // a measuring switch (docs/performance.md), not in the user's --help
     app.add_option("--mesh-hybrid", opt.mesh_hybrid,
                    "Stream engine, meshes: packets of reflected and refracted rays that have scattered (from the "
-                   "second bounce on) walk a mesh's tree as packets until at most N rays reach a node, then one "
+                   "fourth bounce on) walk a mesh's tree as packets until at most N rays reach a node, then one "
                    "by one (default 16; 0: packets only)")
         ->check(CLI::Range(0, 64));
     app.add_option("--colorspace", opt.colorspace, "8-bit output encoding: srgb (default) or linear (the handout's)")

@@ -54,9 +54,12 @@ struct AccelConfig {
     /// of the intersect time in a scanned glass mesh and costs nothing measurable elsewhere.
     std::uint32_t mesh_hybrid_lanes = 16;
 };
-/// The first ray generation (0: camera rays) that --mesh-hybrid applies to: the rays of
-/// generations 0 and 1 leave one smooth or flat surface and still share their paths.
-inline constexpr int kMeshHybridFromDepth = 2;
+/// The first ray generation (0: camera rays) that --mesh-hybrid applies to. Rays of the
+/// first bounces still share most of their paths even when their directions have spread:
+/// on the scanned glass bunny the packet walk was faster for generations 2 and 3 (4.1 and
+/// 2.2 Mrays/s against the hybrid's 3.3 and 1.9), level at 4 and slower from 5 on (0.8 -
+/// 1.1 against 1.0 - 1.2; docs/performance.md, "A switch per ray generation").
+inline constexpr int kMeshHybridFromDepth = 4;
 
 /// The hierarchy over the bounded objects of a scene plus the list of the others.
 struct SceneBvh {

@@ -357,7 +357,7 @@ TEST_CASE("meshes: an OBJ file through the parser, both engines agree, errors ca
 }
 
 TEST_CASE("meshes: the hybrid walk of deep rays (--mesh-hybrid) gives the packet walk's picture, byte for byte") {
-    // Glass and mirror meshes at depth 6: from the second bounce on, packets of rays that
+    // Glass and mirror meshes at depth 6: from the fourth bounce on, packets of rays that
     // have scattered walk the meshes as packets until at most N of them reach a node, then one
     // by one (N = 64: one by one from the root). Both walks run the same watertight test, so
     // every hit, and every pixel, is the same; a lane dropped or mixed up in the hand-over
