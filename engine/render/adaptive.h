@@ -96,7 +96,7 @@ struct AdaptiveRule {
     /// Whether round 0 takes the pixels' corners (render/sampling.h's corner_run): each
     /// corner is traced once and counts as a sample of each pixel it bounds, so the first
     /// round costs about one ray per pixel instead of four. A cap below 4 cannot hold the
-    /// four corners; its first round is min(cap, 4) stratified samples.
+    /// four corners; its first round is min(cap, 4) points of the pixel's sequence.
     bool corner_round() const { return cap >= kFirstRoundSamples; }
     /// Whether a pixel's error is above T (after any round): standard_error() > T, squared and
     /// multiplied out (no root, no division: it runs for every pixel of every round).
