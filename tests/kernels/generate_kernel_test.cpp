@@ -13,6 +13,26 @@
 
 using namespace streamrt;
 
+namespace {
+
+/// Runs the generate kernel of every ISA level this machine supports on `job` (its output a
+/// fresh stream of n rays) and hands each level's rays to check.
+template <class Check>
+void generate_at_every_isa(GenerateJob job, std::size_t n, Check&& check) {
+    for (int level = 0; level < kIsaCount; ++level) {
+        const Isa isa = Isa(level);
+        if (!isa_supported(isa)) continue;
+        CAPTURE(isa_name(isa));
+        RayStream rays;
+        rays.reserve(n);
+        job.out = append_view(rays);
+        kernel_table(isa).generate(job);
+        check(rays);
+    }
+}
+
+}  // namespace
+
 TEST_CASE("generate kernel: same sample positions and directions as the scalar formulas, every ISA") {
     for (const char* sampler : {"stratified", "grid", "random"}) {
         for (int spp : {1, 2, 3, 4, 6, 16}) {
@@ -43,16 +63,10 @@ TEST_CASE("generate kernel: same sample positions and directions as the scalar f
             AlignedVec<float> a_px(px.begin(), px.end()), a_py(py.begin(), py.end()), a_cx(cx.begin(), cx.end()),
                 a_cy(cy.begin(), cy.end());
             AlignedVec<std::uint32_t> a_kp(kp.begin(), kp.end()), a_ks(ks.begin(), ks.end());
-            for (int level = 0; level < kIsaCount; ++level) {
-                const Isa isa = Isa(level);
-                if (!isa_supported(isa)) continue;
-                CAPTURE(isa_name(isa));
-                RayStream rays;
-                rays.reserve(n);
-                GenerateJob job{n, a_px.data(), a_py.data(), a_cx.data(), a_cy.data(), a_kp.data(), a_ks.data(),
-                                int(scene.settings.pattern), spp > 1, float(cols), float(spp / cols),
-                                &cam, 1.f / float(spp), append_view(rays)};
-                kernel_table(isa).generate(job);
+            const GenerateJob job{n, a_px.data(), a_py.data(), a_cx.data(), a_cy.data(), a_kp.data(), a_ks.data(),
+                                  int(scene.settings.pattern), spp > 1, float(cols), float(spp / cols),
+                                  &cam, 1.f / float(spp), {}};
+            generate_at_every_isa(job, n, [&](const RayStream& rays) {
                 for (std::size_t i = 0; i < n; ++i) {
                     const PixelSample ps = pixel_sample(scene.settings.pattern, spp, kp[i], int(ks[i]));
                     CHECK(ps.x >= 0.f);
@@ -64,7 +78,7 @@ TEST_CASE("generate kernel: same sample positions and directions as the scalar f
                     CHECK(rays.ox[i] == cam.origin.x);
                     CHECK(rays.wr[i] == 1.f / float(spp));
                 }
-            }
+            });
         }
     }
 }
@@ -91,16 +105,10 @@ TEST_CASE("generate kernel: adaptive rounds take the scalar sequence's points, e
         px.resize(cap, 0.f), py.resize(cap, 0.f), kp.resize(cap, 0), ks.resize(cap, 0);
         AlignedVec<float> a_px(px.begin(), px.end()), a_py(py.begin(), py.end()), unused(cap, 0.f);
         AlignedVec<std::uint32_t> a_kp(kp.begin(), kp.end()), a_ks(ks.begin(), ks.end());
-        for (int level = 0; level < kIsaCount; ++level) {
-            const Isa isa = Isa(level);
-            if (!isa_supported(isa)) continue;
-            CAPTURE(isa_name(isa));
-            RayStream rays;
-            rays.reserve(n);
-            GenerateJob job{n, a_px.data(), a_py.data(), unused.data(), unused.data(), a_kp.data(), a_ks.data(),
-                            int(SamplePattern::Stratified), true, 1.f, 1.f, &cam, 1.f, append_view(rays)};
-            job.sequence = true;
-            kernel_table(isa).generate(job);
+        GenerateJob job{n, a_px.data(), a_py.data(), unused.data(), unused.data(), a_kp.data(), a_ks.data(),
+                        int(SamplePattern::Stratified), true, 1.f, 1.f, &cam, 1.f, {}};
+        job.sequence = true;
+        generate_at_every_isa(job, n, [&](const RayStream& rays) {
             for (std::size_t i = 0; i < n; ++i) {
                 const PixelSample ps = pixel_sample(SamplePattern::Stratified, run, kp[i], int(ks[i]) - run.first);
                 const Vec3f d = cam.direction(px[i] + ps.x, py[i] + ps.y);
@@ -108,7 +116,7 @@ TEST_CASE("generate kernel: adaptive rounds take the scalar sequence's points, e
                 CHECK(rays.dy[i] == d.y);
                 CHECK(rays.dz[i] == d.z);
             }
-        }
+        });
     }
 }
 
