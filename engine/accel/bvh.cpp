@@ -1,8 +1,10 @@
 #include "accel/bvh.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <memory>
 #include <type_traits>
@@ -240,13 +242,84 @@ struct Builder {
     }
 };
 
-/// Collapses the binary tree into 8-wide nodes: a wide node takes its binary node's two
-/// children, then repeatedly opens the inner child of largest area until it has 8.
+/// Collapses the binary tree into 8-wide nodes with the least SAH cost, by dynamic
+/// programming over the binary tree (after Ylitie, Karras and Laine 2017, "Efficient
+/// incoherent ray traversal on GPUs through compressed wide BVHs"). A greedy collapse (open
+/// the largest child until a node has 8) left two thirds of a large mesh's nodes with two
+/// children: every subtree its parent had no room for became a node of its own. The leaves
+/// are the binary tree's whatever the collapse, so the cost that changes is the wide nodes':
+/// a node of k children costs its area (the chance that a ray visits it) times
+/// (1 + child_cost k), child_cost being one child box test relative to the rest of a visit
+/// (BuildOptions::wide_child_cost). exact[b][k - 1] is the least cost of covering binary node
+/// b's subtree with exactly k children of one wide node (a child is a leaf, or a wide node
+/// of its own; infinite when the subtree has fewer than k leaves).
 struct Collapser {
     const BinNode* bin;
     simd::AlignedVec<WideNode>& out;
+    float child_cost;
+    std::unique_ptr<std::array<float, kNodeWidth>[]> exact;
     std::size_t leaves = 0;
 
+    static constexpr float kInf = std::numeric_limits<float>::infinity();
+
+    /// The least exact[left][j - 1] + exact[right][k - j - 1] over j, and that j.
+    std::pair<float, int> split(const BinNode& n, int k) const {
+        const auto& l = exact[std::size_t(n.left)];
+        const auto& r = exact[std::size_t(n.right)];
+        float c = kInf;
+        int arg = 1;
+        for (int j = 1; j < k; ++j) {
+            const float cj = l[std::size_t(j - 1)] + r[std::size_t(k - j - 1)];
+            if (cj < c) c = cj, arg = j;
+        }
+        return {c, arg};
+    }
+    /// The number of children, from 2 to 8, of the cheapest wide node at inner node b.
+    int node_children(std::int32_t b) const {
+        const BinNode& n = bin[std::size_t(b)];
+        float c = kInf;
+        int arg = 2;
+        for (int k = 2; k <= kNodeWidth; ++k) {
+            const float ck = n.half_area() * (1.f + child_cost * float(k)) + exact[std::size_t(b)][std::size_t(k - 1)];
+            if (ck < c) c = ck, arg = k;
+        }
+        return arg;
+    }
+
+    /// Fills exact[] over b's subtree (children first; the halves of the top levels in parallel).
+    void solve(std::int32_t b, int depth) {
+        const BinNode& n = bin[std::size_t(b)];
+        auto& c = exact[std::size_t(b)];
+        if (n.left < 0) {
+            c.fill(kInf);
+            c[0] = 0.f;
+            return;
+        }
+        if (depth < 10) {
+            parallel_invoke([&] { solve(n.left, depth + 1); }, [&] { solve(n.right, depth + 1); });
+        } else {
+            solve(n.left, depth + 1);
+            solve(n.right, depth + 1);
+        }
+        for (int k = 2; k <= kNodeWidth; ++k) c[std::size_t(k - 1)] = split(n, k).first;
+        const int k = node_children(b);  // b as a wide node of its own
+        c[0] = n.half_area() * (1.f + child_cost * float(k)) + c[std::size_t(k - 1)];
+    }
+
+    /// The k children that cover b's subtree at exact[b][k - 1].
+    void cut(std::int32_t b, int k, std::int32_t* kids, int& nk) const {
+        const BinNode& n = bin[std::size_t(b)];
+        if (k == 1 || n.left < 0) {  // (a leaf has a finite cost for k = 1 only)
+            kids[nk++] = b;
+            return;
+        }
+        const int j = split(n, k).second;
+        cut(n.left, j, kids, nk);
+        cut(n.right, k - j, kids, nk);
+    }
+
+    /// Emits the wide node of binary node b, then its inner children's nodes (parents first,
+    /// which refit relies on); returns its index.
     std::int32_t emit(std::int32_t b) {
         const std::size_t me = out.size();
         out.emplace_back();
@@ -256,23 +329,7 @@ struct Collapser {
         if (root.left < 0) {
             kids[nk++] = b;  // a leaf at the root: one child
         } else {
-            kids[nk++] = root.left;
-            kids[nk++] = root.right;
-            while (nk < kNodeWidth) {
-                int best = -1;
-                float best_area = -1.f;
-                for (int k = 0; k < nk; ++k) {
-                    const BinNode& c = bin[std::size_t(kids[k])];
-                    if (c.left >= 0 && c.half_area() > best_area) {
-                        best_area = c.half_area();
-                        best = k;
-                    }
-                }
-                if (best < 0) break;
-                const BinNode& c = bin[std::size_t(kids[best])];
-                kids[best] = c.left;
-                kids[nk++] = c.right;
-            }
+            cut(b, node_children(b), kids, nk);
         }
         WideNode n;
         for (int j = 0; j < kNodeWidth; ++j) {
@@ -297,12 +354,10 @@ struct Collapser {
         }
         out[me] = n;
         for (int j = 0; j < nk; ++j) {
-            const BinNode& c = bin[std::size_t(kids[j])];
-            if (c.left >= 0) {
-                const std::int32_t child = emit(kids[j]);
-                out[me].child[j] = child;
-                out[me].count[j] = 0;
-            }
+            if (bin[std::size_t(kids[j])].left < 0) continue;
+            const std::int32_t child = emit(kids[j]);
+            out[me].child[j] = child;
+            out[me].count[j] = 0;
         }
         return std::int32_t(me);
     }
@@ -333,8 +388,11 @@ Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
     b.build(root, 0, std::uint32_t(n), all, call, 0);
     const std::size_t n_binary = b.n_nodes.load();
 
-    Collapser c{b.nodes.get(), bvh.nodes};
-    bvh.nodes.reserve(n_binary / 4 + 1);
+    float XC = options.wide_child_cost; if (const char* e = std::getenv("XC")) XC = float(std::atof(e));
+    Collapser c{b.nodes.get(), bvh.nodes, XC,
+                std::make_unique_for_overwrite<std::array<float, kNodeWidth>[]>(n_binary)};
+    c.solve(0, 0);
+    bvh.nodes.reserve(n_binary / 6 + 1);
     c.emit(0);
     bvh.prim_index.resize(n);
     parallel_for_index(n, 65536, [&](std::size_t k) { bvh.prim_index[k] = refs[k].id; });

@@ -69,6 +69,9 @@ struct BuildOptions {
     int max_leaf = 4;        ///< largest leaf the SAH may choose
     int bins = 16;           ///< bins per axis
     float traversal_cost = 3.f;  ///< node visit, relative to one primitive test (measured: 3 beats 1)
+    /// The collapse into 8-wide nodes (bvh.cpp, Collapser): one child box test, relative to
+    /// the rest of a node visit.
+    float wide_child_cost = 0.1f;
     std::size_t parallel_grain = 4096;  ///< subtrees at least this big are built as parallel tasks
 };
 

@@ -89,6 +89,21 @@ inline float lanes_min_where(const B& v, const decltype(B(0.f) < B(0.f))& m) {
     return r;
 }
 
+/// The lanes of `lanes` whose ray meets one of node n's child boxes within (0, t_max). A
+/// packet handed to the single-ray walk at the root first passes this one packet test, so
+/// that a lane missing the whole mesh (a ray inside one glass mesh, against the scene's other
+/// meshes) costs no single-ray set-up and root visit of its own.
+template <class B>
+inline std::uint32_t lanes_meeting_children(const accel::WideNode& n, const Vec3T<B>& o, const Vec3T<B>& inv,
+                                            const B& t_max, std::uint32_t lanes) {
+    auto any_child = t_max != t_max;  // all false (t_max is never NaN)
+    for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
+        B tn;
+        any_child = any_child || robust_box(n, j, o, inv, t_max, tn);
+    }
+    return lanes & movemask_bits(any_child);
+}
+
 }  // namespace mesh_detail
 
 /// A packet whose live rays' directions all lie within about 73 degrees of their mean keeps
@@ -156,7 +171,12 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
     };
     PacketEntry stack[kStack];
     int sp = 0;
-    stack[sp++] = {0, 0, 0.f, movemask_bits(best > B(0.f))};
+    std::uint32_t live = movemask_bits(best > B(0.f));
+    if (std::uint32_t(std::popcount(live)) <= single_lanes) {
+        live = lanes_meeting_children(m.nodes[0], o, inv, best, live);
+        if (live == 0) return;
+    }
+    stack[sp++] = {0, 0, 0.f, live};
     while (sp > 0) {
         const PacketEntry e = stack[--sp];
         if (e.t > best_max) continue;

@@ -1,12 +1,13 @@
 // Embree 3 against streamrt's mesh kernels on the same rays (docs/performance.md, "Against
 // POV-Ray and Embree"). Not a test; built only when CMake finds Embree 3 (perf/CMakeLists.txt).
 //
-//   embree_rays [--reps N] [--isa LEVEL] MESH.{obj,ply} ...
+//   embree_rays [--reps N] [--isa LEVEL] [--quality medium|high] MESH.{obj,ply} ...
 //
 // Each mesh is read by streamrt's own reader (load_mesh_file) and built twice: streamrt's mesh
 // (its 8-wide hierarchy, as a scene uses it) and an Embree scene of the same triangles, in the
 // same order (RTC_GEOMETRY_TYPE_TRIANGLE, RTC_BUILD_QUALITY_HIGH for the scene and the
-// geometry, a device with threads=1). The ray sets are perf/mesh_rays.h's, over a view fitted
+// geometry, a device with threads=1). High quality is Embree's SAH build with spatial splits;
+// --quality medium is its SAH build without them (what streamrt's builder does). The ray sets are perf/mesh_rays.h's, over a view fitted
 // to the mesh's bounds (1280x720 primary rays in 4x4 tiles; from their hits, shadow rays to a
 // point light, mirror-reflected rays and, as the incoherent extreme, diffuse rays). Every set
 // runs on this one thread, median of N runs (default 5), in Mrays/s:
@@ -47,14 +48,14 @@ void embree_error(void*, RTCError code, const char* msg) {
 
 /// The mesh's triangles as an Embree scene (vertices shared as in the mesh, triangles in the
 /// mesh's leaf order, so Embree's primID is streamrt's triangle number).
-RTCScene embree_scene(RTCDevice dev, const Mesh& mesh) {
+RTCScene embree_scene(RTCDevice dev, const Mesh& mesh, RTCBuildQuality quality) {
     const std::size_t nt = mesh.triangle_count();
     std::uint32_t nv = 0;
     for (std::uint32_t i : mesh.index) nv = std::max(nv, i + 1);
     RTCScene scene = rtcNewScene(dev);
-    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneBuildQuality(scene, quality);
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+    rtcSetGeometryBuildQuality(g, quality);
     auto* vb = static_cast<float*>(
         rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
     auto* ib = static_cast<unsigned*>(
@@ -155,6 +156,7 @@ Result embree1(RTCScene scene, const Stream& st, bool any, int reps) {
 int main(int argc, char** argv) {
     Isa isa = best_isa();
     int reps = 5;
+    RTCBuildQuality quality = RTC_BUILD_QUALITY_HIGH;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -162,14 +164,19 @@ int main(int argc, char** argv) {
             reps = std::max(1, std::atoi(argv[++i]));
         } else if (a == "--isa" && i + 1 < argc) {
             if (!parse_isa(argv[++i], isa)) return std::fprintf(stderr, "unknown level %s\n", argv[i]), 2;
+        } else if (a == "--quality" && i + 1 < argc) {
+            const std::string q = argv[++i];
+            if (q != "medium" && q != "high") return std::fprintf(stderr, "--quality: medium or high\n"), 2;
+            quality = q == "high" ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
         } else if (a == "-h" || a == "--help" || a.rfind("--", 0) == 0) {
-            std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa sse2|sse4.2|avx2|avx512] MESH.{obj,ply} ...\n");
+            std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa sse2|sse4.2|avx2|avx512] [--quality medium|high] "
+                                 "MESH.{obj,ply} ...\n");
             return a == "-h" || a == "--help" ? 0 : 2;
         } else {
             files.push_back(a);
         }
     }
-    if (files.empty()) return std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa LEVEL] MESH.{obj,ply} ...\n"), 2;
+    if (files.empty()) return std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa LEVEL] [--quality medium|high] MESH.{obj,ply} ...\n"), 2;
     // Embree's advice for its kernels (denormals flushed); the same mode for streamrt's below.
     _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
@@ -191,16 +198,17 @@ int main(int argc, char** argv) {
             return 1;
         }
         const double t_built = now();
-        RTCScene scene = embree_scene(dev, *mesh);
+        RTCScene scene = embree_scene(dev, *mesh, quality);
         const double t_embree = now() - t_built;
         ObjectXf xf{};
         xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
         xf.mesh = &mesh->view();
         const View view = view_of_bounds(mesh->lo, mesh->hi);
         const Streams s = make_streams(*mesh, kt, xf, view);
-        std::printf("\n%s: %zu triangles; streamrt read + build %.2f s, Embree build (high quality, 1 thread) "
+        std::printf("\n%s: %zu triangles; streamrt read + build %.2f s, Embree build (%s quality, 1 thread) "
                     "%.2f s; %dx%d view\n",
-                    file.c_str(), mesh->triangle_count(), t_built - t_read, t_embree, view.width, view.height);
+                    file.c_str(), mesh->triangle_count(), t_built - t_read,
+                    quality == RTC_BUILD_QUALITY_HIGH ? "high" : "medium", t_embree, view.width, view.height);
         std::printf("%-8s %9s %10s %10s %10s %7s   %s\n", "rays", "count", "Embree16", "Embree1", "streamrt", "ratio",
                     "hits: Embree16 / Embree1 / streamrt");
         struct Kind {

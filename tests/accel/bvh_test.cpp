@@ -219,3 +219,52 @@ TEST_CASE("BVH: build of an empty set, a single box and many equal boxes") {
     CHECK(total == 1000);
     CHECK(many.prim_index.size() == 1000);
 }
+
+TEST_CASE("BVH: the collapse into 8-wide nodes takes the least-cost cut (16 boxes in a row, by hand)") {
+    // Unit cubes at x = 0, 2, ..., 30, one per leaf (max_leaf 1): the binned SAH splits the row
+    // in halves down to single boxes (a perfect binary tree of 16 leaves). A box spanning n
+    // cubes has half-area 2 (2n - 1) + 1: 63 for the row, 31 for 8 cubes, 15 for 4, 7 for 2.
+    // A wide node of k children costs area (1 + k / 4) (wide_child_cost 0.25). By hand:
+    //   root over 8 nodes of 2 leaves:  63 * 3    + 8 * 7 * 1.5  = 273
+    //   root over 2 nodes of 8 leaves:  63 * 1.5  + 2 * 31 * 3   = 280.5
+    //   root over 4 nodes of 4 leaves:  63 * 2    + 4 * 15 * 2   = 246
+    // and 246 is the least over every cut (an exhaustive search of them agrees; e.g. 3 quads
+    // and 2 pairs cost 63 * 2.25 + 3 * 30 + 2 * 10.5 = 252.75). The greedy collapse (open
+    // the largest child until 8) gave the first: 9 nodes.
+    std::vector<accel::Aabb> row(16);
+    for (int i = 0; i < 16; ++i) {
+        row[std::size_t(i)].lo[0] = float(2 * i);
+        row[std::size_t(i)].hi[0] = float(2 * i + 1);
+        row[std::size_t(i)].lo[1] = row[std::size_t(i)].lo[2] = 0.f;
+        row[std::size_t(i)].hi[1] = row[std::size_t(i)].hi[2] = 1.f;
+    }
+    accel::BuildOptions opt;
+    opt.max_leaf = 1;
+    opt.wide_child_cost = 0.25f;
+    const accel::Bvh bvh = accel::Bvh::build(row, opt);
+    REQUIRE(bvh.nodes.size() == 5);
+    const accel::WideNode& root = bvh.nodes[0];
+    for (int j = 0; j < accel::kNodeWidth; ++j) {
+        CAPTURE(j);
+        if (j >= 4) {
+            CHECK(root.child[j] == -1);
+            continue;
+        }
+        REQUIRE(root.count[j] == 0);  // an inner node ...
+        CHECK(root.hi_x[j] - root.lo_x[j] == 7.f);  // ... over 4 cubes
+        const accel::WideNode& quad = bvh.nodes[std::size_t(root.child[j])];
+        for (int k = 0; k < accel::kNodeWidth; ++k) CHECK(quad.count[k] == (k < 4 ? 1u : 0u));
+    }
+    // Without the cost of testing children the least total area of nodes is 63 + 31 + 7 = 101:
+    // the root over one node of 8 leaves, one of 2 and 6 leaves (8 pairs: 63 + 56 = 119).
+    opt.wide_child_cost = 0.f;
+    const accel::Bvh flat = accel::Bvh::build(row, opt);
+    REQUIRE(flat.nodes.size() == 3);
+    int leaves = 0, inner = 0;
+    for (int j = 0; j < accel::kNodeWidth; ++j) {
+        leaves += flat.nodes[0].count[j] == 1;
+        inner += flat.nodes[0].child[j] >= 0 && flat.nodes[0].count[j] == 0;
+    }
+    CHECK(leaves == 6);
+    CHECK(inner == 2);
+}
