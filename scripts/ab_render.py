@@ -1,12 +1,16 @@
 #!/usr/bin/env python3
 """Before/after render times of two streamrt builds, measured in one run (docs/performance.md).
 
-usage: scripts/ab_render.py OLD_BINARY NEW_BINARY [--runs N] [--jobs J] [--size WxH] [--spp S] SCENE...
+usage: scripts/ab_render.py OLD_BINARY NEW_BINARY [--runs N] [--jobs J] [--size WxH] [--spp S] [--stages] SCENE...
 
 Renders each scene with the old and the new binary alternately (old, new, old, new, ...),
 --runs times each, and prints the median render clock (the summary line's "render" phase:
 scene reading, set-up and image writing excluded) of each, and new / old. Alternating keeps
 the two series under the same load on a shared machine. Writes nothing but temporary PFMs.
+
+With --stages, runs `--profile` instead and compares the intersect and occlusion stages'
+thread CPU time (immune to time spent descheduled), median and minimum of each series: the
+figures of docs/performance.md's traversal changes (use --jobs 1).
 """
 import argparse
 import os
@@ -31,6 +35,38 @@ def render_seconds(binary, scene, args, out):
     return float(m.group(1))
 
 
+def stage_seconds(binary, scene, args, out):
+    """Thread CPU seconds of the intersect and occlusion stages (--profile's table)."""
+    cmd = [binary, "-j%d" % args.jobs, "--profile", scene, "-o", out]
+    if args.size:
+        w, h = args.size.split("x")
+        cmd += ["--width", w, "--height", h]
+    if args.spp:
+        cmd += ["--spp", str(args.spp)]
+    r = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    cpu = {}
+    for line in (r.stdout + r.stderr).splitlines():
+        f = line.split()
+        if len(f) >= 4 and f[0] in ("intersect", "occlusion"):
+            cpu[f[0]] = float(f[3])
+    if len(cpu) != 2:
+        sys.exit("no intersect and occlusion rows in: " + r.stdout + r.stderr)
+    return cpu["intersect"], cpu["occlusion"]
+
+
+def compare_stages(args, scene, out):
+    runs = {"old": [], "new": []}
+    for _ in range(args.runs):
+        for which in ("old", "new"):
+            runs[which].append(stage_seconds(getattr(args, which), scene, args, out))
+    row = [scene]
+    for k in (0, 1):
+        for pick in (statistics.median, min):
+            old, new = pick(r[k] for r in runs["old"]), pick(r[k] for r in runs["new"])
+            row.append("%.4f -> %.4f (%.3f)" % (old, new, new / old))
+    print("| " + " | ".join(row) + " |", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("old")
@@ -40,7 +76,15 @@ def main():
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--size", help="WxH (default: the scene's)")
     ap.add_argument("--spp", type=int)
+    ap.add_argument("--stages", action="store_true", help="compare the intersect and occlusion stages' CPU time")
     args = ap.parse_args()
+    if args.stages:
+        print("| scene | intersect median s, old -> new (new / old) | intersect min | occlusion median | occlusion min |")
+        print("|---|---|---|---|---|")
+        with tempfile.TemporaryDirectory() as tmp:
+            for scene in args.scenes:
+                compare_stages(args, scene, os.path.join(tmp, "x.pfm"))
+        return
     print("| scene | old (s) | new (s) | new / old |")
     print("|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
