@@ -64,13 +64,13 @@ void tally_corners(const float* rgb, const Tile& corners, TileTallies& t) {
         }
 }
 
-/// Whether each tally's error is above T, in order.
+/// Whether each tally's error is above its stopping point (AdaptiveRule::above), in order.
 void mark_above(const AdaptiveRule& rule, const std::vector<PixelTally>& tallies, std::uint8_t* above) {
     for (std::size_t i = 0; i < tallies.size(); ++i) above[i] = rule.above(tallies[i]);
 }
 
-/// spread_near of the pixels of `inner` (inside `outer`, whose round-0 above-T flags are
-/// `above`, row by row): its own error or one of its neighbours' (those inside `outer`) above T.
+/// spread_near of the pixels of `inner` (inside `outer`, whose round-0 `above` flags are
+/// `above`, row by row): its own error or one of its neighbours' (those inside `outer`) above.
 void mark_spread(const Tile& outer, const std::uint8_t* above, const Tile& inner, std::vector<std::uint8_t>& spread_near) {
     const std::size_t ow = std::size_t(outer.width());
     for (int y = inner.y0; y < inner.y1; ++y)

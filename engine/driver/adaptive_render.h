@@ -10,7 +10,8 @@
 namespace streamrt {
 
 /// The tallies of a rectangle's pixels, row by row, and (after round 0) whether each has an
-/// error above T in itself or a neighbour (AdaptiveRule::takes_round's spread_near).
+/// error above its stopping point (AdaptiveRule::above) in itself or a neighbour
+/// (AdaptiveRule::takes_round's spread_near).
 struct TileTallies {
     Tile tile{};
     std::vector<PixelTally> pixels;

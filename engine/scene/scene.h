@@ -95,8 +95,9 @@ struct RenderSettings {
     /// The default prunes what an 8-bit picture cannot show: measured (docs/performance.md,
     /// "Weight cut-off"), no pixel of the glass scenes moves by more than one 8-bit step.
     double cutoff = 0.001;
-    /// Adaptive sampling (render/adaptive.h): a pixel stops taking samples once the estimated
-    /// standard error of its mean luminance is at most this; spp is then the most it takes.
+    /// Adaptive sampling (render/adaptive.h): T, the estimated standard error of its mean
+    /// luminance at which a pixel of 16 samples stops (one of n samples stops at T sqrt(n / 16));
+    /// spp is then the most it takes.
     /// 0: every pixel takes spp samples.
     double adaptive = 0.0;
     glm::dvec3 background{0.0, 0.0, 0.0};
