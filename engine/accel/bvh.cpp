@@ -4,7 +4,6 @@
 #include <array>
 #include <atomic>
 #include <chrono>
-#include <cstdlib>
 #include <cmath>
 #include <memory>
 #include <type_traits>
@@ -388,8 +387,7 @@ Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
     b.build(root, 0, std::uint32_t(n), all, call, 0);
     const std::size_t n_binary = b.n_nodes.load();
 
-    float XC = options.wide_child_cost; if (const char* e = std::getenv("XC")) XC = float(std::atof(e));
-    Collapser c{b.nodes.get(), bvh.nodes, XC,
+    Collapser c{b.nodes.get(), bvh.nodes, options.wide_child_cost,
                 std::make_unique_for_overwrite<std::array<float, kNodeWidth>[]>(n_binary)};
     c.solve(0, 0);
     bvh.nodes.reserve(n_binary / 6 + 1);
