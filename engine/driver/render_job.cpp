@@ -106,7 +106,7 @@ std::string override_names() {
 }
 
 std::string settings_token(const PixelSettings& s) {
-    std::string token;
+    std::string token = "pixels=" + std::to_string(kPixelsRevision);
     s.for_each_field([&](const char* name, const auto& value) {
         if (!token.empty()) token += ',';
         token += name;

@@ -63,8 +63,15 @@ struct PixelSettings {
 // Adding a field: list it in for_each_field and kFields, and update this size.
 static_assert(sizeof(PixelSettings) == 88, "PixelSettings changed: list every field in for_each_field");
 
-/// "width=640,height=480,spp=4,...": every field of PixelSettings, enums by their names,
-/// numbers exactly (%.17g), the stream kernels' level as "none" for the recursive engine.
+/// Bumped whenever a change makes the same settings give other pixels, so that shard parts,
+/// checkpoint journals and frames written by an older build are refused, not mixed with new
+/// ones: the settings token starts with it. 2: adaptive sampling's stopping point became
+/// T sqrt(n / 16) (2026-11-27).
+inline constexpr int kPixelsRevision = 2;
+
+/// "pixels=2,width=640,height=480,spp=4,...": kPixelsRevision, then every field of
+/// PixelSettings, enums by their names, numbers exactly (%.17g), the stream kernels' level as
+/// "none" for the recursive engine.
 std::string settings_token(const PixelSettings& s);
 
 /// Sets the override `name` from its text (the command line's spelling: "spp", "light_samples",

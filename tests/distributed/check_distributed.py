@@ -10,6 +10,7 @@ Exits 1 with one line per failure; 0 when everything holds.
 import argparse
 import os
 import pathlib
+import re
 import signal
 import subprocess
 import sys
@@ -167,6 +168,7 @@ SETTING_FLAGS = {
     "accel": ("--accel", "auto", "flat"), "shade": ("--shade", "simd", "scalar"),
     "adaptive": ("--adaptive", "0", "0.05"), "mesh_hybrid": ("--mesh-hybrid", "16", "0"),
     "frame": None, "calibration": None, "exr": None, "target_error": None,
+    "pixels": None,  # the build's kPixelsRevision: below, a part of another revision is refused
 }
 
 
@@ -206,6 +208,22 @@ def group_settings(args, tmp):
         check(r.returncode == 2 and one_line(r), f"parts differing in {flag} ({a} vs {b}) were merged: "
                                                 f"{r.returncode}: {r.stderr.strip()!r}")
         check(not (tmp / f"{key}.pfm").exists(), f"a refused merge ({flag}) wrote an image")
+    # A part written by a build that computes the pixels differently (another kPixelsRevision,
+    # the token's first item) is refused like any other difference.
+    other = tmp / "other_build.part"
+    r = run([args.streamrt, *base(), "-o", other, "--shard", "1/2"])
+    check(r.returncode == 0, f"shard render failed: {r.stderr.strip()}")
+    data = other.read_bytes()
+    head, rest = data.split(b"\n", 1)
+    revision = re.search(rb"settings=pixels=(\d+),", head)
+    check(revision is not None, f"no pixels revision first in the settings token: {head!r}")
+    if revision:
+        older = str(int(revision.group(1)) - 1).encode()
+        other.write_bytes(head.replace(b"settings=pixels=" + revision.group(1), b"settings=pixels=" + older) + b"\n" + rest)
+        r = run([args.streamrt, "merge", probe, other, "-o", tmp / "mixed.pfm"])
+        check(r.returncode == 2 and one_line(r), f"parts of two pixels revisions were merged: {r.returncode}: "
+                                                f"{r.stderr.strip()!r}")
+        check(not (tmp / "mixed.pfm").exists(), "a refused merge (pixels revision) wrote an image")
 
 
 def interrupt_when_journaled(cmd, journal):
