@@ -21,36 +21,36 @@ import sys
 import tempfile
 
 
-def render_seconds(binary, scene, args, out):
-    cmd = [binary, "-j%d" % args.jobs, scene, "-o", out]
+def streamrt(binary, scene, args, out, *extra):
+    """Runs one render with the options asked for; its output (stdout and stderr)."""
+    cmd = [binary, "-j%d" % args.jobs, *extra, scene, "-o", out]
     if args.size:
         w, h = args.size.split("x")
         cmd += ["--width", w, "--height", h]
     if args.spp:
         cmd += ["--spp", str(args.spp)]
     r = subprocess.run(cmd, capture_output=True, text=True, check=True)
-    m = re.search(r"render ([0-9.]+) s", r.stdout + r.stderr)
+    return r.stdout + r.stderr
+
+
+def render_seconds(binary, scene, args, out):
+    text = streamrt(binary, scene, args, out)
+    m = re.search(r"render ([0-9.]+) s", text)
     if not m:
-        sys.exit("no render time in: " + r.stdout + r.stderr)
+        sys.exit("no render time in: " + text)
     return float(m.group(1))
 
 
 def stage_seconds(binary, scene, args, out):
     """Thread CPU seconds of the intersect and occlusion stages (--profile's table)."""
-    cmd = [binary, "-j%d" % args.jobs, "--profile", scene, "-o", out]
-    if args.size:
-        w, h = args.size.split("x")
-        cmd += ["--width", w, "--height", h]
-    if args.spp:
-        cmd += ["--spp", str(args.spp)]
-    r = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    text = streamrt(binary, scene, args, out, "--profile")
     cpu = {}
-    for line in (r.stdout + r.stderr).splitlines():
+    for line in text.splitlines():
         f = line.split()
         if len(f) >= 4 and f[0] in ("intersect", "occlusion"):
             cpu[f[0]] = float(f[3])
     if len(cpu) != 2:
-        sys.exit("no intersect and occlusion rows in: " + r.stdout + r.stderr)
+        sys.exit("no intersect and occlusion rows in: " + text)
     return cpu["intersect"], cpu["occlusion"]
 
 
