@@ -107,8 +107,8 @@ struct AdaptiveRule {
     /// n >= 4 s / T: in proportion to s, which spends each sample where it lowers the image's
     /// squared error most (a doubling round gains s^2 / (2 n) for n samples' cost, so the
     /// best next samples go to the pixels of largest s^2 / n^2). Stopping at a fixed standard
-    /// error (n in proportion to s^2) spent 17 - 19 % more rays at equal image error on
-    /// whitted and textured (docs/adaptive-sampling.md). Squared and multiplied out: no root,
+    /// error (n in proportion to s^2) spent about a quarter more rays at equal image error on
+    /// whitted and textured (docs/adaptive-sampling.md, Figures). Squared and multiplied out: no root,
     /// no division (it runs for every pixel of every round).
     bool above(const PixelTally& tally) const {
         if (tally.n < 2) return true;
