@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "kernels/shade_job.h"
+#include "kernels/every_isa.h"
 #include "kernels/kernel_table.h"
 #include "render/adaptive.h"
 #include "render/camera_rays.h"
@@ -19,16 +20,13 @@ namespace {
 /// fresh stream of n rays) and hands each level's rays to check.
 template <class Check>
 void generate_at_every_isa(GenerateJob job, std::size_t n, Check&& check) {
-    for (int level = 0; level < kIsaCount; ++level) {
-        const Isa isa = Isa(level);
-        if (!isa_supported(isa)) continue;
-        CAPTURE(isa_name(isa));
+    at_every_isa([&](Isa isa) {
         RayStream rays;
         rays.reserve(n);
         job.out = append_view(rays);
         kernel_table(isa).generate(job);
         check(rays);
-    }
+    });
 }
 
 }  // namespace

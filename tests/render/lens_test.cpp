@@ -11,6 +11,7 @@
 
 #include "driver/render.h"
 #include "kernels/shade_job.h"
+#include "kernels/every_isa.h"
 #include "kernels/kernel_table.h"
 #include "render/camera_rays.h"
 #include "render/sampling.h"
@@ -157,10 +158,7 @@ TEST_CASE("thin lens: the generate(lens) kernel traces the scalar formulas' rays
                             a_lx = aligned(lx), a_ly = aligned(ly);
     kp.resize(cap, 0), ks.resize(cap, 0);
     const AlignedVec<std::uint32_t> a_kp(kp.begin(), kp.end()), a_ks(ks.begin(), ks.end());
-    for (int level = 0; level < kIsaCount; ++level) {
-        const Isa isa = Isa(level);
-        if (!isa_supported(isa)) continue;
-        CAPTURE(isa_name(isa));
+    at_every_isa([&](Isa isa) {
         RayStream rays;
         rays.reserve(n);
         GenerateJob job{n, a_px.data(), a_py.data(), a_cx.data(), a_cy.data(), a_kp.data(), a_ks.data(),
@@ -179,7 +177,7 @@ TEST_CASE("thin lens: the generate(lens) kernel traces the scalar formulas' rays
             CHECK(rays.dy[i] == d.y);
             CHECK(rays.dz[i] == d.z);
         }
-    }
+    });
 }
 
 namespace {
