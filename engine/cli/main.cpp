@@ -57,7 +57,7 @@ int run(int argc, char** argv) {
         ->check(CLI::IsMember(names_vector(kSamplePatternNames)));
     app.add_option("--adaptive", opt.adaptive,
                    "Adaptive sampling: a pixel of n samples stops once the standard error of its mean luminance is "
-                   "at most T sqrt(n / 16) (T at 16 samples, e.g. 0.01); --spp is the most it takes (default 64)")
+                   "at most T (n / 16)^(3/4) (T at 16 samples, e.g. 0.03); --spp is the most it takes (default 64)")
         ->check(CLI::Range(0.0, 1.0));
     app.add_option("--target-error", opt.target_error,
                    "Adaptive sampling until the image's estimated RMSE (luminance) is at most E")

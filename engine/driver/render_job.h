@@ -67,10 +67,10 @@ static_assert(sizeof(PixelSettings) == 88, "PixelSettings changed: list every fi
 /// checkpoint journals and frames written by an older build are refused, not mixed with new
 /// ones: the settings token starts with it. 2: adaptive sampling's stopping point became
 /// T sqrt(n / 16) (2026-11-27). 3: an adaptive pixel's corners weigh a quarter of its own
-/// samples in its mean (kCornerWeight, 2026-11-27).
-inline constexpr int kPixelsRevision = 3;
+/// samples in its mean (kCornerWeight); 4: its stopping point became T (n / 16)^(3/4) (both 2026-11-27).
+inline constexpr int kPixelsRevision = 4;
 
-/// "pixels=3,width=640,height=480,spp=4,...": kPixelsRevision, then every field of
+/// "pixels=4,width=640,height=480,spp=4,...": kPixelsRevision, then every field of
 /// PixelSettings, enums by their names, numbers exactly (%.17g), the stream kernels' level as
 /// "none" for the recursive engine.
 std::string settings_token(const PixelSettings& s);

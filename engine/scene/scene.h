@@ -96,7 +96,7 @@ struct RenderSettings {
     /// "Weight cut-off"), no pixel of the glass scenes moves by more than one 8-bit step.
     double cutoff = 0.001;
     /// Adaptive sampling (render/adaptive.h): T, the estimated standard error of its mean
-    /// luminance at which a pixel of 16 samples stops (one of n samples stops at T sqrt(n / 16));
+    /// luminance at which a pixel of 16 samples stops (one of n samples stops at T (n / 16)^(3/4));
     /// spp is then the most it takes.
     /// 0: every pixel takes spp samples.
     double adaptive = 0.0;

@@ -252,7 +252,7 @@ TEST_CASE("adaptive: round 1 follows the pixel's or a neighbour's spread, later 
     CHECK_FALSE(rule.takes_round(settled, 2, true));  // the neighbour rule is round 1's only
 }
 
-TEST_CASE("adaptive: a pixel of n samples stops at the standard error T sqrt(n / 16)") {
+TEST_CASE("adaptive: a pixel of n samples stops at the standard error T (n / 16)^(3/4)") {
     const AdaptiveRule rule{0.01, 64};
     // Two values a and b, half the samples each: se = (|a - b| / 2) / sqrt(n - 1).
     const auto pixel = [](int n, float a, float b) {
@@ -260,14 +260,18 @@ TEST_CASE("adaptive: a pixel of n samples stops at the standard error T sqrt(n /
         for (int i = 0; i < n; ++i) t.add(i % 2 ? a : b, i % 2 ? a : b, i % 2 ? a : b);
         return t;
     };
-    // 4 samples, se = 0.015 / sqrt(3) = 0.00866: under T, but above T sqrt(4 / 16) = 0.005.
-    const PixelTally few = pixel(4, 0.515f, 0.485f);
-    CHECK(few.standard_error() == doctest::Approx(0.015 / std::sqrt(3.0)).epsilon(1e-5));
+    // 4 samples, se = 0.0075 / sqrt(3) = 0.00433: above T (4 / 16)^(3/4) = 0.003536, though
+    // under T sqrt(4 / 16) = 0.005 (the square-root rule would stop it).
+    const PixelTally few = pixel(4, 0.5075f, 0.4925f);
+    CHECK(few.standard_error() == doctest::Approx(0.0075 / std::sqrt(3.0)).epsilon(1e-5));
     CHECK(rule.above(few));
-    // 32 samples, se = 0.07 / sqrt(31) = 0.01257: over T, but under T sqrt(32 / 16) = 0.01414.
-    const PixelTally many = pixel(32, 0.57f, 0.43f);
-    CHECK(many.standard_error() == doctest::Approx(0.07 / std::sqrt(31.0)).epsilon(1e-5));
+    // 32 samples, se = 0.086 / sqrt(31) = 0.01545: under T (32 / 16)^(3/4) = 0.01682, though
+    // over T sqrt(32 / 16) = 0.01414 (the square-root rule would go on).
+    const PixelTally many = pixel(32, 0.586f, 0.414f);
+    CHECK(many.standard_error() == doctest::Approx(0.086 / std::sqrt(31.0)).epsilon(1e-5));
     CHECK_FALSE(rule.above(many));
+    // And just over it: se = 0.0943 / sqrt(31) = 0.01694.
+    CHECK(rule.above(pixel(32, 0.5943f, 0.4057f)));
     // 16 samples stop at T itself: half-spreads 1.05 T sqrt(15) and 0.95 T sqrt(15) give
     // se = 1.05 T (above) and 0.95 T (not).
     CHECK(rule.above(pixel(16, float(0.5 + 0.0105 * std::sqrt(15.0)), float(0.5 - 0.0105 * std::sqrt(15.0)))));
