@@ -12,7 +12,7 @@ namespace {
 
 TileTallies tallies_for(const Tile& tile) {
     const std::size_t n = std::size_t(tile.width()) * std::size_t(tile.height());
-    return {tile, std::vector<PixelTally>(n), std::vector<std::uint8_t>(n, 0)};
+    return {tile, std::vector<PixelTally>(n), std::vector<std::uint8_t>(n, 0), {}};
 }
 
 /// Runs round r on the pixels of `t` that take it; returns how many did. `counts` gets the
@@ -23,8 +23,17 @@ int refine(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, c
     static thread_local std::vector<std::uint32_t> pixels;
     static thread_local std::vector<float> colours;
     pixels.clear();
-    for (std::size_t p = 0; p < t.pixels.size(); ++p)
-        if (prepared.adaptive.takes_round(t.pixels[p], r, run, t.spread_near[p] != 0)) pixels.push_back(std::uint32_t(p));
+    const auto consider = [&](std::uint32_t p) {
+        if (prepared.adaptive.takes_round(t.pixels[p], r, run, t.spread_near[p] != 0)) pixels.push_back(p);
+    };
+    // From round 2 on only the pixels that took the last round may take this one: the scan
+    // skips the others' tallies (most of the image, 72 bytes each).
+    if (r >= 2) {
+        for (const std::uint32_t p : t.took_last) consider(p);
+    } else {
+        for (std::size_t p = 0; p < t.pixels.size(); ++p) consider(std::uint32_t(p));
+    }
+    t.took_last.assign(pixels.begin(), pixels.end());
     if (pixels.empty()) return 0;
     colours.resize(pixels.size() * std::size_t(run.count) * 3);
     prepared.render_samples(t.tile, run, pixels.data(), int(pixels.size()), colours.data(), counts, cancel);
@@ -69,18 +78,30 @@ void mark_above(const AdaptiveRule& rule, const std::vector<PixelTally>& tallies
     for (std::size_t i = 0; i < tallies.size(); ++i) above[i] = rule.above(tallies[i]);
 }
 
-/// spread_near of the pixels of `inner` (inside `outer`, whose round-0 `above` flags are
-/// `above`, row by row): its own error or one of its neighbours' (those inside `outer`) above.
+/// spread_near of the pixels of `inner` (inside `outer`, whose round-0 `above` flags, 0 or 1,
+/// are `above`, row by row): its own error or one of its neighbours' (those inside `outer`)
+/// above. The 3 x 3 window is taken in two passes: each row's flags with their left and right
+/// neighbours', then three such rows.
 void mark_spread(const Tile& outer, const std::uint8_t* above, const Tile& inner, std::vector<std::uint8_t>& spread_near) {
-    const std::size_t ow = std::size_t(outer.width());
-    for (int y = inner.y0; y < inner.y1; ++y)
+    const std::size_t ow = std::size_t(outer.width()), w = std::size_t(inner.width());
+    const int ya = std::max(outer.y0, inner.y0 - 1), yb = std::min(outer.y1, inner.y1 + 1);
+    static thread_local std::vector<std::uint8_t> rows;  // rows ya .. yb - 1, columns of inner
+    rows.resize(std::size_t(yb - ya) * w);
+    for (int y = ya; y < yb; ++y) {
+        const std::uint8_t* a = above + std::size_t(y - outer.y0) * ow;
+        std::uint8_t* h = &rows[std::size_t(y - ya) * w];
         for (int x = inner.x0; x < inner.x1; ++x) {
-            bool near = false;
-            for (int ny = std::max(outer.y0, y - 1); ny <= std::min(outer.y1 - 1, y + 1); ++ny)
-                for (int nx = std::max(outer.x0, x - 1); nx <= std::min(outer.x1 - 1, x + 1); ++nx)
-                    near |= above[std::size_t(ny - outer.y0) * ow + std::size_t(nx - outer.x0)] != 0;
-            spread_near[std::size_t(y - inner.y0) * std::size_t(inner.width()) + std::size_t(x - inner.x0)] = near;
+            const std::size_t i = std::size_t(x - outer.x0);
+            h[x - inner.x0] = std::uint8_t(a[i] | (x > outer.x0 ? a[i - 1] : 0) | (x + 1 < outer.x1 ? a[i + 1] : 0));
         }
+    }
+    for (int y = inner.y0; y < inner.y1; ++y) {
+        const std::uint8_t* mid = &rows[std::size_t(y - ya) * w];
+        const std::uint8_t* up = y > ya ? mid - w : mid;
+        const std::uint8_t* down = y + 1 < yb ? mid + w : mid;
+        std::uint8_t* out = &spread_near[std::size_t(y - inner.y0) * w];
+        for (std::size_t x = 0; x < w; ++x) out[x] = std::uint8_t(up[x] | mid[x] | down[x]);
+    }
 }
 
 void write_means(const TileTallies& t, float* rgb) {

@@ -16,6 +16,7 @@ struct TileTallies {
     Tile tile{};
     std::vector<PixelTally> pixels;
     std::vector<std::uint8_t> spread_near;
+    std::vector<std::uint32_t> took_last;  ///< the pixels that took the last round run on the tile
 };
 
 /// Every round on one tile, then its means into rgb (tile.width() x tile.height() x 3):
