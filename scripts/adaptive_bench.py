@@ -13,8 +13,10 @@ and each threshold of --thresholds, all with the streamrt command at -jJOBS, tim
 image_compare's (every channel clamped to [0, 1]); the estimate check compares the adaptive
 render's own estimated RMSE (the closing line's, luminance) with the measured RMSE of the
 luminance (unclamped). Prints one table per scene, the equal-error ratio (the fastest adaptive
-run whose RMSE is at most uniform 16 spp's, its time over uniform 16's) and writes
-BUILD/perf/adaptive.csv.
+run whose RMSE is at most uniform 16 spp's, its time over uniform 16's), the rays traced at
+equal error (every kind, from the closing lines; interpolated between the sweep's two runs
+around uniform 16 spp's RMSE, in log rays against log RMSE: rays and RMSE are deterministic,
+so this ratio does not move with the machine's load) and writes BUILD/perf/adaptive.csv.
 """
 import argparse
 import csv
@@ -31,6 +33,25 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import perf_common as pc  # noqa: E402
 
 ADAPTIVE_RE = re.compile(r"spp ([0-9.]+) adaptive \(at most (\d+), estimated error ([0-9.e+-]+)")
+RAYS_RE = re.compile(r"s, (\d+) rays")
+
+
+def rays_in(line):
+    m = RAYS_RE.search(line)
+    if not m:
+        sys.exit("no ray count in: " + line)
+    return int(m.group(1))
+
+
+def rays_at_error(rows, rmse):
+    """Rays of the adaptive runs interpolated to `rmse` (log-log between the two runs around it), or None."""
+    import math
+    pts = sorted((r["rmse"], r["rays"]) for r in rows if r["sampler"] == "adaptive")
+    for (e0, r0), (e1, r1) in zip(pts, pts[1:]):
+        if e0 <= rmse <= e1 and e1 > e0:
+            f = (math.log(rmse) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(r0) + f * (math.log(r1) - math.log(r0)))
+    return None
 
 
 def scene_size(path):
@@ -106,8 +127,8 @@ def main(argv=None):
         ref = pc.np.asarray(vals, pc.np.float64).reshape(h, w, 3)
         scene_rows = []
         for spp in (4, 8, 16, 32):
-            secs, img, _ = run(exe, path, args, size, ["--spp", str(spp)])
-            scene_rows.append(dict(scene=base, sampler="uniform", threshold="", spp=spp, seconds=secs,
+            secs, img, line = run(exe, path, args, size, ["--spp", str(spp)])
+            scene_rows.append(dict(scene=base, sampler="uniform", threshold="", spp=spp, rays=rays_in(line), seconds=secs,
                                    rmse=pc.array_error(img, ref)["rmse"], estimated="", measured_luminance=""))
         for t in args.thresholds.split(","):
             secs, img, line = run(exe, path, args, size, ["--spp", str(args.cap), "--adaptive", t])
@@ -116,18 +137,19 @@ def main(argv=None):
                 sys.exit("no adaptive summary in: " + line)
             lum = float(pc.np.sqrt(((luminance(img) - luminance(ref)) ** 2).mean()))
             scene_rows.append(dict(scene=base, sampler="adaptive", threshold=float(t), spp=float(m.group(1)),
-                                   seconds=secs, rmse=pc.array_error(img, ref)["rmse"],
+                                   rays=rays_in(line), seconds=secs, rmse=pc.array_error(img, ref)["rmse"],
                                    estimated=float(m.group(3)), measured_luminance=lum))
         print("\n%s, %dx%d, -j%d, whole process, median of %d (reference: recursive, %d spp)" % (
             base, size[0], size[1], args.jobs, args.runs, args.ref_spp))
-        print("| sampling | spp | seconds | RMSE | estimated / measured (luminance) |")
-        print("|---|---|---|---|---|")
+        print("| sampling | spp | rays | seconds | RMSE | estimated / measured (luminance) |")
+        print("|---|---|---|---|---|---|")
         for r in scene_rows:
             how = "uniform" if r["sampler"] == "uniform" else "adaptive T=%g" % r["threshold"]
             ratio = "" if r["sampler"] == "uniform" else "%.4f / %.4f (%.2f)" % (
                 r["estimated"], r["measured_luminance"], r["estimated"] / max(r["measured_luminance"], 1e-12))
-            print("| %s | %s | %.3f | %.5f | %s |" % (how, r["spp"] if r["sampler"] == "uniform" else "%.2f" % r["spp"],
-                                                    r["seconds"], r["rmse"], ratio))
+            print("| %s | %s | %.2f M | %.3f | %.5f | %s |" % (
+                how, r["spp"] if r["sampler"] == "uniform" else "%.2f" % r["spp"], r["rays"] / 1e6, r["seconds"], r["rmse"],
+                ratio))
         u16 = next(r for r in scene_rows if r["sampler"] == "uniform" and r["spp"] == 16)
         ok = [r for r in scene_rows if r["sampler"] == "adaptive" and r["rmse"] <= u16["rmse"]]
         if ok:
@@ -136,6 +158,10 @@ def main(argv=None):
                 u16["rmse"], u16["seconds"], best["threshold"], best["seconds"], best["seconds"] / u16["seconds"]))
         else:
             print("equal error: no adaptive run of the sweep reaches uniform 16 spp's RMSE %.5f" % u16["rmse"])
+        rays = rays_at_error(scene_rows, u16["rmse"])
+        if rays is not None:
+            print("rays at equal error (interpolated): %.2f M, %.3f of uniform 16's %.2f M" % (
+                rays / 1e6, rays / u16["rays"], u16["rays"] / 1e6))
         rows += scene_rows
     csv_path = os.path.join(out_dir, "adaptive.csv")
     with open(csv_path, "w", newline="") as f:
