@@ -51,14 +51,6 @@ inline auto slab_test(const B& lox, const B& loy, const B& loz, const B& hix, co
     return tn <= tf;
 }
 
-template <class B>
-inline float horizontal_max(const B& v) {
-    alignas(64) float a[B::size];
-    v.store_aligned(a);
-    float m = a[0];
-    for (std::size_t l = 1; l < B::size; ++l) m = std::max(m, a[l]);
-    return m;
-}
 
 /// Pushes the hit children of a node farthest first (so the nearest is popped first).
 inline void push_sorted(StackEntry* stack, int& sp, StackEntry* hits, int nh) {
@@ -193,7 +185,7 @@ void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object
         B best = B::load_aligned(rays.t_max + i);
         const B start = best;
         B best_id(-1.f);
-        float best_max = horizontal_max(best);
+        float best_max = lanes_max(best);
         if (!(best_max > 0.f)) continue;
         int sp = 0;
         stack[sp++] = {0, 0, 0.f};
@@ -216,7 +208,7 @@ void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object
                         best_id = xsimd::select(closer, B(float(ob.xf.id)), best_id);
                     });
                 }
-                best_max = horizontal_max(best);
+                best_max = lanes_max(best);
                 continue;
             }
             const accel::WideNode& n = bvh.nodes[e.child];
@@ -227,7 +219,7 @@ void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object
                 const auto hit = slab_test(B(n.lo_x[j]), B(n.lo_y[j]), B(n.lo_z[j]), B(n.hi_x[j]), B(n.hi_y[j]),
                                            B(n.hi_z[j]), o, inv, best, tn);
                 if (!xsimd::any(hit)) continue;
-                const float t_min = -horizontal_max(xsimd::select(hit, -tn, B(-kInfF)));
+                const float t_min = lanes_min_where(tn, hit);
                 hits[nh++] = {n.child[j], n.count[j], t_min};
             }
             push_sorted(stack, sp, hits, nh);

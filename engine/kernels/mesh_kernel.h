@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "kernels/lane_extremes.h"
 #include "kernels/mesh_single_kernel.h"
 #include "mesh/mesh_view.h"
 #include "shapes/triangle_math.h"
@@ -70,23 +71,6 @@ template <class B>
 inline Vec3T<B> vertex(const MeshView& m, std::uint32_t k, int j) {
     const float* p = m.tri + 9 * std::size_t(k) + 3 * j;
     return {B(p[0]), B(p[1]), B(p[2])};
-}
-
-template <class B>
-inline float lanes_max(const B& v) {
-    alignas(64) float a[B::size];
-    v.store_aligned(a);
-    float r = a[0];
-    for (std::size_t l = 1; l < B::size; ++l) r = r > a[l] ? r : a[l];
-    return r;
-}
-template <class B>
-inline float lanes_min_where(const B& v, const decltype(B(0.f) < B(0.f))& m) {
-    alignas(64) float a[B::size];
-    xsimd::select(m, v, B(std::numeric_limits<float>::infinity())).store_aligned(a);
-    float r = a[0];
-    for (std::size_t l = 1; l < B::size; ++l) r = r < a[l] ? r : a[l];
-    return r;
 }
 
 /// The lanes of `lanes` whose ray meets one of node n's child boxes within (0, t_max). A
