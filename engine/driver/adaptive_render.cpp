@@ -10,39 +10,54 @@ namespace streamrt {
 
 namespace {
 
-TileTallies tallies_for(const Tile& tile) {
+/// A tally for every pixel of `tile` (no corner round, or a tile rendered alone).
+TileTallies dense_tallies(const Tile& tile) {
     const std::size_t n = std::size_t(tile.width()) * std::size_t(tile.height());
-    return {tile, std::vector<PixelTally>(n), std::vector<std::uint8_t>(n, 0), {}};
+    TileTallies t{tile, std::vector<PixelTally>(n), std::vector<std::uint32_t>(n), std::vector<std::uint8_t>(n, 0), {}};
+    std::iota(t.pixel.begin(), t.pixel.end(), 0u);
+    return t;
 }
 
-/// Runs round r on the pixels of `t` that take it; returns how many did. `counts` gets the
+/// The tally of a pixel's corner round: its four corners at `c`, `c` + 1, `c` + `row` and
+/// `c` + `row` + 1 of a corner rectangle's colours (3 floats each), in a fixed order (top left,
+/// top right, bottom left, bottom right).
+PixelTally corner_tally(const float* rgb, std::size_t row, std::size_t c) {
+    PixelTally p;
+    for (const std::size_t k : {c, c + 1, c + row, c + row + 1}) p.add_corner(rgb[k * 3], rgb[k * 3 + 1], rgb[k * 3 + 2]);
+    return p;
+}
+
+/// Runs round r on the tallies of `t` that take it; returns how many did. `counts` gets the
 /// rays traced.
 int refine(PreparedRender& prepared, int r, TileTallies& t, RayCounts& counts, const RenderProgress* cancel) {
     const SampleRun run = adaptive_round(r, prepared.adaptive.cap);
-    // Per-thread scratch: the pixels taking the round and their samples' colours.
-    static thread_local std::vector<std::uint32_t> pixels;
+    // Per-thread scratch: the tallies taking the round, their pixels and their samples' colours.
+    static thread_local std::vector<std::uint32_t> chosen, pixels;
     static thread_local std::vector<float> colours;
+    chosen.clear();
     pixels.clear();
-    const auto consider = [&](std::uint32_t p) {
-        if (prepared.adaptive.takes_round(t.pixels[p], r, run, t.spread_near[p] != 0)) pixels.push_back(p);
+    const auto consider = [&](std::uint32_t i) {
+        if (prepared.adaptive.takes_round(t.tallies[i], r, run, t.spread_near[i] != 0)) {
+            chosen.push_back(i);
+            pixels.push_back(t.pixel[i]);
+        }
     };
-    // From round 2 on only the pixels that took the last round may take this one: the scan
-    // skips the others' tallies (most of the image, 72 bytes each).
+    // From round 2 on only the tallies that took the last round may take this one.
     if (r >= 2) {
-        for (const std::uint32_t p : t.took_last) consider(p);
+        for (const std::uint32_t i : t.took_last) consider(i);
     } else {
-        for (std::size_t p = 0; p < t.pixels.size(); ++p) consider(std::uint32_t(p));
+        for (std::size_t i = 0; i < t.tallies.size(); ++i) consider(std::uint32_t(i));
     }
-    t.took_last.assign(pixels.begin(), pixels.end());
+    t.took_last.assign(chosen.begin(), chosen.end());
     if (pixels.empty()) return 0;
     colours.resize(pixels.size() * std::size_t(run.count) * 3);
     prepared.render_samples(t.tile, run, pixels.data(), int(pixels.size()), colours.data(), counts, cancel);
     if (cancel && cancel->cancelled()) return 0;
     // The samples go into each tally in their order: the same sums whatever else was traced.
     const float* c = colours.data();
-    for (const std::uint32_t p : pixels) {
-        t.pixels[p].begin_round();
-        for (int j = 0; j < run.count; ++j, c += 3) t.pixels[p].add(c[0], c[1], c[2]);
+    for (const std::uint32_t i : chosen) {
+        t.tallies[i].begin_round();
+        for (int j = 0; j < run.count; ++j, c += 3) t.tallies[i].add(c[0], c[1], c[2]);
     }
     return int(pixels.size());
 }
@@ -60,17 +75,14 @@ void trace_corners(PreparedRender& prepared, const Tile& corners, float* out, Ra
     prepared.render_samples(corners, corner_run(), all.data(), int(n), out, counts, cancel);
 }
 
-/// Round 0 from traced corners: each pixel of t.tile takes its four corners, in a fixed order
-/// (top left, top right, bottom left, bottom right), from `rgb`, the corners of the rectangle
-/// `corners` of the corner lattice (3 floats each, row by row).
+/// Round 0 from traced corners into dense tallies (dense_tallies): each pixel of t.tile takes
+/// its four corners from `rgb`, the corners of the rectangle `corners` of the corner lattice.
 void tally_corners(const float* rgb, const Tile& corners, TileTallies& t) {
     const std::size_t row = std::size_t(corners.width());
     for (int y = t.tile.y0; y < t.tile.y1; ++y)
-        for (int x = t.tile.x0; x < t.tile.x1; ++x) {
-            PixelTally& p = t.pixels[std::size_t(y - t.tile.y0) * std::size_t(t.tile.width()) + std::size_t(x - t.tile.x0)];
-            const std::size_t c = std::size_t(y - corners.y0) * row + std::size_t(x - corners.x0);
-            for (const std::size_t k : {c, c + 1, c + row, c + row + 1}) p.add_corner(rgb[k * 3], rgb[k * 3 + 1], rgb[k * 3 + 2]);
-        }
+        for (int x = t.tile.x0; x < t.tile.x1; ++x)
+            t.tallies[std::size_t(y - t.tile.y0) * std::size_t(t.tile.width()) + std::size_t(x - t.tile.x0)] =
+                corner_tally(rgb, row, std::size_t(y - corners.y0) * row + std::size_t(x - corners.x0));
 }
 
 /// Whether each tally's error is above its stopping point (AdaptiveRule::above), in order.
@@ -104,11 +116,30 @@ void mark_spread(const Tile& outer, const std::uint8_t* above, const Tile& inner
     }
 }
 
+/// The means of dense tallies (dense_tallies) into rgb, row by row.
 void write_means(const TileTallies& t, float* rgb) {
-    for (std::size_t p = 0; p < t.pixels.size(); ++p) {
-        const ColorT<double> m = t.pixels[p].mean();
+    for (std::size_t p = 0; p < t.tallies.size(); ++p) {
+        const ColorT<double> m = t.tallies[p].mean();
         rgb[p * 3 + 0] = float(m.x), rgb[p * 3 + 1] = float(m.y), rgb[p * 3 + 2] = float(m.z);
     }
+}
+
+/// Calls f(x, y, tally) for every pixel of t.tile in row order: its own tally when it has
+/// one, otherwise (a pixel that stopped at its corners) the tally of its corners from the
+/// whole image's corner lattice `corner_rgb` ((w + 1) x (h + 1) colours).
+template <class F>
+void for_each_pixel(const TileTallies& t, const float* corner_rgb, int w, F&& f) {
+    const std::size_t row = std::size_t(w) + 1;
+    std::size_t k = 0;  // the next tally: t.pixel is ascending
+    std::uint32_t p = 0;
+    for (int y = t.tile.y0; y < t.tile.y1; ++y)
+        for (int x = t.tile.x0; x < t.tile.x1; ++x, ++p) {
+            if (k < t.pixel.size() && t.pixel[k] == p) {
+                f(x, y, t.tallies[k++]);
+            } else {
+                f(x, y, corner_tally(corner_rgb, row, std::size_t(y) * row + std::size_t(x)));
+            }
+        }
 }
 
 }  // namespace
@@ -119,7 +150,7 @@ void render_adaptive_tile(PreparedRender& prepared, const Tile& tile, float* rgb
     // samples are the ones their own tiles take, so the rule sees what a whole-image render sees.
     const Tile ring{std::max(0, tile.x0 - 1), std::max(0, tile.y0 - 1), std::min(prepared.width, tile.x1 + 1),
                     std::min(prepared.height, tile.y1 + 1)};
-    TileTallies outer = tallies_for(ring);
+    TileTallies outer = dense_tallies(ring);
     if (prepared.adaptive.corner_round()) {
         // The ring's corners: the same corner samples the neighbouring tiles trace.
         const Tile corners{ring.x0, ring.y0, ring.x1 + 1, ring.y1 + 1};
@@ -129,12 +160,12 @@ void render_adaptive_tile(PreparedRender& prepared, const Tile& tile, float* rgb
     } else {
         refine(prepared, 0, outer, counts, cancel);
     }
-    TileTallies t = tallies_for(tile);
+    TileTallies t = dense_tallies(tile);
     for (int y = tile.y0; y < tile.y1; ++y)
-        std::copy_n(&outer.pixels[std::size_t(y - ring.y0) * std::size_t(ring.width()) + std::size_t(tile.x0 - ring.x0)],
-                    tile.width(), &t.pixels[std::size_t(y - tile.y0) * std::size_t(tile.width())]);
-    std::vector<std::uint8_t> above(outer.pixels.size());
-    mark_above(prepared.adaptive, outer.pixels, above.data());
+        std::copy_n(&outer.tallies[std::size_t(y - ring.y0) * std::size_t(ring.width()) + std::size_t(tile.x0 - ring.x0)],
+                    tile.width(), &t.tallies[std::size_t(y - tile.y0) * std::size_t(tile.width())]);
+    std::vector<std::uint8_t> above(outer.tallies.size());
+    mark_above(prepared.adaptive, outer.tallies, above.data());
     mark_spread(ring, above.data(), tile, t.spread_near);
     for (int r = 1; refine(prepared, r, t, counts, cancel) > 0; ++r) {
     }
@@ -150,10 +181,22 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     };
     const int w = prepared.width, h = prepared.height;
     const int nx = (w + kTileSize - 1) / kTileSize, ny = (h + kTileSize - 1) / kTileSize;
-    // 72 bytes a pixel, first touched by the threads that use them (22 MB at 640x480: zeroing
-    // them on one thread took a fifth of a corners-only render).
+    // The corner lattice of a corner round 0, (w + 1) x (h + 1) corners, each traced once: a
+    // tile traces the corners at its pixels' top left, and those of the image's last column
+    // and row when it borders them.
+    const bool corners_first = prepared.adaptive.corner_round();
+    std::vector<float> corner_rgb(corners_first ? std::size_t(w + 1) * std::size_t(h + 1) * 3 : 0);
+    // With a corner round, a pixel gets a tally (72 bytes) only when it takes round 1: most
+    // pixels stop at their corners, and their tallies are made from corner_rgb when read
+    // (whitted.cfg at 640x480: allocating and zeroing a tally for every pixel was a twelfth
+    // of the render at -j2). Without one, every pixel has a tally from round 0, first touched
+    // by the thread that uses it.
     std::vector<TileTallies> tiles(std::size_t(nx) * std::size_t(ny));
-    par.for_each_index(tiles.size(), 1, [&](std::size_t i) { tiles[i] = tallies_for(tile_rect(w, h, int(i))); });
+    par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
+        const Tile tile = tile_rect(w, h, int(i));
+        if (corners_first) tiles[i].tile = tile;
+        else tiles[i] = dense_tallies(tile);
+    });
 
     // Tiles in an interleaved order (a stride near n / golden ratio, prime to n): the work of
     // later rounds sits in a few regions (edges, penumbrae), and a loop that hands out halves
@@ -168,18 +211,11 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
         for (std::size_t k = 0; k < n; ++k) order[k] = int((k * stride) % n);
     }
 
-    // The corner lattice of a corner round 0, (w + 1) x (h + 1) corners, each traced once: a
-    // tile traces the corners at its pixels' top left, and those of the image's last column
-    // and row when it borders them.
-    const bool corners_first = prepared.adaptive.corner_round();
-    const Tile lattice{0, 0, w + 1, h + 1};
-    std::vector<float> corner_rgb(corners_first ? std::size_t(w + 1) * std::size_t(h + 1) * 3 : 0);
-
     AdaptiveSummary summary;
     const auto estimated_rmse = [&] {  // in a fixed order: the same figure for every -j
         double sum = 0;
         for (const TileTallies& t : tiles)
-            for (const PixelTally& p : t.pixels) sum += p.image_error_squared();
+            for_each_pixel(t, corner_rgb.data(), w, [&](int, int, const PixelTally& p) { sum += p.image_error_squared(); });
         return std::sqrt(sum / (double(w) * double(h)));
     };
     for (int r = 0;; ++r) {
@@ -197,7 +233,6 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                                 &corner_rgb[(std::size_t(y) * std::size_t(w + 1) + std::size_t(own.x0)) * 3]);
                 if (progress) progress->add(counts);
             });
-            par.for_each_index(tiles.size(), 1, [&](std::size_t i) { tally_corners(corner_rgb.data(), lattice, tiles[i]); });
             summary.rounds = 1;
             if (progress && progress->cancelled()) break;
             if (out_of_time()) {
@@ -212,15 +247,29 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
             // image of bytes, then each tile's pixels look at their eight neighbours there.
             std::vector<std::uint8_t> above_image(std::size_t(w) * std::size_t(h));
             par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
-                const TileTallies& t = tiles[i];
-                std::uint8_t flags[kTileSize * kTileSize];
-                mark_above(prepared.adaptive, t.pixels, flags);
-                for (int y = t.tile.y0; y < t.tile.y1; ++y)
-                    std::copy_n(&flags[std::size_t(y - t.tile.y0) * std::size_t(t.tile.width())], t.tile.width(),
-                                &above_image[std::size_t(y) * std::size_t(w) + std::size_t(t.tile.x0)]);
+                for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int x, int y, const PixelTally& p) {
+                    above_image[std::size_t(y) * std::size_t(w) + std::size_t(x)] = prepared.adaptive.above(p);
+                });
             });
             par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
-                mark_spread({0, 0, w, h}, above_image.data(), tiles[i].tile, tiles[i].spread_near);
+                TileTallies& t = tiles[i];
+                if (!corners_first) {
+                    mark_spread({0, 0, w, h}, above_image.data(), t.tile, t.spread_near);
+                    return;
+                }
+                // The pixels that take round 1 get their tallies, from their corners.
+                static thread_local std::vector<std::uint8_t> near;
+                near.resize(std::size_t(t.tile.width()) * std::size_t(t.tile.height()));
+                mark_spread({0, 0, w, h}, above_image.data(), t.tile, near);
+                const std::size_t row = std::size_t(w) + 1;
+                std::uint32_t p = 0;
+                for (int y = t.tile.y0; y < t.tile.y1; ++y)
+                    for (int x = t.tile.x0; x < t.tile.x1; ++x, ++p)
+                        if (near[p]) {
+                            t.tallies.push_back(corner_tally(corner_rgb.data(), row, std::size_t(y) * row + std::size_t(x)));
+                            t.pixel.push_back(p);
+                            t.spread_near.push_back(1);
+                        }
             });
         }
         std::atomic<int> refined{0};
@@ -259,21 +308,17 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     Framebuffer map = Framebuffer::uninitialized(w, h);
     std::vector<double> tile_samples(tiles.size());  // summed in tile order after: the same for any -j
     par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
-        const TileTallies& t = tiles[i];
-        float rgb[kTileSize * kTileSize * 3];
-        write_means(t, rgb);
         double n = 0;
-        for (int y = t.tile.y0; y < t.tile.y1; ++y)
-            for (int x = t.tile.x0; x < t.tile.x1; ++x) {
-                const std::size_t p = std::size_t(y - t.tile.y0) * std::size_t(t.tile.width()) + std::size_t(x - t.tile.x0);
-                std::copy_n(&rgb[p * 3], 3, image.pixel(x, y));
-                const PixelTally& tally = t.pixels[p];
-                float* m = map.pixel(x, y);
-                m[0] = float(tally.n);
-                m[1] = float(tally.standard_error());
-                m[2] = 0.f;
-                n += tally.n;
-            }
+        for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int x, int y, const PixelTally& tally) {
+            const ColorT<double> mean = tally.mean();
+            float* px = image.pixel(x, y);
+            px[0] = float(mean.x), px[1] = float(mean.y), px[2] = float(mean.z);
+            float* m = map.pixel(x, y);
+            m[0] = float(tally.n);
+            m[1] = float(tally.standard_error());
+            m[2] = 0.f;
+            n += tally.n;
+        });
         tile_samples[i] = n;
     });
     double samples = 0;  // camera rays: a corner is traced once for the four pixels it bounds

@@ -9,14 +9,17 @@
 
 namespace streamrt {
 
-/// The tallies of a rectangle's pixels, row by row, and (after round 0) whether each has an
-/// error above its stopping point (AdaptiveRule::above) in itself or a neighbour
-/// (AdaptiveRule::takes_round's spread_near).
+/// The tallies of the pixels of a rectangle that take samples after the corner round (every
+/// pixel without one), in row order: most pixels of a picture stop at their corners, and
+/// their values are read from the corners themselves (72 bytes a pixel only where needed).
 struct TileTallies {
     Tile tile{};
-    std::vector<PixelTally> pixels;
+    std::vector<PixelTally> tallies;
+    std::vector<std::uint32_t> pixel;  ///< each tally's pixel in the rectangle (row by row), ascending
+    /// Each tally's AdaptiveRule::takes_round spread_near: its error after round 0, or one of
+    /// its neighbours', above its stopping point.
     std::vector<std::uint8_t> spread_near;
-    std::vector<std::uint32_t> took_last;  ///< the pixels that took the last round run on the tile
+    std::vector<std::uint32_t> took_last;  ///< the tallies that took the last round run on the tile
 };
 
 /// Every round on one tile, then its means into rgb (tile.width() x tile.height() x 3):

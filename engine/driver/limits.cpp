@@ -52,9 +52,12 @@ MemoryEstimate estimate_render_memory(const Scene& scene, const RenderSettings& 
         e.per_thread_bytes = (double(s.depth) + 2) * kRecursiveFrameBytes;
     }
     if (s.adaptive > 0) {
-        // Per pixel: its tally, its neighbour flag, its above-T flag (the neighbour rule's
-        // image, driver/adaptive_render.cpp) and its sample-map pixel.
-        e.adaptive_bytes = pixels * (sizeof(PixelTally) + 2 * sizeof(std::uint8_t) + 3 * sizeof(float));
+        // Per pixel, at most (a pixel that stops at its corners has no tally): its tally, its
+        // place in the tile and in the last round's list (two 32-bit indices), its neighbour
+        // flag, its above-T flag (the neighbour rule's image, driver/adaptive_render.cpp) and
+        // its sample-map pixel.
+        e.adaptive_bytes =
+            pixels * (sizeof(PixelTally) + 2 * sizeof(std::uint32_t) + 2 * sizeof(std::uint8_t) + 3 * sizeof(float));
         // The first round's corners, (width + 1) x (height + 1) colours (render/adaptive.h).
         if (AdaptiveRule{s.adaptive, s.spp}.corner_round())
             e.adaptive_bytes += (double(s.width) + 1) * (double(s.height) + 1) * 3 * sizeof(float);
