@@ -50,7 +50,7 @@ def main(argv=None):
     ap.add_argument("--ref-light-samples", type=int, help="area-light scenes: reference light samples (default 64, quick 16)")
     ap.add_argument("-j", "--jobs", type=int, default=2)
     ap.add_argument("--runs", type=int, default=1, help="timed renders per point (median)")
-    ap.add_argument("--thresholds", default="0.04,0.02,0.01,0.005,0.0025",
+    ap.add_argument("--thresholds", default="0.08,0.04,0.02,0.01,0.005",
                     help="adaptive sampling's thresholds T (comma-separated; empty: no adaptive curve)")
     ap.add_argument("--img", default=os.path.join(pc.ROOT, "docs", "img"), help="where the plots go")
     args = ap.parse_args(argv)
