@@ -212,11 +212,21 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     }
 
     AdaptiveSummary summary;
-    const auto estimated_rmse = [&] {  // in a fixed order: the same figure for every -j
+    // The image's estimated RMSE from each tile's sum of its pixels' shares: the tiles' sums
+    // are taken in parallel and added in tile order, the same figure for every -j.
+    std::vector<double> tile_error(tiles.size());
+    const auto rmse_of_tiles = [&] {
         double sum = 0;
-        for (const TileTallies& t : tiles)
-            for_each_pixel(t, corner_rgb.data(), w, [&](int, int, const PixelTally& p) { sum += p.image_error_squared(); });
+        for (const double e : tile_error) sum += e;
         return std::sqrt(sum / (double(w) * double(h)));
+    };
+    const auto estimated_rmse = [&] {
+        par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
+            double sum = 0;
+            for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int, int, const PixelTally& p) { sum += p.image_error_squared(); });
+            tile_error[i] = sum;
+        });
+        return rmse_of_tiles();
     };
     for (int r = 0;; ++r) {
         if (r == 0 && corners_first) {
@@ -308,7 +318,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     Framebuffer map = Framebuffer::uninitialized(w, h);
     std::vector<double> tile_samples(tiles.size());  // summed in tile order after: the same for any -j
     par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
-        double n = 0;
+        double n = 0, error = 0;
         for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int x, int y, const PixelTally& tally) {
             const ColorT<double> mean = tally.mean();
             float* px = image.pixel(x, y);
@@ -318,14 +328,16 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
             m[1] = float(tally.standard_error());
             m[2] = 0.f;
             n += tally.n;
+            error += tally.image_error_squared();
         });
         tile_samples[i] = n;
+        tile_error[i] = error;
     });
     double samples = 0;  // camera rays: a corner is traced once for the four pixels it bounds
     if (corners_first) samples = double(w + 1) * double(h + 1) - double(kFirstRoundSamples) * double(w) * double(h);
     for (const double n : tile_samples) samples += n;
     summary.mean_spp = samples / (double(w) * double(h));
-    summary.estimated_rmse = estimated_rmse();
+    summary.estimated_rmse = rmse_of_tiles();
     prepared.last_adaptive = summary;
     prepared.sample_map = std::move(map);
     return image;
