@@ -51,7 +51,6 @@ inline auto slab_test(const B& lox, const B& loy, const B& loz, const B& hix, co
     return tn <= tf;
 }
 
-
 /// Pushes the hit children of a node farthest first (so the nearest is popped first).
 inline void push_sorted(StackEntry* stack, int& sp, StackEntry* hits, int nh) {
     for (int a = 1; a < nh; ++a) {

@@ -77,12 +77,12 @@ struct PixelTally {
         corner_y += add_luminance(luminance(sr, sg, sb));
         ++corners;
     }
-    /// The weight of the pixel's samples in its mean.
-    double weight() const { return (n - corners) + kCornerWeight * corners; }
+    /// The weight in the pixel's mean of its first `count` samples (the corners come first).
+    double weight(int count) const { return (count - corners) + kCornerWeight * corners; }
     /// The pixel's value: the weighted mean of its samples.
     ColorT<double> mean() const {
         if (n == 0) return {0, 0, 0};
-        const double w = weight();
+        const double w = weight(n);
         return {r / w, g / w, b / w};
     }
     /// n (n - 1) s^2 with s^2 the unbiased sample variance of the luminance (n sum_yy - sum_y^2).
@@ -108,7 +108,7 @@ struct PixelTally {
         if (n_before >= 2 && n == 2 * n_before) {
             const double m = n - n_before;
             // Before the round: its own samples and its corners (all of the round's are its own).
-            const double w = (n_before - corners) + kCornerWeight * corners;
+            const double w = weight(n_before);
             const double a = (sum_y_before - corner_y + kCornerWeight * corner_y) / w;
             const double d = (sum_y - sum_y_before) / m - a;
             return d * d * w * m / ((w + m) * (w + m));
