@@ -237,3 +237,37 @@ TEST_CASE("mesh walks: the hybrid hands packets over both ways (coherent packets
     check_against_oracle(mesh, coherent);
     check_against_oracle(mesh, sparse);
 }
+
+TEST_CASE("mesh walks: packets of one direction octant keep every lane's hit through the bundle test") {
+    // Every packet's live directions share their signs, so the packet walks first cull a
+    // node's children with the bundle's interval bounds (mesh_kernel.h, PacketFrustum). The
+    // rays start anywhere around the soup and aim at random triangles' interiors: the bundle is
+    // wide, and a bound on the wrong side (origin or inverse direction) drops lanes' hits.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.5f, 1.5f), w(0.05f, 0.9f);
+    const MeshData sd = soup(300, rng);
+    const auto mesh = Mesh::build("soup", sd.positions, sd.triangles);
+    std::vector<std::vector<std::pair<Vec3f, Vec3f>>> by_octant(8);
+    while (true) {
+        const Vec3f o{u(rng), u(rng), u(rng)};
+        const float* p = &mesh->tri[9 * (std::size_t(rng()) % mesh->triangle_count())];
+        const float a = w(rng), b = (1.f - a) * w(rng);
+        const Vec3f q{p[0] + a * (p[3] - p[0]) + b * (p[6] - p[0]), p[1] + a * (p[4] - p[1]) + b * (p[7] - p[1]),
+                      p[2] + a * (p[5] - p[2]) + b * (p[8] - p[2])};
+        const Vec3f d = q - o;
+        // An origin almost on a triangle: t's float error there is beyond the check's 1e-4.
+        if (oracle(*mesh, o, d, 1e30).t < 0.01) continue;
+        const int octant = (d.x < 0) | (d.y < 0) << 1 | (d.z < 0) << 2;
+        by_octant[std::size_t(octant)].push_back({o, d});
+        bool full = true;
+        for (const auto& v : by_octant) full = full && v.size() >= 256;
+        if (full) break;
+    }
+    Case c;
+    for (const auto& v : by_octant)
+        for (std::size_t i = 0; i < 256; ++i) {  // 256: whole packets of every width
+            c.o.push_back(v[i].first), c.d.push_back(v[i].second);
+            c.t_max.push_back(i % 3 ? 1e30f : 0.5f);  // a third end halfway to their target
+        }
+    check_against_oracle(mesh, c);
+}
