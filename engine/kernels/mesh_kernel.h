@@ -103,9 +103,14 @@ struct PacketFrustum {
     int near[3], far[3];  ///< plane offsets in the node (as SingleRay's), -1: the axis gives no bound
     float o_near[3], o_far[3], inv_lo[3], inv_hi[3];
 
+    /// walk false: the packet goes to the single-ray walk whole, so no bound is computed.
     template <class M>
-    PacketFrustum(const Vec3T<B>& o, const Vec3T<B>& inv, const M& live) {
+    PacketFrustum(const Vec3T<B>& o, const Vec3T<B>& inv, const M& live, bool walk = true) {
         constexpr float inf = std::numeric_limits<float>::infinity();
+        if (!walk) {
+            near[0] = near[1] = near[2] = far[0] = far[1] = far[2] = -1;
+            return;
+        }
         const B oc[3] = {o.x, o.y, o.z}, ic[3] = {inv.x, inv.y, inv.z};
         bool negative[3];
         for (int a = 0; a < 3; ++a) {
@@ -245,10 +250,10 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
         bv = B::load_aligned(v_l);
         bprim = I::load_aligned(p_l);
     };
-    const PacketFrustum<B> frustum(o, inv, best > B(0.f));
     PacketEntry stack[kStack];
     int sp = 0;
     std::uint32_t live = movemask_bits(best > B(0.f));
+    const PacketFrustum<B> frustum(o, inv, best > B(0.f), std::uint32_t(std::popcount(live)) > single_lanes);
     if (std::uint32_t(std::popcount(live)) <= single_lanes) {
         live = lanes_meeting_children(m.nodes[0], o, inv, best, live);
         if (live == 0) return;
@@ -354,9 +359,8 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
         }
         if (e.count > 0) {
             for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
-                const TriangleHit<B> h = triangle_hit(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2),
-                                                      B(0.f), t_max);
-                const auto now = open && (h.t < t_max);
+                const auto now =
+                    open && triangle_blocks(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2), t_max);
                 blocked = blocked || now;
                 open = open && !now;
             }

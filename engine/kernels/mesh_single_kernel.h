@@ -211,10 +211,10 @@ inline bool single_leaf_any(const MeshView& m, const SingleRay<NodeArch, LeafArc
                             std::uint32_t count, float t_max) {
     using LB = typename SingleRay<NodeArch, LeafArch>::LB;
     const TriangleBlock* b = m.blocks + m.block_of[first];
-    for (std::uint32_t k = 0; k < count; k += kBlockTriangles, ++b) {
-        const TriangleHit<LB> h = block_hit(*b, r, t_max);
-        if (xsimd::any(h.t < LB(t_max))) return true;
-    }
+    for (std::uint32_t k = 0; k < count; k += kBlockTriangles, ++b)
+        if (xsimd::any(triangle_blocks_permuted(r.wr, block_corner(*b, 0, r), block_corner(*b, 1, r),
+                                                block_corner(*b, 2, r), LB(t_max))))
+            return true;
     return false;
 }
 

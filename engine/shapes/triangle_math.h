@@ -107,6 +107,29 @@ inline WatertightRay<V> watertight_ray(const Vec3T<V>& o, const Vec3T<V>& d) {
     return r;
 }
 
+namespace tri_detail {
+/// The edge functions of the sheared triangle, its determinant and scaled distance (t = T / det).
+template <class V>
+struct Sheared {
+    V U, Vv, W, det, T;
+    decltype(V(0) < V(0)) inside;  ///< the ray passes through the triangle or its border
+};
+template <class V>
+[[gnu::always_inline]] inline Sheared<V> shear(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b, const Vec3T<V>& c) {
+    const V ax = a.x - r.sx * a.z, ay = a.y - r.sy * a.z;
+    const V bx = b.x - r.sx * b.z, by = b.y - r.sy * b.z;
+    const V cx = c.x - r.sx * c.z, cy = c.y - r.sy * c.z;
+    V U = cx * by - cy * bx;
+    V Vv = ax * cy - ay * cx;
+    V W = bx * ay - by * ax;
+    edge_fallback(U, Vv, W, ax, ay, bx, by, cx, cy);
+    const auto outside = ((U < V(0)) || (Vv < V(0)) || (W < V(0))) && ((U > V(0)) || (Vv > V(0)) || (W > V(0)));
+    const V det = U + Vv + W;
+    const V T = U * (r.sz * a.z) + Vv * (r.sz * b.z) + W * (r.sz * c.z);
+    return {U, Vv, W, det, T, !outside};
+}
+}  // namespace tri_detail
+
 /// The test proper, on the corners relative to the ray's origin and already permuted
 /// (x: axis kx, y: ky, z: kz). triangle_hit() permutes with per-lane selects (a packet's rays
 /// may differ in kz); the single-ray walk, whose one ray fixes the axes, loads the permuted
@@ -116,21 +139,27 @@ template <class V>
 inline TriangleHit<V> triangle_hit_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
                                             const Vec3T<V>& c, V t_min, V t_max) {
     using namespace simd;
-    const V ax = a.x - r.sx * a.z, ay = a.y - r.sy * a.z;
-    const V bx = b.x - r.sx * b.z, by = b.y - r.sy * b.z;
-    const V cx = c.x - r.sx * c.z, cy = c.y - r.sy * c.z;
-    V U = cx * by - cy * bx;
-    V Vv = ax * cy - ay * cx;
-    V W = bx * ay - by * ax;
-    tri_detail::edge_fallback(U, Vv, W, ax, ay, bx, by, cx, cy);
-    const auto outside = ((U < V(0)) || (Vv < V(0)) || (W < V(0))) && ((U > V(0)) || (Vv > V(0)) || (W > V(0)));
-    const V det = U + Vv + W;
-    const V T = U * (r.sz * a.z) + Vv * (r.sz * b.z) + W * (r.sz * c.z);
-    const auto ok = !outside && (det != V(0));
-    const V inv_det = V(1) / select(ok, det, V(1));
-    const V t = T * inv_det;
+    const tri_detail::Sheared<V> s = tri_detail::shear(r, a, b, c);
+    const auto ok = s.inside && (s.det != V(0));
+    const V inv_det = V(1) / select(ok, s.det, V(1));
+    const V t = s.T * inv_det;
     const auto hit = ok && (t > t_min) && (t < t_max);
-    return {select(hit, t, infinity_v<V>()), Vv * inv_det, W * inv_det};
+    return {select(hit, t, infinity_v<V>()), s.Vv * inv_det, s.W * inv_det};
+}
+
+/// Whether the triangle blocks the ray for t in (0, t_max), without the division: t = T / det
+/// lies in (0, t_max) when T and det have one sign and |T| < t_max |det|. The any-hit walks
+/// need no distance, and the division was their triangle test's slowest instruction (a
+/// 16-lane divide per triangle and packet). The comparison rounds once (the product), where
+/// T * (1 / det) < t_max rounds twice, so the two may differ for a hit within an ulp or two of
+/// t_max; the walks' tests grant any-hit that margin (tests/meshes/mesh_walk_test.cpp).
+template <class V>
+inline auto triangle_blocks_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
+                                     const Vec3T<V>& c, V t_max) {
+    using namespace simd;
+    const tri_detail::Sheared<V> s = tri_detail::shear(r, a, b, c);
+    const auto same_sign = ((s.T > V(0)) && (s.det > V(0))) || ((s.T < V(0)) && (s.det < V(0)));
+    return s.inside && same_sign && (abs(s.T) < t_max * abs(s.det));
 }
 
 /// Nearest hit in (t_min, t_max) with the triangle (p0, p1, p2), t = +inf on a miss. Both
@@ -143,6 +172,17 @@ inline TriangleHit<V> triangle_hit(const WatertightRay<V>& r, const Vec3T<V>& p0
         return Vec3T<V>{pick(r.kx0, r.kx1, p), pick(r.ky0, r.ky1, p), pick(r.kz0, r.kz1, p)};
     };
     return triangle_hit_permuted(r, permuted(p0 - r.o), permuted(p1 - r.o), permuted(p2 - r.o), t_min, t_max);
+}
+
+/// triangle_blocks_permuted on the triangle (p0, p1, p2), as triangle_hit permutes it.
+template <class V>
+inline auto triangle_blocks(const WatertightRay<V>& r, const Vec3T<V>& p0, const Vec3T<V>& p1, const Vec3T<V>& p2,
+                            V t_max) {
+    using tri_detail::pick;
+    const auto permuted = [&r](const Vec3T<V>& p) {
+        return Vec3T<V>{pick(r.kx0, r.kx1, p), pick(r.ky0, r.ky1, p), pick(r.kz0, r.kz1, p)};
+    };
+    return triangle_blocks_permuted(r, permuted(p0 - r.o), permuted(p1 - r.o), permuted(p2 - r.o), t_max);
 }
 
 /// Unnormalised geometric normal (p1 - p0) x (p2 - p0): outward for counter-clockwise

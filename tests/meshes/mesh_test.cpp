@@ -170,6 +170,37 @@ TEST_CASE("meshes: triangle test basics, both faces, barycentrics, t range") {
     CHECK(triangle_hit(rf, Vec3f{0, 0, 0}, Vec3f{1, 0, 0}, Vec3f{0, 1, 0}, 0.f, 10.f).t == doctest::Approx(0.5f));
 }
 
+TEST_CASE("meshes: the any-hit triangle test without division: both faces, t range, misses") {
+    // t = 0.5 along (0, 0, -2) from z = 1 (front face), t = 1 along (0, 0, 1) from z = -1 (back).
+    const Vec3f p0{0, 0, 0}, p1{1, 0, 0}, p2{0, 1, 0};
+    const WatertightRay<float> front = watertight_ray(Vec3f{0.25f, 0.5f, 1}, Vec3f{0, 0, -2});
+    const WatertightRay<float> back = watertight_ray(Vec3f{0.25f, 0.5f, -1}, Vec3f{0, 0, 1});
+    CHECK(triangle_blocks(front, p0, p1, p2, 0.51f));
+    CHECK_FALSE(triangle_blocks(front, p0, p1, p2, 0.49f));
+    CHECK_FALSE(triangle_blocks(front, p0, p1, p2, 0.5f));  // the interval is open at t_max
+    CHECK(triangle_blocks(back, p0, p1, p2, 1.01f));
+    CHECK_FALSE(triangle_blocks(back, p0, p1, p2, 0.99f));
+    // behind the origin (T and det of opposite signs), outside the edges, parallel, idle lane
+    CHECK_FALSE(triangle_blocks(watertight_ray(Vec3f{0.25f, 0.5f, 1}, Vec3f{0, 0, 1}), p0, p1, p2, 10.f));
+    CHECK_FALSE(triangle_blocks(watertight_ray(Vec3f{0.8f, 0.8f, 1}, Vec3f{0, 0, -1}), p0, p1, p2, 10.f));
+    CHECK_FALSE(triangle_blocks(watertight_ray(Vec3f{-1, 0.2f, 0}, Vec3f{1, 0, 0}), p0, p1, p2, 10.f));
+    CHECK_FALSE(triangle_blocks(front, p0, p1, p2, 0.f));
+    CHECK(triangle_blocks(front, p0, p1, p2, std::numeric_limits<float>::infinity()));
+    // Away from t_max it agrees with the closest-hit test, ray for ray.
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<float> u(-2.f, 2.f), tm(0.1f, 5.f);
+    int blocked = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const WatertightRay<float> r = watertight_ray(Vec3f{u(rng), u(rng), u(rng)}, Vec3f{u(rng), u(rng), u(rng)});
+        const float t_max = tm(rng);
+        const float t = triangle_hit(r, p0, p1, p2, 0.f, 1e30f).t;
+        if (std::abs(t - t_max) < 1e-4f * t_max) continue;
+        CHECK(triangle_blocks(r, p0, p1, p2, t_max) == (t < t_max));
+        blocked += t < t_max;
+    }
+    CHECK(blocked > 100);  // the comparison saw both answers (193 of the 20000)
+}
+
 TEST_CASE("meshes: degenerate triangles are dropped, normals, memory") {
     const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0};
     const auto m = Mesh::build("t", pos, {0, 1, 2, 0, 1, 3, 0, 0, 1, 0, 1, 7});
