@@ -88,103 +88,6 @@ inline std::uint32_t lanes_meeting_children(const accel::WideNode& n, const Vec3
     return lanes & movemask_bits(any_child);
 }
 
-/// The packet's rays as one bundle for a first, cheap test of a node's 8 child boxes at once:
-/// interval bounds over the live lanes of each axis's origin and inverse direction give, per
-/// child, a lower bound of every lane's entry distance and an upper bound of every lane's exit
-/// distance. A child whose bounds do not overlap is missed by every lane, so the per-lane
-/// test (robust_box) runs only on the children that pass. Conservative in float: the slab
-/// distances are monotone in the origin and in the inverse direction, and rounding keeps
-/// that order, so each lane's rounded distance lies inside the rounded bounds. An axis whose
-/// live directions differ in sign gives no bound (the inverse directions span infinity).
-template <class B>
-struct PacketFrustum {
-    using NodeArch = typename SingleRayArchs<typename B::arch_type>::node;
-    using NB = xsimd::batch<float, NodeArch>;
-    int near[3], far[3];  ///< plane offsets in the node (as SingleRay's), -1: the axis gives no bound
-    float o_near[3], o_far[3], inv_lo[3], inv_hi[3];
-
-    /// walk false: the packet goes to the single-ray walk whole, so no bound is computed.
-    template <class M>
-    PacketFrustum(const Vec3T<B>& o, const Vec3T<B>& inv, const M& live, bool walk = true) {
-        constexpr float inf = std::numeric_limits<float>::infinity();
-        if (!walk) {
-            near[0] = near[1] = near[2] = far[0] = far[1] = far[2] = -1;
-            return;
-        }
-        const B oc[3] = {o.x, o.y, o.z}, ic[3] = {inv.x, inv.y, inv.z};
-        bool negative[3];
-        for (int a = 0; a < 3; ++a) {
-            const auto neg = live && (ic[a] < B(0.f));  // 1 / -0 = -inf: negative
-            negative[a] = xsimd::any(neg);
-            const int lo = a * accel::kNodeWidth, hi = (3 + a) * accel::kNodeWidth;
-            if (negative[a] && !xsimd::all(neg || !live)) {
-                near[a] = far[a] = -1;  // mixed signs
-            } else {
-                near[a] = negative[a] ? hi : lo;
-                far[a] = negative[a] ? lo : hi;
-            }
-        }
-        if (!bounded()) return;
-        for (int a = 0; a < 3; ++a) {
-            const float o_min = -lanes_max(xsimd::select(live, -oc[a], B(-inf)));
-            const float o_max = lanes_max(xsimd::select(live, oc[a], B(-inf)));
-            inv_lo[a] = -lanes_max(xsimd::select(live, -ic[a], B(-inf)));
-            inv_hi[a] = lanes_max(xsimd::select(live, ic[a], B(-inf)));
-            // Entry through the low plane (positive directions): the smallest (lo - o) is at the
-            // largest origin; through the high plane (negative): the largest (hi - o) gives the
-            // smallest product. The exit the other way round.
-            o_near[a] = negative[a] ? o_min : o_max;
-            o_far[a] = negative[a] ? o_max : o_min;
-        }
-    }
-
-    /// Every axis bounds the packet. Otherwise the test culls too little to pay (scattered rays:
-    /// diffuse bounces measured 10 % slower with it), and children() passes every child.
-    bool bounded() const { return near[0] >= 0 && near[1] >= 0 && near[2] >= 0; }
-
-    /// Bit j set when child j's box may be entered by a live lane with t in [0, t_far] (t_far:
-    /// at least every live lane's largest distance).
-    std::uint32_t children(const accel::WideNode& n, float t_far) const {
-        if (!bounded()) return (1u << accel::kNodeWidth) - 1;
-        const float* base = reinterpret_cast<const float*>(&n);
-        std::uint32_t bits = 0;
-        for (std::size_t j = 0; j < std::size_t(accel::kNodeWidth); j += NB::size) {
-            NB tn(0.f), tf(t_far);
-            for (int a = 0; a < 3; ++a) {
-                const NB il(inv_lo[a]), ih(inv_hi[a]);
-                const NB xn = NB::load_aligned(base + near[a] + j) - NB(o_near[a]);
-                const NB xf = NB::load_aligned(base + far[a] + j) - NB(o_far[a]);
-                const NB n0 = xn * il, n1 = xn * ih, f0 = xf * il, f1 = xf * ih;
-                const NB n_a = xsimd::select(n0 < n1, n0, n1), f_a = xsimd::select(f0 > f1, f0, f1);
-                tn = xsimd::select(n_a > tn, n_a, tn);  // NaN (0 * inf): no bound
-                tf = xsimd::select(f_a < tf, f_a, tf);
-            }
-            bits |= movemask_bits(tn <= tf * NB(kWiden)) << j;
-        }
-        return bits;
-    }
-
-    /// robust_box for one child, each lane. When every axis's live directions share their
-    /// sign the near and far planes are known, so the slabs need no compare and selects (a ray
-    /// lying in a slab plane, 0 * inf, is then kept, as by the single-ray walk).
-    auto lane_box(const accel::WideNode& n, int j, const Vec3T<B>& o, const Vec3T<B>& inv, const B& t_max,
-                  B& t_near) const {
-        if (!bounded()) return robust_box(n, j, o, inv, t_max, t_near);
-        const float* base = reinterpret_cast<const float*>(&n);
-        B tn(0.f), tf = t_max;
-        const auto slab = [&](int a, const B& oc, const B& ic) {
-            const B n_a = (B(base[near[a] + j]) - oc) * ic, f_a = (B(base[far[a] + j]) - oc) * ic;
-            tn = xsimd::select(n_a > tn, n_a, tn);  // NaN (0 * inf): the slab does not limit
-            tf = xsimd::select(f_a < tf, f_a, tf);
-        };
-        slab(0, o.x, inv.x);
-        slab(1, o.y, inv.y);
-        slab(2, o.z, inv.z);
-        t_near = tn;
-        return tn <= tf * B(kWiden);
-    }
-};
-
 }  // namespace mesh_detail
 
 /// A packet whose live rays' directions all lie within about 73 degrees of their mean keeps
@@ -253,7 +156,6 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
     PacketEntry stack[kStack];
     int sp = 0;
     std::uint32_t live = movemask_bits(best > B(0.f));
-    const PacketFrustum<B> frustum(o, inv, best > B(0.f), std::uint32_t(std::popcount(live)) > single_lanes);
     if (std::uint32_t(std::popcount(live)) <= single_lanes) {
         live = lanes_meeting_children(m.nodes[0], o, inv, best, live);
         if (live == 0) return;
@@ -284,11 +186,9 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
         const accel::WideNode& n = m.nodes[e.child];
         PacketEntry hits[accel::kNodeWidth];
         int nh = 0;
-        for (std::uint32_t bits = frustum.children(n, best_max); bits; bits &= bits - 1) {
-            const int j = std::countr_zero(bits);
-            if (n.child[j] < 0) break;
+        for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
             B tn;
-            const auto hit = frustum.lane_box(n, j, o, inv, best, tn);
+            const auto hit = robust_box(n, j, o, inv, best, tn);
             if (!xsimd::any(hit)) continue;
             // farthest first, so the nearest is popped first
             const PacketEntry en{n.child[j], n.count[j], lanes_min_where(tn, hit),
@@ -332,8 +232,6 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
     const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
     const WatertightRay<B> wr = watertight_ray(o, d);
     const PacketLanes<B> lanes(o, d);
-    const PacketFrustum<B> frustum(o, inv, open);
-    const float t_far = lanes_max(xsimd::select(open, t_max, B(0.f)));
     // The open lanes of e, finished one by one by the single-ray walk.
     const auto hand_over = [&](const PacketEntry& e) {
         alignas(64) float t_l[W], blocked_l[W];
@@ -368,11 +266,9 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
             continue;
         }
         const accel::WideNode& n = m.nodes[e.child];
-        for (std::uint32_t bits = frustum.children(n, t_far); bits; bits &= bits - 1) {
-            const int j = std::countr_zero(bits);
-            if (n.child[j] < 0) break;
+        for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
             B tn;
-            const auto hit = frustum.lane_box(n, j, o, inv, t_max, tn) && open;
+            const auto hit = robust_box(n, j, o, inv, t_max, tn) && open;
             if (xsimd::any(hit))
                 stack[sp++] = {n.child[j], n.count[j], 0.f, single_lanes > 0 ? movemask_bits(hit) : ~0u};
         }

@@ -238,11 +238,13 @@ TEST_CASE("mesh walks: the hybrid hands packets over both ways (coherent packets
     check_against_oracle(mesh, sparse);
 }
 
-TEST_CASE("mesh walks: packets of one direction octant keep every lane's hit through the bundle test") {
-    // Every packet's live directions share their signs, so the packet walks first cull a
-    // node's children with the bundle's interval bounds (mesh_kernel.h, PacketFrustum). The
-    // rays start anywhere around the soup and aim at random triangles' interiors: the bundle is
-    // wide, and a bound on the wrong side (origin or inverse direction) drops lanes' hits.
+TEST_CASE("mesh walks: packets of one direction octant that reach different leaves keep every lane's hit") {
+    // Every packet's live directions share their signs, as a packet of camera rays or of
+    // shadow rays to one light does: the packet walks keep such packets whole (the random
+    // rays above scatter and go to single rays), while rays that start anywhere around the
+    // soup and aim at random triangles' interiors reach different leaves. (A bundle test that
+    // culled children by the packet's interval bounds, tried on 2026-11-27 and not kept, failed
+    // here when a bound was put on the wrong side.)
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(-1.5f, 1.5f), w(0.05f, 0.9f);
     const MeshData sd = soup(300, rng);
