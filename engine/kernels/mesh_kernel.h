@@ -171,8 +171,9 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
         }
         if (e.count > 0) {
             for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
-                const TriangleHit<B> h = triangle_hit(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2),
-                                                      B(0.f), best);
+                const auto sheared = triangle_sheared(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2));
+                if (!xsimd::any(triangle_may_hit(sheared, best))) continue;
+                const TriangleHit<B> h = triangle_hit_sheared(sheared, B(0.f), best);
                 const auto closer = h.t < best;
                 if (!xsimd::any(closer)) continue;
                 best = xsimd::select(closer, h.t, best);

@@ -174,13 +174,6 @@ inline auto block_corner(const TriangleBlock& b, int c, const SingleRay<NodeArch
                      LB::load_aligned(b.corner[c][r.axis[2]]) - r.o_perm[2]};
 }
 
-template <class NodeArch, class LeafArch>
-inline auto block_hit(const TriangleBlock& b, const SingleRay<NodeArch, LeafArch>& r, float t_max) {
-    using LB = typename SingleRay<NodeArch, LeafArch>::LB;
-    return triangle_hit_permuted(r.wr, block_corner(b, 0, r), block_corner(b, 1, r), block_corner(b, 2, r), LB(0.f),
-                                 LB(t_max));
-}
-
 /// The leaf (first, count) against one ray, 4 triangles per test: shrinks best and records
 /// the hit; true when it found one.
 template <class NodeArch, class LeafArch>
@@ -190,7 +183,10 @@ inline bool single_leaf_closest(const MeshView& m, const SingleRay<NodeArch, Lea
     const TriangleBlock* b = m.blocks + m.block_of[first];
     bool found = false;
     for (std::uint32_t k = 0; k < count; k += kBlockTriangles, ++b) {
-        const TriangleHit<LB> h = block_hit(*b, r, best);
+        const auto sheared =
+            tri_detail::shear(r.wr, block_corner(*b, 0, r), block_corner(*b, 1, r), block_corner(*b, 2, r));
+        if (!xsimd::any(triangle_may_hit(sheared, LB(best)))) continue;
+        const TriangleHit<LB> h = triangle_hit_sheared(sheared, LB(0.f), LB(best));
         if (!xsimd::any(h.t < LB(best))) continue;
         alignas(16) float t[kBlockTriangles], u[kBlockTriangles], v[kBlockTriangles];
         h.t.store_aligned(t);

@@ -137,14 +137,35 @@ template <class V>
 /// the same order either way, so both give the same bits.
 template <class V>
 inline TriangleHit<V> triangle_hit_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
-                                            const Vec3T<V>& c, V t_min, V t_max) {
+                                            const Vec3T<V>& c, V t_min, V t_max);
+
+/// The rest of the test on a sheared triangle (tri_detail::shear): the division, t, u, v.
+template <class V>
+inline TriangleHit<V> triangle_hit_sheared(const tri_detail::Sheared<V>& s, V t_min, V t_max) {
     using namespace simd;
-    const tri_detail::Sheared<V> s = tri_detail::shear(r, a, b, c);
     const auto ok = s.inside && (s.det != V(0));
     const V inv_det = V(1) / select(ok, s.det, V(1));
     const V t = s.T * inv_det;
     const auto hit = ok && (t > t_min) && (t < t_max);
     return {select(hit, t, infinity_v<V>()), s.Vv * inv_det, s.W * inv_det};
+}
+
+template <class V>
+inline TriangleHit<V> triangle_hit_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
+                                            const Vec3T<V>& c, V t_min, V t_max) {
+    return triangle_hit_sheared(tri_detail::shear(r, a, b, c), t_min, t_max);
+}
+
+/// A superset of the lanes that triangle_hit_sheared(s, 0, t_max) finds a hit on, without its
+/// division: the closest-hit walks skip the division for triangles no lane can hit (most of the
+/// triangles they test). T / det in (0, t_max) needs T and det of one sign and |T| < t_max |det|;
+/// the slack of 2^-20 covers the roundings of both forms (t rounds twice, the product once: a
+/// few times 2^-24 apart), so a lane the exact test accepts always passes here.
+template <class V>
+inline auto triangle_may_hit(const tri_detail::Sheared<V>& s, V t_max) {
+    using namespace simd;
+    const auto same_sign = ((s.T > V(0)) && (s.det > V(0))) || ((s.T < V(0)) && (s.det < V(0)));
+    return s.inside && same_sign && (abs(s.T) <= (t_max * abs(s.det)) * V(1 + 0x1p-20));
 }
 
 /// Whether the triangle blocks the ray for t in (0, t_max), without the division: t = T / det
@@ -172,6 +193,17 @@ inline TriangleHit<V> triangle_hit(const WatertightRay<V>& r, const Vec3T<V>& p0
         return Vec3T<V>{pick(r.kx0, r.kx1, p), pick(r.ky0, r.ky1, p), pick(r.kz0, r.kz1, p)};
     };
     return triangle_hit_permuted(r, permuted(p0 - r.o), permuted(p1 - r.o), permuted(p2 - r.o), t_min, t_max);
+}
+
+/// The triangle (p0, p1, p2) sheared for the ray, permuted as triangle_hit permutes it.
+template <class V>
+inline tri_detail::Sheared<V> triangle_sheared(const WatertightRay<V>& r, const Vec3T<V>& p0, const Vec3T<V>& p1,
+                                               const Vec3T<V>& p2) {
+    using tri_detail::pick;
+    const auto permuted = [&r](const Vec3T<V>& p) {
+        return Vec3T<V>{pick(r.kx0, r.kx1, p), pick(r.ky0, r.ky1, p), pick(r.kz0, r.kz1, p)};
+    };
+    return tri_detail::shear(r, permuted(p0 - r.o), permuted(p1 - r.o), permuted(p2 - r.o));
 }
 
 /// triangle_blocks_permuted on the triangle (p0, p1, p2), as triangle_hit permutes it.

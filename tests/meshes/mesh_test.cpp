@@ -201,6 +201,30 @@ TEST_CASE("meshes: the any-hit triangle test without division: both faces, t ran
     CHECK(blocked > 100);  // the comparison saw both answers (193 of the 20000)
 }
 
+TEST_CASE("meshes: the closest-hit walks' division-free pre-test passes every lane the exact test hits") {
+    // The walks skip a triangle's division when triangle_may_hit passes no lane; it must pass
+    // every lane triangle_hit_sheared accepts, also with t_max one ulp beyond the hit, where the
+    // two forms' roundings differ most.
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<float> u(-2.f, 2.f);
+    const Vec3f p0{0.1f, -0.3f, 0.2f}, p1{1.3f, 0.1f, -0.4f}, p2{-0.2f, 1.1f, 0.5f};
+    int at_limit = 0;
+    for (int i = 0; i < 200000; ++i) {
+        const Vec3f o{u(rng), u(rng), u(rng)};
+        const Vec3f aim = p0 + (p1 - p0) * (0.5f * (u(rng) + 2.f) / 4.f) + (p2 - p0) * (0.5f * (u(rng) + 2.f) / 4.f);
+        const WatertightRay<float> r = watertight_ray(o, (aim - o) * (0.25f + (u(rng) + 2.f)));
+        const auto s = triangle_sheared(r, p0, p1, p2);
+        const float t = triangle_hit_sheared(s, 0.f, std::numeric_limits<float>::infinity()).t;
+        if (std::isinf(t)) continue;
+        for (const float t_max : {std::nextafter(t, 1e30f), std::nextafter(std::nextafter(t, 1e30f), 1e30f), 2.f * t}) {
+            const bool hit = triangle_hit_sheared(s, 0.f, t_max).t < t_max;
+            at_limit += hit && t_max < 2.f * t;
+            if (hit && !triangle_may_hit(s, t_max)) FAIL_CHECK("pre-test drops a hit at t ", t, ", t_max ", t_max);
+        }
+    }
+    CHECK(at_limit > 100000);  // the exact test hit at one or two ulps beyond t on most rays
+}
+
 TEST_CASE("meshes: degenerate triangles are dropped, normals, memory") {
     const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0};
     const auto m = Mesh::build("t", pos, {0, 1, 2, 0, 1, 3, 0, 0, 1, 0, 1, 7});
