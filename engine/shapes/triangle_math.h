@@ -114,8 +114,16 @@ struct Sheared {
     V U, Vv, W, det, T;
     decltype(V(0) < V(0)) inside;  ///< the ray passes through the triangle or its border
 };
+/// The test proper up to the division, on the corners relative to the ray's origin and
+/// already permuted (x: axis kx, y: ky, z: kz). triangle_sheared() permutes with per-lane
+/// selects (a packet's rays may differ in kz); the single-ray walk, whose one ray fixes the
+/// axes, and a packet whose lanes share them load the permuted coordinates directly
+/// (kernels/mesh_single_kernel.h, mesh_kernel.h). Same operations in the same order either
+/// way, so all give the same bits. The rest: triangle_hit_sheared, triangle_may_hit,
+/// triangle_blocks_sheared.
 template <class V>
-[[gnu::always_inline]] inline Sheared<V> shear(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b, const Vec3T<V>& c) {
+[[gnu::always_inline]] inline Sheared<V> shear(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
+                                               const Vec3T<V>& c) {
     const V ax = a.x - r.sx * a.z, ay = a.y - r.sy * a.z;
     const V bx = b.x - r.sx * b.z, by = b.y - r.sy * b.z;
     const V cx = c.x - r.sx * c.z, cy = c.y - r.sy * c.z;
@@ -130,15 +138,6 @@ template <class V>
 }
 }  // namespace tri_detail
 
-/// The test proper, on the corners relative to the ray's origin and already permuted
-/// (x: axis kx, y: ky, z: kz). triangle_hit() permutes with per-lane selects (a packet's rays
-/// may differ in kz); the single-ray walk, whose one ray fixes the axes, loads the permuted
-/// coordinates of 4 triangles directly (kernels/mesh_single_kernel.h). Same operations in
-/// the same order either way, so both give the same bits.
-template <class V>
-inline TriangleHit<V> triangle_hit_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
-                                            const Vec3T<V>& c, V t_min, V t_max);
-
 /// The rest of the test on a sheared triangle (tri_detail::shear): the division, t, u, v.
 template <class V>
 inline TriangleHit<V> triangle_hit_sheared(const tri_detail::Sheared<V>& s, V t_min, V t_max) {
@@ -148,12 +147,6 @@ inline TriangleHit<V> triangle_hit_sheared(const tri_detail::Sheared<V>& s, V t_
     const V t = s.T * inv_det;
     const auto hit = ok && (t > t_min) && (t < t_max);
     return {select(hit, t, infinity_v<V>()), s.Vv * inv_det, s.W * inv_det};
-}
-
-template <class V>
-inline TriangleHit<V> triangle_hit_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
-                                            const Vec3T<V>& c, V t_min, V t_max) {
-    return triangle_hit_sheared(tri_detail::shear(r, a, b, c), t_min, t_max);
 }
 
 /// A superset of the lanes that triangle_hit_sheared(s, 0, t_max) finds a hit on, without its
@@ -175,27 +168,19 @@ inline auto triangle_may_hit(const tri_detail::Sheared<V>& s, V t_max) {
 /// T * (1 / det) < t_max rounds twice, so the two may differ for a hit within an ulp or two of
 /// t_max; the walks' tests grant any-hit that margin (tests/meshes/mesh_walk_test.cpp).
 template <class V>
-inline auto triangle_blocks_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
-                                     const Vec3T<V>& c, V t_max) {
+inline auto triangle_blocks_sheared(const tri_detail::Sheared<V>& s, V t_max) {
     using namespace simd;
-    const tri_detail::Sheared<V> s = tri_detail::shear(r, a, b, c);
     const auto same_sign = ((s.T > V(0)) && (s.det > V(0))) || ((s.T < V(0)) && (s.det < V(0)));
     return s.inside && same_sign && (abs(s.T) < t_max * abs(s.det));
 }
-
-/// Nearest hit in (t_min, t_max) with the triangle (p0, p1, p2), t = +inf on a miss. Both
-/// faces count. t is measured along the direction given to watertight_ray().
 template <class V>
-inline TriangleHit<V> triangle_hit(const WatertightRay<V>& r, const Vec3T<V>& p0, const Vec3T<V>& p1,
-                                   const Vec3T<V>& p2, V t_min, V t_max) {
-    using tri_detail::pick;
-    const auto permuted = [&r](const Vec3T<V>& p) {
-        return Vec3T<V>{pick(r.kx0, r.kx1, p), pick(r.ky0, r.ky1, p), pick(r.kz0, r.kz1, p)};
-    };
-    return triangle_hit_permuted(r, permuted(p0 - r.o), permuted(p1 - r.o), permuted(p2 - r.o), t_min, t_max);
+inline auto triangle_blocks_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
+                                     const Vec3T<V>& c, V t_max) {
+    return triangle_blocks_sheared(tri_detail::shear(r, a, b, c), t_max);
 }
 
-/// The triangle (p0, p1, p2) sheared for the ray, permuted as triangle_hit permutes it.
+/// The triangle (p0, p1, p2) sheared for the ray: each corner relative to the ray's origin,
+/// permuted to the ray's axes (per lane, with selects).
 template <class V>
 inline tri_detail::Sheared<V> triangle_sheared(const WatertightRay<V>& r, const Vec3T<V>& p0, const Vec3T<V>& p1,
                                                const Vec3T<V>& p2) {
@@ -206,15 +191,19 @@ inline tri_detail::Sheared<V> triangle_sheared(const WatertightRay<V>& r, const 
     return tri_detail::shear(r, permuted(p0 - r.o), permuted(p1 - r.o), permuted(p2 - r.o));
 }
 
-/// triangle_blocks_permuted on the triangle (p0, p1, p2), as triangle_hit permutes it.
+/// Nearest hit in (t_min, t_max) with the triangle (p0, p1, p2), t = +inf on a miss. Both
+/// faces count. t is measured along the direction given to watertight_ray().
+template <class V>
+inline TriangleHit<V> triangle_hit(const WatertightRay<V>& r, const Vec3T<V>& p0, const Vec3T<V>& p1,
+                                   const Vec3T<V>& p2, V t_min, V t_max) {
+    return triangle_hit_sheared(triangle_sheared(r, p0, p1, p2), t_min, t_max);
+}
+
+/// triangle_blocks_sheared on the triangle (p0, p1, p2).
 template <class V>
 inline auto triangle_blocks(const WatertightRay<V>& r, const Vec3T<V>& p0, const Vec3T<V>& p1, const Vec3T<V>& p2,
                             V t_max) {
-    using tri_detail::pick;
-    const auto permuted = [&r](const Vec3T<V>& p) {
-        return Vec3T<V>{pick(r.kx0, r.kx1, p), pick(r.ky0, r.ky1, p), pick(r.kz0, r.kz1, p)};
-    };
-    return triangle_blocks_permuted(r, permuted(p0 - r.o), permuted(p1 - r.o), permuted(p2 - r.o), t_max);
+    return triangle_blocks_sheared(triangle_sheared(r, p0, p1, p2), t_max);
 }
 
 /// Unnormalised geometric normal (p1 - p0) x (p2 - p0): outward for counter-clockwise
