@@ -117,10 +117,10 @@ struct Sheared {
 /// The test proper up to the division, on the corners relative to the ray's origin and
 /// already permuted (x: axis kx, y: ky, z: kz). triangle_sheared() permutes with per-lane
 /// selects (a packet's rays may differ in kz); the single-ray walk, whose one ray fixes the
-/// axes, and a packet whose lanes share them load the permuted coordinates directly
-/// (kernels/mesh_single_kernel.h, mesh_kernel.h). Same operations in the same order either
-/// way, so all give the same bits. The rest: triangle_hit_sheared, triangle_may_hit,
-/// triangle_blocks_sheared.
+/// axes, loads the permuted coordinates of 4 triangles directly (kernels/mesh_single_kernel.h).
+/// Same operations in the same order either way, so both give the same bits. The rest of the
+/// test: triangle_hit_sheared (the division: t, u, v), triangle_may_hit (which lanes may hit,
+/// without it), triangle_blocks_sheared (any hit, without it).
 template <class V>
 [[gnu::always_inline]] inline Sheared<V> shear(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,
                                                const Vec3T<V>& c) {
