@@ -136,6 +136,14 @@ template <class V>
     const V T = U * (r.sz * a.z) + Vv * (r.sz * b.z) + W * (r.sz * c.z);
     return {U, Vv, W, det, T, !outside};
 }
+
+/// The ray passes through the triangle at some t > 0: inside its edges, and T and det of one
+/// sign (t = T / det). What is left is the comparison with t_max.
+template <class V>
+inline auto ahead(const Sheared<V>& s) {
+    const auto same_sign = ((s.T > V(0)) && (s.det > V(0))) || ((s.T < V(0)) && (s.det < V(0)));
+    return s.inside && same_sign;
+}
 }  // namespace tri_detail
 
 /// The rest of the test on a sheared triangle (tri_detail::shear): the division, t, u, v.
@@ -157,8 +165,7 @@ inline TriangleHit<V> triangle_hit_sheared(const tri_detail::Sheared<V>& s, V t_
 template <class V>
 inline auto triangle_may_hit(const tri_detail::Sheared<V>& s, V t_max) {
     using namespace simd;
-    const auto same_sign = ((s.T > V(0)) && (s.det > V(0))) || ((s.T < V(0)) && (s.det < V(0)));
-    return s.inside && same_sign && (abs(s.T) <= (t_max * abs(s.det)) * V(1 + 0x1p-20));
+    return tri_detail::ahead(s) && (abs(s.T) <= (t_max * abs(s.det)) * V(1 + 0x1p-20));
 }
 
 /// Whether the triangle blocks the ray for t in (0, t_max), without the division: t = T / det
@@ -170,8 +177,7 @@ inline auto triangle_may_hit(const tri_detail::Sheared<V>& s, V t_max) {
 template <class V>
 inline auto triangle_blocks_sheared(const tri_detail::Sheared<V>& s, V t_max) {
     using namespace simd;
-    const auto same_sign = ((s.T > V(0)) && (s.det > V(0))) || ((s.T < V(0)) && (s.det < V(0)));
-    return s.inside && same_sign && (abs(s.T) < t_max * abs(s.det));
+    return tri_detail::ahead(s) && (abs(s.T) < t_max * abs(s.det));
 }
 template <class V>
 inline auto triangle_blocks_permuted(const WatertightRay<V>& r, const Vec3T<V>& a, const Vec3T<V>& b,

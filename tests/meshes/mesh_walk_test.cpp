@@ -240,9 +240,8 @@ TEST_CASE("mesh walks: the hybrid hands packets over both ways (coherent packets
 
 TEST_CASE("mesh walks: packets of one direction octant that reach different leaves keep every lane's hit") {
     // Every packet's live directions share their signs, as a packet of camera rays or of
-    // shadow rays to one light does: the packet walks keep such packets whole (the random
-    // rays above scatter and go to single rays), while rays that start anywhere around the
-    // soup and aim at random triangles' interiors reach different leaves. (A bundle test that
+    // shadow rays to one light does, while its rays start anywhere around the soup and aim at
+    // random triangles' interiors, so its lanes reach different leaves. (A bundle test that
     // culled children by the packet's interval bounds, tried on 2026-11-27 and not kept, failed
     // here when a bound was put on the wrong side.)
     std::mt19937 rng(11);
