@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Before/after render times of two streamrt builds, measured in one run (docs/performance.md).
 
-usage: scripts/ab_render.py OLD_BINARY NEW_BINARY [--runs N] [--jobs J] [--size WxH] [--spp S] [--stages] SCENE...
+usage: scripts/ab_render.py OLD_BINARY NEW_BINARY [--runs N] [--jobs J] [--size WxH] [--spp S] [--stages]
+                             [--stage-names a,b] SCENE...
 
 Renders each scene with the old and the new binary alternately (old, new, old, new, ...),
 --runs times each, and prints the median render clock (the summary line's "render" phase:
@@ -10,7 +11,8 @@ the two series under the same load on a shared machine. Writes nothing but tempo
 
 With --stages, runs `--profile` instead and compares the intersect and occlusion stages'
 thread CPU time (immune to time spent descheduled), median and minimum of each series: the
-figures of docs/performance.md's traversal changes (use --jobs 1).
+figures of docs/performance.md's traversal changes (use --jobs 1). --stage-names picks
+other rows of that table (default intersect,occlusion; e.g. shade+spawn,intersect).
 """
 import argparse
 import os
@@ -42,16 +44,16 @@ def render_seconds(binary, scene, args, out):
 
 
 def stage_seconds(binary, scene, args, out):
-    """Thread CPU seconds of the intersect and occlusion stages (--profile's table)."""
+    """Thread CPU seconds of the stages args.stage_names (--profile's table), in that order."""
     text = streamrt(binary, scene, args, out, "--profile")
     cpu = {}
     for line in text.splitlines():
         f = line.split()
-        if len(f) >= 4 and f[0] in ("intersect", "occlusion"):
+        if len(f) >= 4 and f[0] in args.stage_names and f[0] not in cpu:
             cpu[f[0]] = float(f[3])
-    if len(cpu) != 2:
-        sys.exit("no intersect and occlusion rows in: " + text)
-    return cpu["intersect"], cpu["occlusion"]
+    if len(cpu) != len(args.stage_names):
+        sys.exit("no %s rows in: %s" % (" and ".join(args.stage_names), text))
+    return tuple(cpu[n] for n in args.stage_names)
 
 
 def compare_stages(args, scene, out):
@@ -60,7 +62,7 @@ def compare_stages(args, scene, out):
         for which in ("old", "new"):
             runs[which].append(stage_seconds(getattr(args, which), scene, args, out))
     row = [scene]
-    for k in (0, 1):
+    for k in range(len(args.stage_names)):
         for pick in (statistics.median, min):
             old, new = pick(r[k] for r in runs["old"]), pick(r[k] for r in runs["new"])
             row.append("%.4f -> %.4f (%.3f)" % (old, new, new / old))
@@ -76,11 +78,17 @@ def main():
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--size", help="WxH (default: the scene's)")
     ap.add_argument("--spp", type=int)
-    ap.add_argument("--stages", action="store_true", help="compare the intersect and occlusion stages' CPU time")
+    ap.add_argument("--stages", action="store_true", help="compare stages' CPU time (--stage-names)")
+    ap.add_argument("--stage-names", default="intersect,occlusion",
+                    help="rows of --profile's stage table to compare (default intersect,occlusion)")
     args = ap.parse_args()
+    args.stage_names = args.stage_names.split(",")
     if args.stages:
-        print("| scene | intersect median s, old -> new (new / old) | intersect min | occlusion median | occlusion min |")
-        print("|---|---|---|---|---|")
+        head = ["%s median s, old -> new (new / old)" % args.stage_names[0], "%s min" % args.stage_names[0]]
+        for name in args.stage_names[1:]:
+            head += ["%s median" % name, "%s min" % name]
+        print("| scene | " + " | ".join(head) + " |")
+        print("|---" * (1 + len(head)) + "|")
         with tempfile.TemporaryDirectory() as tmp:
             for scene in args.scenes:
                 compare_stages(args, scene, os.path.join(tmp, "x.pfm"))

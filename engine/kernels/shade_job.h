@@ -44,9 +44,14 @@ inline ShadowAppend append_view(ShadowStream& s) {
 }
 
 struct ShadeJob {
-    // Rays [begin, end) of the sorted arrays; readable up to end + kMaxLanes (padding).
+    // The slice's rays, in its own order (the stream's arrays; t is the closest hit's).
     const float *ox, *oy, *oz, *dx, *dy, *dz, *t, *wr, *wg, *wb, *cone;
     const std::int32_t* pixel;
+    // The run: its j-th ray, for j in [begin, end), is ray order[j] of those arrays; order is
+    // readable up to end + kMaxLanes, past the last run with the index of a hit. Reading the
+    // rays through it (gathers) replaced copying every field into run order, which cost a
+    // fifth of the render on scenes/whitted.cfg.
+    const std::int32_t* order;
     std::size_t begin, end;
     // The object they all hit: its record (Mi, kind, parameter, mesh), colour and material.
     // Gathered runs (scenes too large to regroup by object) share only the material and the
@@ -57,21 +62,21 @@ struct ShadeJob {
     const LightT<float>* lights;
     std::size_t n_lights;
     ShadeRules<float> rules;  ///< degree, ambient, whether children spawn, cut-off, cone spread
-    // Outputs: the weighted local colour of each ray (same indexing as the inputs) ...
+    // Outputs: the weighted local colour of each ray (indexed as `order`) ...
     float *lr, *lg, *lb;
     // ... and the rays it spawns.
     RayAppend next;
     ShadowAppend shadows;
-    // Mesh objects only: the hit triangle and its barycentrics per ray (same indexing); the
+    // Mesh objects only: the hit triangle and its barycentrics per ray (the slice's order); the
     // mesh and its smooth flag are the run's object's, or (gathered) each ray's object's.
     const std::int32_t* prim = nullptr;
     const float* bu = nullptr;
     const float* bv = nullptr;
-    const std::int32_t* ids = nullptr;         ///< gathered: per ray, its object's id
+    const std::int32_t* ids = nullptr;         ///< gathered: per ray (the slice's order), its object's id
     const KernelObject* objects = nullptr;     ///< gathered: every object's record, by id
     const SurfaceRecord* surfaces = nullptr;   ///< gathered: every object's colour, by id
     ShapeKind kind = ShapeKind::Sphere;        ///< gathered: the run's shape kind
-    const std::uint32_t* key = nullptr;        ///< area lights: per ray, its light-sampling key
+    const std::uint32_t* key = nullptr;        ///< area lights: per ray (the slice's order), its light-sampling key
 };
 
 /// Camera rays for one chunk. Per ray (arrays padded to whole packets): the pixel's corner

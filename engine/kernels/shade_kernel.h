@@ -41,12 +41,18 @@ inline Vec3T<B> canonical_normal(ShapeKind kind, const Vec3T<B>& p, const B& par
     return visit_shape(kind, [&](auto shape) { return shape.template normal<B>(p, param); });
 }
 
+/// The slice indices of the run's rays i .. i + W (ShadeJob::order).
+template <class A>
+inline xsimd::batch<std::int32_t, A> rays_of(const ShadeJob& job, std::size_t i) {
+    return xsimd::batch<std::int32_t, A>::load_unaligned(job.order + i);
+}
+
 /// The record of lane l's object in the packet starting at ray i: the run's object, or
 /// (kGathered) the lane's own, read through its id. Lanes past the run must not ask (their
 /// ids belong to the next run, perhaps not a mesh).
 template <bool kGathered>
 inline const ObjectXf& lane_object(const ShadeJob& job, std::size_t i, std::size_t l) {
-    if constexpr (kGathered) return job.objects[std::size_t(job.ids[i + l])].xf;
+    if constexpr (kGathered) return job.objects[std::size_t(job.ids[job.order[i + l]])].xf;
     else return job.object->xf;
 }
 
@@ -64,7 +70,8 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
         if (i + l >= job.end) continue;
         const ObjectXf& ob = lane_object<kGathered>(job, i, l);
         const MeshView& m = *ob.mesh;
-        const std::size_t k = std::size_t(job.prim[i + l]);
+        const std::size_t ray = std::size_t(job.order[i + l]);
+        const std::size_t k = std::size_t(job.prim[ray]);
         if (ob.param == 0.f) {  // flat
             const float* p = m.tri + 9 * k;
             const float e1x = p[3] - p[0], e1y = p[4] - p[1], e1z = p[5] - p[2];
@@ -73,7 +80,7 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
             ny[l] = e1z * e2x - e1x * e2z;
             nz[l] = e1x * e2y - e1y * e2x;
         } else {
-            const float u = job.bu[i + l], v = job.bv[i + l], w = 1.f - u - v;
+            const float u = job.bu[ray], v = job.bv[ray], w = 1.f - u - v;
             const float* n0 = m.vertex_normals + 3 * std::size_t(m.index[3 * k]);
             const float* n1 = m.vertex_normals + 3 * std::size_t(m.index[3 * k + 1]);
             const float* n2 = m.vertex_normals + 3 * std::size_t(m.index[3 * k + 2]);
@@ -105,7 +112,8 @@ inline Vec3T<B> terminator_shifts(const ShadeJob& job, std::size_t i, const Rows
             continue;
         }
         const MeshView& m = *ob->mesh;
-        const std::size_t k = std::size_t(job.prim[i + l]);
+        const std::size_t ray = std::size_t(job.order[i + l]);
+        const std::size_t k = std::size_t(job.prim[ray]);
         for (int j = 0; j < 3; ++j) {
             const float* p = m.tri + 9 * k + 3 * std::size_t(j);
             const float* n = m.vertex_normals + 3 * std::size_t(m.index[3 * k + std::size_t(j)]);
@@ -114,8 +122,8 @@ inline Vec3T<B> terminator_shifts(const ShadeJob& job, std::size_t i, const Rows
                 corner[1][j][a][l] = n[a];
             }
         }
-        us[l] = job.bu[i + l];
-        vs[l] = job.bv[i + l];
+        us[l] = job.bu[ray];
+        vs[l] = job.bv[ray];
     }
     SmoothCorners<B> c;
     for (int j = 0; j < 3; ++j) {
@@ -154,7 +162,8 @@ inline ColorT<B> texture_colors(const ShadeJob& job, std::size_t i, const Materi
         // Lanes past the run have no triangle (their colour is never used); meshes without vt
         // read (0, 0), as the scalar path.
         const MeshView* mv = i + l < job.end ? lane_object<kGathered>(job, i, l).mesh : nullptr;
-        const UvT<float> uv = mv && mv->uv ? mesh_uv(*mv, std::uint32_t(job.prim[i + l]), job.bu[i + l], job.bv[i + l])
+        const std::size_t ray = mv ? std::size_t(job.order[i + l]) : 0;
+        const UvT<float> uv = mv && mv->uv ? mesh_uv(*mv, std::uint32_t(job.prim[ray]), job.bu[ray], job.bv[ray])
                                            : UvT<float>{0.f, 0.f};
         us[l] = uv.u;
         vs[l] = uv.v;
@@ -185,11 +194,11 @@ inline void append(const ShadeJob& job, std::size_t i, const M& active, const Ve
     compress_store(cone, bits, r.cone + j);
     B(std::numeric_limits<float>::infinity()).store_unaligned(r.t_max + j);
     const std::size_t n =
-        compress_store(xsimd::batch<std::int32_t, A>::load_unaligned(job.pixel + i), bits, r.pixel + j);
+        compress_store(gather_ints(job.pixel, rays_of<A>(job, i)), bits, r.pixel + j);
     std::memset(r.kind + j, int(kind), n);
     if (r.key)  // area lights: children inherit the key (uniform per scene)
-        compress_store(xsimd::batch<std::int32_t, A>::load_unaligned(reinterpret_cast<const std::int32_t*>(job.key + i)),
-                       bits, reinterpret_cast<std::int32_t*>(r.key + j));
+        compress_store(gather_ints(reinterpret_cast<const std::int32_t*>(job.key), rays_of<A>(job, i)), bits,
+                       reinterpret_cast<std::int32_t*>(r.key + j));
     *r.count = j + n;
 }
 
@@ -222,8 +231,7 @@ struct SimdSink {
         compress_store(c.x, bits, sa.cr + j);
         compress_store(c.y, bits, sa.cg + j);
         compress_store(c.z, bits, sa.cb + j);
-        *sa.count = j + compress_store(xsimd::batch<std::int32_t, typename B::arch_type>::load_unaligned(job.pixel + i),
-                                       bits, sa.pixel + j);
+        *sa.count = j + compress_store(gather_ints(job.pixel, rays_of<typename B::arch_type>(job, i)), bits, sa.pixel + j);
     }
     void child(const Mask& send, const Vec3T<B>& from, const Vec3T<B>& dir, const ColorT<B>& weight, const ColorT<B>&,
                const B& cone, RayKind kind) const {
@@ -231,7 +239,8 @@ struct SimdSink {
     }
     /// Area lights only: the packet's light-sampling keys.
     xsimd::batch<std::uint32_t, typename B::arch_type> light_key() const {
-        return xsimd::batch<std::uint32_t, typename B::arch_type>::load_unaligned(job.key + i);
+        return xsimd::bitwise_cast<xsimd::batch<std::uint32_t, typename B::arch_type>>(
+            gather_ints(reinterpret_cast<const std::int32_t*>(job.key), rays_of<typename B::arch_type>(job, i)));
     }
 };
 
@@ -264,17 +273,19 @@ void shade_run(const ShadeJob& job) {
         // The last packet may be partial: its extra lanes read padding and are never stored
         // into a stream (their local colour lands in padding too).
         const auto active = lanes < B(float(job.end - i));
-        const Vec3T<B> o{B::load_unaligned(job.ox + i), B::load_unaligned(job.oy + i), B::load_unaligned(job.oz + i)};
-        const Vec3T<B> d{B::load_unaligned(job.dx + i), B::load_unaligned(job.dy + i), B::load_unaligned(job.dz + i)};
-        const B t = B::load_unaligned(job.t + i);
-        const ColorT<B> w{B::load_unaligned(job.wr + i), B::load_unaligned(job.wg + i), B::load_unaligned(job.wb + i)};
+        // The packet's rays, gathered from the slice's arrays (ShadeJob::order).
+        const I at_ray = rays_of<Arch>(job, i);
+        const Vec3T<B> o{gather_floats(job.ox, at_ray), gather_floats(job.oy, at_ray), gather_floats(job.oz, at_ray)};
+        const Vec3T<B> d{gather_floats(job.dx, at_ray), gather_floats(job.dy, at_ray), gather_floats(job.dz, at_ray)};
+        const B t = gather_floats(job.t, at_ray);
+        const ColorT<B> w{gather_floats(job.wr, at_ray), gather_floats(job.wg, at_ray), gather_floats(job.wb, at_ray)};
 
         // The object of each lane: broadcast from the run's record, or gathered per lane.
         std::conditional_t<kGathered, LaneRows<B>, BroadcastRows<B>> rows;
         B param;
         ColorT<B> color;
         if constexpr (kGathered) {
-            const I ids = I::load_unaligned(job.ids + i);  // padding lanes hold id 0
+            const I ids = gather_ints(job.ids, at_ray);  // padding lanes read a hit's id
             const I at = ids * I(18), sat = ids * I(4);
             for (int k = 0; k < 12; ++k) rows.v[k] = gather_floats(object_floats + k, at);
             param = gather_floats(object_floats + 12, at);
@@ -293,7 +304,7 @@ void shade_run(const ShadeJob& job) {
         if (kLit || m.checker || m.texture)
             n_out = apply_normal(rows, kind == ShapeKind::Mesh ? mesh_normals<B, kGathered>(job, i)
                                                                 : canonical_normal(kind, pc, param));
-        const ArrivingRay<B> arriving{o, d, t, B::load_unaligned(job.cone + i), w, w};
+        const ArrivingRay<B> arriving{o, d, t, gather_floats(job.cone, at_ray), w, w};
         if (m.texture) {  // one branch per run: the texture replaces the object's colour
             const B footprint = footprint_width(arriving.cone, B(job.rules.spread), t, dot(d, n_out));
             color = texture_colors<B, kGathered>(job, i, m, kind, kind == ShapeKind::Mesh, pc, param, rows, run_scale,

@@ -47,10 +47,33 @@ inline ShadeMode resolve_shade_mode(const StreamScene& sc, ShadeMode asked) {
 
 namespace stage_detail {
 
+inline ColorT<float> load_sum(const float* accum, std::int32_t pixel) {
+    return {accum[pixel * 3 + 0], accum[pixel * 3 + 1], accum[pixel * 3 + 2]};
+}
+inline void store_sum(float* accum, std::int32_t pixel, const ColorT<float>& c) {
+    accum[pixel * 3 + 0] = c.x;
+    accum[pixel * 3 + 1] = c.y;
+    accum[pixel * 3 + 2] = c.z;
+}
 inline void add(float* accum, std::int32_t pixel, const ColorT<float>& c) {
     accum[pixel * 3 + 0] += c.x;
     accum[pixel * 3 + 1] += c.y;
     accum[pixel * 3 + 2] += c.z;
+}
+/// accum[pixel[order[j]]] += (r, g, b)[j] for j in [0, n), in that order: a run of rays of
+/// one pixel adds in registers and stores once. The same additions in the same order as one
+/// add() per ray, so the same bits; without the store-to-load wait of each ray on the one before.
+inline void add_runs(float* __restrict accum, const std::int32_t* __restrict pixel, const std::int32_t* __restrict order,
+                     const float* __restrict r, const float* __restrict g, const float* __restrict b, std::size_t n) {
+    for (std::size_t j = 0; j < n;) {
+        const std::int32_t p = pixel[order[j]];
+        float* a = accum + std::ptrdiff_t(p) * 3;
+        float sr = a[0], sg = a[1], sb = a[2];
+        do {
+            sr += r[j], sg += g[j], sb += b[j];
+        } while (++j < n && pixel[order[j]] == p);
+        a[0] = sr, a[1] = sg, a[2] = sb;
+    }
 }
 inline std::uint64_t lanes_for(std::size_t n, int width) {
     return (std::uint64_t(n) + std::uint64_t(width) - 1) / std::uint64_t(width) * std::uint64_t(width);
@@ -197,64 +220,84 @@ struct ShadeStage {
         };
         const std::size_t n_keys = gathered ? sc.materials.size() * kShapeKindCount : sc.object_count;
         h.run_start.assign(n_keys + 1, 0);
+        // Each ray's run key (kMissKey: a miss, which brings the background now), counted.
+        // Neighbouring rays mostly share their pixel and their object, so the counts and the
+        // background sums are kept in registers along a run of one key or one pixel: the
+        // same additions in the same order, without each waiting on the store of the last.
+        constexpr std::uint32_t kMissKey = ~0u;
+        std::vector<std::uint32_t>& key = ws.slot;
+        key.resize(rays.count);
         std::size_t hits = 0;
-        for (std::size_t i = 0; i < rays.count; ++i) {
-            const std::int32_t id = object[i];
-            if (id < 0) {
-                add(accum, rays.pixel[i], mul(ColorT<float>{rays.wr[i], rays.wg[i], rays.wb[i]}, sc.background));
-                continue;
+        {
+            std::uint32_t* __restrict count = h.run_start.data() + 1;
+            const std::int32_t* __restrict ids = object.data();
+            std::uint32_t* __restrict keys = key.data();
+            std::uint32_t run_key = kMissKey, run = 0;
+            std::int32_t bg_pixel = -1;  // the pixel whose background sum is in bg
+            ColorT<float> bg{};
+            for (std::size_t i = 0; i < rays.count; ++i) {
+                const std::int32_t id = ids[i];
+                if (id < 0) {
+                    keys[i] = kMissKey;
+                    const std::int32_t p = rays.pixel[i];
+                    if (p != bg_pixel) {
+                        if (bg_pixel >= 0) store_sum(accum, bg_pixel, bg);
+                        bg = load_sum(accum, p);
+                        bg_pixel = p;
+                    }
+                    bg = bg + mul(ColorT<float>{rays.wr[i], rays.wg[i], rays.wb[i]}, sc.background);
+                    continue;
+                }
+                const std::uint32_t k = std::uint32_t(key_of(id));
+                keys[i] = k;
+                if (k != run_key) {
+                    if (run > 0) count[run_key] += run;
+                    run_key = k, run = 0;
+                }
+                ++run;
+                ++hits;
             }
-            ++h.run_start[key_of(id) + 1];
-            ++hits;
+            if (run > 0) count[run_key] += run;
+            if (bg_pixel >= 0) store_sum(accum, bg_pixel, bg);
         }
         for (std::size_t k = 1; k <= n_keys; ++k) h.run_start[k] += h.run_start[k - 1];
         h.reserve(hits);
-        if (sc.features.area_lights) h.reserve_keys();
+        // The run order: the slice index of each hit, run after run, each run in stream order
+        // (a stable counting sort). The kernels read the rays through it.
         {
-            std::vector<std::uint32_t>& next_slot = ws.slot;
-            next_slot.assign(h.run_start.begin(), h.run_start.end() - 1);
+            h.fill.assign(h.run_start.begin(), h.run_start.end() - 1);
+            std::uint32_t* __restrict fill = h.fill.data();
+            const std::uint32_t* __restrict keys = key.data();
+            std::int32_t* __restrict order = h.order.data();
+            std::uint32_t run_key = kMissKey, at = 0;
             for (std::size_t i = 0; i < rays.count; ++i) {
-                const std::int32_t id = object[i];
-                if (id < 0) continue;
-                const std::size_t j = next_slot[key_of(id)]++;
-                h.ox[j] = rays.ox[i];
-                h.oy[j] = rays.oy[i];
-                h.oz[j] = rays.oz[i];
-                h.dx[j] = rays.dx[i];
-                h.dy[j] = rays.dy[i];
-                h.dz[j] = rays.dz[i];
-                h.t[j] = rays.t_max[i];
-                h.wr[j] = rays.wr[i];
-                h.wg[j] = rays.wg[i];
-                h.wb[j] = rays.wb[i];
-                h.cone[j] = rays.cone[i];
-                h.pixel[j] = rays.pixel[i];
-                if (gathered) h.object[j] = id;
-                if (sc.features.area_lights) h.key[j] = rays.key[i];
-                if (sc.has_meshes) {
-                    h.prim[j] = ws.mesh_hits.prim[i];
-                    h.bu[j] = ws.mesh_hits.u[i];
-                    h.bv[j] = ws.mesh_hits.v[i];
+                const std::uint32_t k = keys[i];
+                if (k == kMissKey) continue;
+                if (k != run_key) {
+                    if (run_key != kMissKey) fill[run_key] = at;
+                    run_key = k, at = fill[k];
                 }
+                order[at++] = std::int32_t(i);
             }
-            // A gathered packet reads a whole batch of ids past the last hit: valid ones.
-            if (gathered) std::fill_n(h.object.begin() + std::ptrdiff_t(hits), simd::kMaxLanes, 0);
+            // Past the last run, whole packets read a hit (gathered runs read its object's id).
+            std::fill_n(order + hits, simd::kMaxLanes, hits > 0 ? order[hits - 1] : 0);
         }
         const std::size_t next_before = ws.next.count;
         RayStream& nx = ws.next;
         ShadowStream& sh = ws.shadows;
-        ShadeJob job{.ox = h.ox.data(),
-                     .oy = h.oy.data(),
-                     .oz = h.oz.data(),
-                     .dx = h.dx.data(),
-                     .dy = h.dy.data(),
-                     .dz = h.dz.data(),
-                     .t = h.t.data(),
-                     .wr = h.wr.data(),
-                     .wg = h.wg.data(),
-                     .wb = h.wb.data(),
-                     .cone = h.cone.data(),
-                     .pixel = h.pixel.data(),
+        ShadeJob job{.ox = rays.ox.data(),
+                     .oy = rays.oy.data(),
+                     .oz = rays.oz.data(),
+                     .dx = rays.dx.data(),
+                     .dy = rays.dy.data(),
+                     .dz = rays.dz.data(),
+                     .t = rays.t_max.data(),
+                     .wr = rays.wr.data(),
+                     .wg = rays.wg.data(),
+                     .wb = rays.wb.data(),
+                     .cone = rays.cone.data(),
+                     .pixel = rays.pixel.data(),
+                     .order = h.order.data(),
                      .begin = 0,
                      .end = 0,
                      .object = nullptr,
@@ -268,14 +311,14 @@ struct ShadeStage {
                      .lb = h.lb.data(),
                      .next = append_view(nx),
                      .shadows = append_view(sh),
-                     .prim = h.prim.data(),
-                     .bu = h.bu.data(),
-                     .bv = h.bv.data()};
-        if (sc.features.area_lights) job.key = h.key.data(), job.next.key = nx.key.data();
+                     .prim = ws.mesh_hits.prim.data(),
+                     .bu = ws.mesh_hits.u.data(),
+                     .bv = ws.mesh_hits.v.data()};
+        if (sc.features.area_lights) job.key = rays.key.data(), job.next.key = nx.key.data();
         const int variant = (kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0);
         const ShadeFn fn = gathered ? kt.shade_gathered[variant] : kt.shade[variant];
         if (gathered) {
-            job.ids = h.object.data();
+            job.ids = object.data();
             job.objects = sc.objects;
             job.surfaces = sc.surfaces.data();
         }
@@ -294,7 +337,7 @@ struct ShadeStage {
             }
             fn(job);
         }
-        for (std::size_t j = 0; j < hits; ++j) add(accum, h.pixel[j], {h.lr[j], h.lg[j], h.lb[j]});
+        add_runs(accum, rays.pixel.data(), h.order.data(), h.lr.data(), h.lg.data(), h.lb.data(), hits);
         if constexpr (kSecondary) {
             for (std::size_t j = next_before; j < nx.count; ++j) {
                 if (nx.kind[j] == std::uint8_t(RayKind::Reflected)) ++counts.reflected;

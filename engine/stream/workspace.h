@@ -13,22 +13,17 @@ namespace streamrt {
 /// Hit rays regrouped by object (a stable counting sort), so that every SIMD packet of the
 /// shade kernel shares one object: its transforms and material are broadcast, not gathered.
 struct SortedHits {
-    AlignedVec<float> ox, oy, oz, dx, dy, dz, t, wr, wg, wb, cone, lr, lg, lb, bu, bv;
-    AlignedVec<std::int32_t> pixel, prim, object;  ///< object: gathered runs only
-    AlignedVec<std::uint32_t> key;  ///< area lights only: light-sampling keys (reserve_keys)
-    std::vector<std::uint32_t> run_start;  ///< per object, then one past the end
+    AlignedVec<float> lr, lg, lb;        ///< each hit's local colour, in run order
+    AlignedVec<std::int32_t> order;      ///< run order -> the hit's index in the slice (ShadeJob::order)
+    std::vector<std::uint32_t> run_start;  ///< per run key, then one past the end
+    std::vector<std::uint32_t> fill;       ///< per run key, the next place while ordering
     void reserve(std::size_t n) {
         // Kernels read a whole packet past the last ray of a run.
         const std::size_t cap = simd::round_up_lanes(n) + simd::kMaxLanes;
-        if (ox.size() < cap) {
-            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t, &wr, &wg, &wb, &cone, &lr, &lg, &lb, &bu, &bv}) a->resize(cap);
-            pixel.resize(cap);
-            prim.resize(cap);
-            object.resize(cap);
+        if (order.size() < cap) {
+            for (auto* a : {&lr, &lg, &lb}) a->resize(cap);
+            order.resize(cap);
         }
-    }
-    void reserve_keys() {
-        if (key.size() < ox.size()) key.resize(ox.size());
     }
 };
 
