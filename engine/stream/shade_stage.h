@@ -75,6 +75,25 @@ inline void add_runs(float* __restrict accum, const std::int32_t* __restrict pix
         a[0] = sr, a[1] = sg, a[2] = sb;
     }
 }
+/// accum[pixel[i]] += (cr, cg, cb)[i] for each unblocked shadow ray (t_max > 0), in order; a
+/// pixel's sum stays in registers until another pixel's ray comes (add_runs: the same bits).
+inline void add_unblocked(float* __restrict accum, const ShadowStream& s) {
+    const float *__restrict t = s.t_max.data(), *__restrict r = s.cr.data(), *__restrict g = s.cg.data(),
+                *__restrict b = s.cb.data();
+    const std::int32_t* __restrict pixel = s.pixel.data();
+    std::int32_t held = -1;
+    ColorT<float> sum{};
+    for (std::size_t i = 0; i < s.count; ++i) {
+        if (!(t[i] > 0.f)) continue;
+        if (pixel[i] != held) {
+            if (held >= 0) store_sum(accum, held, sum);
+            held = pixel[i];
+            sum = load_sum(accum, held);
+        }
+        sum.x += r[i], sum.y += g[i], sum.z += b[i];
+    }
+    if (held >= 0) store_sum(accum, held, sum);
+}
 inline std::uint64_t lanes_for(std::size_t n, int width) {
     return (std::uint64_t(n) + std::uint64_t(width) - 1) / std::uint64_t(width) * std::uint64_t(width);
 }
