@@ -9,12 +9,15 @@
 // geometry, a device with threads=1). High quality is Embree's SAH build with spatial splits;
 // --quality medium is its SAH build without them (what streamrt's builder does). The ray sets are perf/mesh_rays.h's, over a view fitted
 // to the mesh's bounds (1280x720 primary rays in 4x4 tiles; from their hits, shadow rays to a
-// point light, mirror-reflected rays and, as the incoherent extreme, diffuse rays). Every set
+// point light, mirror-reflected rays, rays refracted into the mesh (index 1.5: they travel
+// inside it, as a glass mesh's deeper rays do) and, as the incoherent extreme, diffuse rays). Every set
 // runs on this one thread, median of N runs (default 5), in Mrays/s:
 //   Embree16   rtcIntersect16 / rtcOccluded16 on packets of 16 consecutive rays (a 4x4 pixel
 //              tile for primary rays); the packets are filled before the clock starts
 //   Embree1    rtcIntersect1 / rtcOccluded1 ray by ray
 //   streamrt   the level's flat mesh kernel (KernelTable closest/any[Mesh]) over the stream
+//   single     streamrt's single-ray walk alone (every packet handed over at the root; the
+//              stream engine's choice for scattered packets of deep rays, --mesh-hybrid)
 // ratio = streamrt / Embree16. The numbers of rays hit (or blocked) by each are printed as a
 // check that all three traced the same rays.
 #include <embree3/rtcore.h>
@@ -209,21 +212,27 @@ int main(int argc, char** argv) {
                     "%.2f s; %dx%d view\n",
                     file.c_str(), mesh->triangle_count(), t_built - t_read,
                     quality == RTC_BUILD_QUALITY_HIGH ? "high" : "medium", t_embree, view.width, view.height);
-        std::printf("%-8s %9s %10s %10s %10s %7s   %s\n", "rays", "count", "Embree16", "Embree1", "streamrt", "ratio",
-                    "hits: Embree16 / Embree1 / streamrt");
+        std::printf("%-8s %9s %10s %10s %10s %7s %10s   %s\n", "rays", "count", "Embree16", "Embree1", "streamrt", "ratio",
+                    "single", "hits: Embree16 / Embree1 / streamrt");
+        // The same mesh with every packet handed to the single-ray walk at the root.
+        const std::shared_ptr<const Mesh> single = mesh->with_single_ray_lanes(16);
+        ObjectXf xf_single = xf;
+        xf_single.mesh = &single->view();
         struct Kind {
             const char* name;
             const Stream* st;
             bool any;
         };
         for (const Kind& k : {Kind{"primary", &s.primary, false}, Kind{"shadow", &s.shadow, true},
-                              Kind{"mirror", &s.mirror, false}, Kind{"diffuse", &s.diffuse, false}}) {
+                              Kind{"mirror", &s.mirror, false}, Kind{"glass", &s.glass, false},
+                              Kind{"diffuse", &s.diffuse, false}}) {
             const Result e16 = embree16(scene, *k.st, k.any, reps);
             const Result e1 = embree1(scene, *k.st, k.any, reps);
             std::size_t hits = 0;
             const double ours = mrays(*k.st, k.any, kt, xf, reps, &hits);
-            std::printf("%-8s %9zu %10.2f %10.2f %10.2f %6.2fx   %zu / %zu / %zu\n", k.name, k.st->count, e16.mrays,
-                        e1.mrays, ours, ours / e16.mrays, e16.hits, e1.hits, hits);
+            const double ours_single = mrays(*k.st, k.any, kt, xf_single, reps);
+            std::printf("%-8s %9zu %10.2f %10.2f %10.2f %6.2fx %10.2f   %zu / %zu / %zu\n", k.name, k.st->count,
+                        e16.mrays, e1.mrays, ours, ours / e16.mrays, ours_single, e16.hits, e1.hits, hits);
             std::fflush(stdout);
         }
         rtcReleaseScene(scene);
