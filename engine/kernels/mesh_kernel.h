@@ -54,11 +54,13 @@ template <class B>
 inline auto robust_box(const accel::WideNode& n, int j, const Vec3T<B>& o, const Vec3T<B>& inv, const B& t_max,
                        B& t_near) {
     B tn(0.f), tf = t_max;
+    // min(x, y) / max(x, y) are the minps / maxps instructions, which give y when x is NaN:
+    // the same bits as select(x < y, x, y) and select(x > y, x, y), in one instruction.
     const auto slab = [&](float lo, float hi, const B& oc, const B& ic) {
         const B a = (B(lo) - oc) * ic, b = (B(hi) - oc) * ic;
-        const B mn = xsimd::select(a < b, a, b), mx = xsimd::select(a < b, b, a);
-        tn = xsimd::select(mn > tn, mn, tn);  // NaN (0 * inf): the slab does not limit
-        tf = xsimd::select(mx < tf, mx, tf);
+        const B mn = xsimd::min(a, b), mx = xsimd::max(b, a);
+        tn = xsimd::max(mn, tn);  // NaN (0 * inf): the slab does not limit
+        tf = xsimd::min(mx, tf);
     };
     slab(n.lo_x[j], n.hi_x[j], o.x, inv.x);
     slab(n.lo_y[j], n.hi_y[j], o.y, inv.y);
