@@ -16,11 +16,12 @@ namespace streamrt {
 namespace {
 // Bytes per ray slot: RayStream 11 floats + pixel int32 + kind byte; ShadowStream 10 floats +
 // pixel int32; per traced ray: closest-hit object int32 and mesh hit (int32 + 2 floats), sized
-// as the slice's buffer (2 x slice); per hit: the sorted copy (16 floats + 3 int32).
+// as the slice's buffer (2 x slice); per ray shaded: its run key, its place in run order and
+// its local colour (2 int32 + 3 floats; the shade stage reads the rays through that order).
 constexpr double kRayBytes = 11 * 4 + 4 + 1;
 constexpr double kShadowBytes = 10 * 4 + 4;
 constexpr double kHitBytes = 4 + 12;
-constexpr double kSortedBytes = 16 * 4 + 3 * 4;
+constexpr double kSortedBytes = 2 * 4 + 3 * 4;
 constexpr double kRecursiveFrameBytes = 2048;  // one recursion level of the baseline, generous
 }  // namespace
 
