@@ -37,16 +37,6 @@ inline xsimd::batch<float, A> gather_floats(const float* src, const xsimd::batch
     return xsimd::batch<float, A>::load_aligned(out);
 }
 
-/// The same for 32-bit integers (pixel slots, light-sampling keys, object ids).
-template <class A>
-inline xsimd::batch<std::int32_t, A> gather_ints(const std::int32_t* src, const xsimd::batch<std::int32_t, A>& index) {
-    constexpr std::size_t W = xsimd::batch<std::int32_t, A>::size;
-    alignas(64) std::int32_t at[W], out[W];
-    index.store_aligned(at);
-    for (std::size_t l = 0; l < W; ++l) out[l] = src[at[l]];
-    return xsimd::batch<std::int32_t, A>::load_aligned(out);
-}
-
 template <class A, class T>
 inline std::size_t compress_store(const xsimd::batch<T, A>& v, unsigned bits, T* dst) {
     alignas(64) T tmp[xsimd::batch<T, A>::size];
@@ -61,10 +51,6 @@ inline std::size_t compress_store(const xsimd::batch<T, A>& v, unsigned bits, T*
 inline xsimd::batch<float, xsimd::avx512bw> gather_floats(const float* src,
                                                           const xsimd::batch<std::int32_t, xsimd::avx512bw>& index) {
     return _mm512_i32gather_ps(index, src, 4);
-}
-inline xsimd::batch<std::int32_t, xsimd::avx512bw> gather_ints(const std::int32_t* src,
-                                                               const xsimd::batch<std::int32_t, xsimd::avx512bw>& index) {
-    return _mm512_i32gather_epi32(index, src, 4);
 }
 inline unsigned lane_bits(const xsimd::batch_bool<float, xsimd::avx512bw>& m) { return unsigned(m.data); }
 inline std::size_t compress_store(const xsimd::batch<float, xsimd::avx512bw>& v, unsigned bits, float* dst) {
@@ -103,10 +89,6 @@ inline __m256i permutation(unsigned bits) {
 inline xsimd::batch<float, xsimd::fma3<xsimd::avx2>> gather_floats(
     const float* src, const xsimd::batch<std::int32_t, xsimd::fma3<xsimd::avx2>>& index) {
     return _mm256_i32gather_ps(src, index, 4);
-}
-inline xsimd::batch<std::int32_t, xsimd::fma3<xsimd::avx2>> gather_ints(
-    const std::int32_t* src, const xsimd::batch<std::int32_t, xsimd::fma3<xsimd::avx2>>& index) {
-    return _mm256_i32gather_epi32(src, index, 4);
 }
 inline unsigned lane_bits(const xsimd::batch_bool<float, xsimd::fma3<xsimd::avx2>>& m) {
     return unsigned(_mm256_movemask_ps(m));
