@@ -81,6 +81,8 @@ struct Workspace {
     MeshHits mesh_hits;               ///< triangle and barycentrics per ray of the slice (mesh hits)
     ShadowStream shadows, shadows_in_pixel_order;
     SortedHits sorted;
+    /// Scratch of the shade stage, one use at a time: each ray's run key (shade_sorted), then
+    /// each pixel's first shadow ray (order_shadows_by_pixel).
     std::vector<std::uint32_t> slot;
 };
 
