@@ -224,9 +224,10 @@ struct ShadeStage {
         }
     }
 
-    /// shade + spawn, SIMD: misses bring the background; hits are regrouped by object and
-    /// each run goes through the shade kernel; local colours then go into the tile in the
-    /// sorted order (fixed for a given tile, so the picture does not depend on threads).
+    /// shade + spawn, SIMD: misses bring the background; hits are put in runs by object (an
+    /// index in run order, SortedHits::order) and each run goes through the shade kernel;
+    /// local colours then go into the tile in run order (fixed for a given tile, so the
+    /// picture does not depend on threads).
     static void shade_sorted(const StreamScene& sc, const KernelTable& kt, const RayStream& rays,
                              const AlignedVec<std::int32_t>& object, int depth, Workspace& ws, float* accum,
                              RayCounts& counts, bool gathered) {
