@@ -75,6 +75,42 @@ inline Vec3T<B> vertex(const MeshView& m, std::uint32_t k, int j) {
     return {B(p[0]), B(p[1]), B(p[2])};
 }
 
+/// The watertight test's axis permutation (kx, ky, kz as 0, 1, 2) when every lane of `live`
+/// has the same one, as coherent packets (camera rays of a tile, shadow rays of a patch
+/// towards one light) almost always do: the leaves then read each triangle's permuted
+/// coordinates once, instead of choosing them lane by lane with 18 selects per triangle.
+/// False when the lanes differ (or none is live).
+template <class B>
+inline bool shared_axes(const WatertightRay<B>& wr, std::uint32_t live, int axes[3]) {
+    const auto axis = [live](const auto& is0, const auto& is1, int& out) {
+        const std::uint32_t b0 = movemask_bits(is0) & live, b1 = movemask_bits(is1) & live;
+        if ((b0 != 0 && b0 != live) || (b1 != 0 && b1 != live)) return false;
+        out = b0 ? 0 : b1 ? 1 : 2;
+        return true;
+    };
+    return live != 0 && axis(wr.kx0, wr.kx1, axes[0]) && axis(wr.ky0, wr.ky1, axes[1]) && axis(wr.kz0, wr.kz1, axes[2]);
+}
+
+/// The corners of triangle k relative to the rays' origins on the shared axes (shared_axes):
+/// the same operations, per lane, as triangle_sheared's subtraction then pick, so the same bits.
+template <class B>
+struct SharedAxesTriangles {
+    int axis[3];
+    Vec3T<B> o_perm;  ///< the origins' coordinates on those axes
+    SharedAxesTriangles(const int axes[3], const Vec3T<B>& o) {
+        const B oc[3] = {o.x, o.y, o.z};
+        for (int a = 0; a < 3; ++a) axis[a] = axes[a];
+        o_perm = {oc[axes[0]], oc[axes[1]], oc[axes[2]]};
+    }
+    Vec3T<B> corner(const MeshView& m, std::uint32_t k, int j) const {
+        const float* p = m.tri + 9 * std::size_t(k) + 3 * j;
+        return {B(p[axis[0]]) - o_perm.x, B(p[axis[1]]) - o_perm.y, B(p[axis[2]]) - o_perm.z};
+    }
+    tri_detail::Sheared<B> sheared(const WatertightRay<B>& wr, const MeshView& m, std::uint32_t k) const {
+        return tri_detail::shear(wr, corner(m, k, 0), corner(m, k, 1), corner(m, k, 2));
+    }
+};
+
 /// The lanes of `lanes` whose ray meets one of node n's child boxes within (0, t_max). A
 /// packet handed to the single-ray walk at the root first passes this one packet test, so
 /// that a lane missing the whole mesh (a ray inside one glass mesh, against the scene's other
@@ -114,12 +150,12 @@ inline std::uint32_t scattered_packet_lanes(const Vec3T<B>& d, const M& live, st
     return xsimd::any(live && (cos_to_mean < B(kScatteredPacketCos))) ? lanes : 0u;
 }
 
-/// Closest hit of the canonical packet (o, d) with the mesh for t in (0, best): shrinks best
-/// per lane and, for the lanes it shrank, writes triangle number and barycentrics into
-/// prim/u/v[0 .. W) (when prim is not null). single_lanes: see the hybrid above (0: packet only).
-template <class B>
-inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, B& best, std::int32_t* prim,
-                                float* u, float* v, std::uint32_t single_lanes) {
+/// mesh_closest_packet's walk; Shared: the live lanes share the triangle test's axes, and the
+/// leaves read the permuted corners from `shared`.
+template <bool Shared, class B>
+inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, B& best,
+                                     std::int32_t* prim, float* u, float* v, std::uint32_t single_lanes,
+                                     const WatertightRay<B>& wr, const mesh_detail::SharedAxesTriangles<B>& shared) {
     using namespace mesh_detail;
     using I = xsimd::batch<std::int32_t, typename B::arch_type>;
     using Archs = SingleRayArchs<typename B::arch_type>;
@@ -127,9 +163,7 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
     if (!m.nodes) return;
     const B start = best;
     float best_max = lanes_max(best);
-    if (!(best_max > 0.f)) return;
     const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
-    const WatertightRay<B> wr = watertight_ray(o, d);
     B bu(0.f), bv(0.f);
     I bprim(-1);
     // Lanes handed to the single-ray walk: rays, then the hits as arrays, loaded back after.
@@ -173,7 +207,8 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
         }
         if (e.count > 0) {
             for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
-                const auto sheared = triangle_sheared(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2));
+                const auto sheared = Shared ? shared.sheared(wr, m, k)
+                                            : triangle_sheared(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2));
                 if (!xsimd::any(triangle_may_hit(sheared, best))) continue;
                 const TriangleHit<B> h = triangle_hit_sheared(sheared, B(0.f), best);
                 const auto closer = h.t < best;
@@ -222,18 +257,36 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
         }
 }
 
-/// Any hit for t in (0, t_max) of the lanes in `open`: the lanes the mesh blocks.
-/// single_lanes: see the hybrid above (0: packet only).
-template <class B, class M>
-inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, const B& t_max, M open,
-                         std::uint32_t single_lanes) {
+/// Closest hit of the canonical packet (o, d) with the mesh for t in (0, best): shrinks best
+/// per lane and, for the lanes it shrank, writes triangle number and barycentrics into
+/// prim/u/v[0 .. W) (when prim is not null). single_lanes: see the hybrid above (0: packet only).
+/// The walk is built twice, for packets whose live lanes share the triangle test's axes and
+/// for the others (shared_axes).
+template <class B>
+inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, B& best, std::int32_t* prim,
+                                float* u, float* v, std::uint32_t single_lanes) {
+    if (!m.nodes || !(lanes_max(best) > 0.f)) return;
+    const WatertightRay<B> wr = watertight_ray(o, d);
+    int axes[3] = {0, 1, 2};
+    const bool shared = mesh_detail::shared_axes(wr, movemask_bits(best > B(0.f)), axes);
+    const mesh_detail::SharedAxesTriangles<B> corners(axes, o);
+    if (shared) {
+        mesh_closest_packet_walk<true>(m, o, d, best, prim, u, v, single_lanes, wr, corners);
+    } else {
+        mesh_closest_packet_walk<false>(m, o, d, best, prim, u, v, single_lanes, wr, corners);
+    }
+}
+
+/// mesh_any_packet's walk; Shared as for mesh_closest_packet_walk.
+template <bool Shared, class B, class M>
+inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, const B& t_max, M open,
+                              std::uint32_t single_lanes, const WatertightRay<B>& wr,
+                              const mesh_detail::SharedAxesTriangles<B>& shared) {
     using namespace mesh_detail;
     using Archs = SingleRayArchs<typename B::arch_type>;
     constexpr std::size_t W = B::size;
     M blocked = B(0.f) != B(0.f);
-    if (!m.nodes || !xsimd::any(open)) return blocked;
     const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
-    const WatertightRay<B> wr = watertight_ray(o, d);
     const PacketLanes<B> lanes(o, d);
     // The open lanes of e, finished one by one by the single-ray walk.
     const auto hand_over = [&](const PacketEntry& e) {
@@ -261,7 +314,10 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
         if (e.count > 0) {
             for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
                 const auto now =
-                    open && triangle_blocks(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2), t_max);
+                    open && triangle_blocks_sheared(Shared ? shared.sheared(wr, m, k)
+                                                            : triangle_sheared(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1),
+                                                                               vertex<B>(m, k, 2)),
+                                                    t_max);
                 blocked = blocked || now;
                 open = open && !now;
             }
@@ -277,6 +333,20 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
         }
     }
     return blocked;
+}
+
+/// Any hit for t in (0, t_max) of the lanes in `open`: the lanes the mesh blocks.
+/// single_lanes: see the hybrid above (0: packet only). Built twice, as mesh_closest_packet.
+template <class B, class M>
+inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, const B& t_max, M open,
+                         std::uint32_t single_lanes) {
+    if (!m.nodes || !xsimd::any(open)) return B(0.f) != B(0.f);
+    const WatertightRay<B> wr = watertight_ray(o, d);
+    int axes[3] = {0, 1, 2};
+    const bool shared = mesh_detail::shared_axes(wr, movemask_bits(open), axes);
+    const mesh_detail::SharedAxesTriangles<B> corners(axes, o);
+    return shared ? mesh_any_packet_walk<true>(m, o, d, t_max, open, single_lanes, wr, corners)
+                  : mesh_any_packet_walk<false>(m, o, d, t_max, open, single_lanes, wr, corners);
 }
 
 }  // namespace streamrt::STREAMRT_ISA_NAMESPACE

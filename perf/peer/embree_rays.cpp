@@ -1,7 +1,10 @@
 // Embree 3 against streamrt's mesh kernels on the same rays (docs/performance.md, "Against
 // POV-Ray and Embree"). Not a test; built only when CMake finds Embree 3 (perf/CMakeLists.txt).
 //
-//   embree_rays [--reps N] [--isa LEVEL] [--quality medium|high] MESH.{obj,ply} ...
+//   embree_rays [--reps N] [--isa LEVEL] [--quality medium|high] [--rays KIND,...] MESH.{obj,ply} ...
+//
+// --rays keeps only the listed ray sets (primary, shadow, mirror, glass, diffuse), e.g. to
+// profile one of them with perf.
 //
 // Each mesh is read by streamrt's own reader (load_mesh_file) and built twice: streamrt's mesh
 // (its 8-wide hierarchy, as a scene uses it) and an Embree scene of the same triangles, in the
@@ -161,6 +164,7 @@ int main(int argc, char** argv) {
     int reps = 5;
     RTCBuildQuality quality = RTC_BUILD_QUALITY_HIGH;
     std::vector<std::string> files;
+    std::string only;  // --rays: comma-separated kinds, empty = all
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--reps" && i + 1 < argc) {
@@ -171,9 +175,11 @@ int main(int argc, char** argv) {
             const std::string q = argv[++i];
             if (q != "medium" && q != "high") return std::fprintf(stderr, "--quality: medium or high\n"), 2;
             quality = q == "high" ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
+        } else if (a == "--rays" && i + 1 < argc) {
+            only = "," + std::string(argv[++i]) + ",";
         } else if (a == "-h" || a == "--help" || a.rfind("--", 0) == 0) {
             std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa sse2|sse4.2|avx2|avx512] [--quality medium|high] "
-                                 "MESH.{obj,ply} ...\n");
+                                 "[--rays primary,shadow,mirror,glass,diffuse] MESH.{obj,ply} ...\n");
             return a == "-h" || a == "--help" ? 0 : 2;
         } else {
             files.push_back(a);
@@ -226,6 +232,7 @@ int main(int argc, char** argv) {
         for (const Kind& k : {Kind{"primary", &s.primary, false}, Kind{"shadow", &s.shadow, true},
                               Kind{"mirror", &s.mirror, false}, Kind{"glass", &s.glass, false},
                               Kind{"diffuse", &s.diffuse, false}}) {
+            if (!only.empty() && only.find("," + std::string(k.name) + ",") == std::string::npos) continue;
             const Result e16 = embree16(scene, *k.st, k.any, reps);
             const Result e1 = embree1(scene, *k.st, k.any, reps);
             std::size_t hits = 0;

@@ -9,6 +9,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -271,4 +272,63 @@ TEST_CASE("mesh walks: packets of one direction octant that reach different leav
             c.t_max.push_back(i % 3 ? 1e30f : 0.5f);  // a third end halfway to their target
         }
     check_against_oracle(mesh, c);
+}
+
+TEST_CASE("mesh walks: packets whose lanes share the triangle test's axes give the bits of the general test") {
+    // A packet whose live lanes have one axis permutation (the dominant axis of the direction
+    // and its sign) reads each triangle's permuted corners once (mesh_kernel.h, shared_axes);
+    // any other packet picks them lane by lane. Rays with +z dominant aimed at a soup's
+    // triangles are traced twice: in packets of their own (the shared path), and with the last
+    // lane of every packet replaced by a ray along +x (the general path for the other lanes).
+    // Their t, triangle and barycentrics must match to the bit, and the shared stream must
+    // agree with the oracle.
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<float> u(-1.5f, 1.5f), w(0.05f, 0.9f);
+    const MeshData sd = soup(300, rng);
+    const auto mesh = Mesh::build("soup", sd.positions, sd.triangles);
+    Case shared;
+    while (shared.o.size() < 1024) {
+        const Vec3f o{u(rng), u(rng), -2.5f};
+        const float* p = &mesh->tri[9 * (std::size_t(rng()) % mesh->triangle_count())];
+        const float a = w(rng), b = (1.f - a) * w(rng);
+        const Vec3f q{p[0] + a * (p[3] - p[0]) + b * (p[6] - p[0]), p[1] + a * (p[4] - p[1]) + b * (p[7] - p[1]),
+                      p[2] + a * (p[5] - p[2]) + b * (p[8] - p[2])};
+        const Vec3f d = q - o;
+        if (!(d.z > std::abs(d.x) && d.z > std::abs(d.y))) continue;  // +z dominant
+        shared.o.push_back(o), shared.d.push_back(d);
+        shared.t_max.push_back(shared.o.size() % 3 ? 1e30f : 0.8f);
+    }
+    check_against_oracle(mesh, shared);
+    for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
+        if (!isa_supported(isa)) continue;
+        const std::string isa_str = isa_name(isa);
+        CAPTURE(isa_str);
+        const KernelTable& kt = kernel_table(isa);
+        const std::size_t lanes = std::size_t(kt.float_lanes);
+        Case mixed = shared;
+        for (std::size_t i = lanes - 1; i < mixed.o.size(); i += lanes) mixed.d[i] = {1.f, 0.1f, 0.2f};
+        ObjectXf xf{};
+        xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
+        xf.mesh = &mesh->view();
+        Traced a(shared), b(mixed);
+        kt.closest[int(ShapeKind::Mesh)](a.view, a.id.data(), &xf, 1);
+        kt.closest[int(ShapeKind::Mesh)](b.view, b.id.data(), &xf, 1);
+        RayStream sa, sb;
+        fill(sa, shared);
+        fill(sb, mixed);
+        kt.any[int(ShapeKind::Mesh)](view_of(sa), &xf, 1);
+        kt.any[int(ShapeKind::Mesh)](view_of(sb), &xf, 1);
+        std::size_t differ = 0, hits = 0, blocked = 0;
+        for (std::size_t i = 0; i < shared.o.size(); ++i) {
+            if (i % lanes == lanes - 1) continue;
+            hits += a.id[i] == 0;
+            blocked += sa.t_max[i] == 0.f;
+            differ += a.id[i] != b.id[i] || a.prim[i] != b.prim[i] || sa.t_max[i] != sb.t_max[i] ||
+                      std::memcmp(&a.rs.t_max[i], &b.rs.t_max[i], 4) != 0 || std::memcmp(&a.bu[i], &b.bu[i], 4) != 0 ||
+                      std::memcmp(&a.bv[i], &b.bv[i], 4) != 0;
+        }
+        CHECK(differ == 0);
+        CHECK(hits > 500);  // most rays reach their triangle (or one in front of it)
+        CHECK(blocked > 500);
+    }
 }
