@@ -131,8 +131,8 @@ inline void prefetch_child(const MeshView& m, const Entry& e) {
 /// origin; a NaN origin would pass it, hence the check of its child number. Inlined into the
 /// walk, so the ray's constants stay in registers from node to node.
 template <class NodeArch, class LeafArch>
-[[gnu::always_inline]] inline int single_node_hits(const MeshView& m, const accel::WideNode& n, const SingleRay<NodeArch, LeafArch>& r,
-                            float t_max, Entry* hits) {
+[[gnu::always_inline]] inline int single_node_hits(const MeshView& m, const accel::WideNode& n,
+                                                   const SingleRay<NodeArch, LeafArch>& r, float t_max, Entry* hits) {
     using NB = typename SingleRay<NodeArch, LeafArch>::NB;
     constexpr std::size_t NW = NB::size;
     const float* base = reinterpret_cast<const float*>(&n);
