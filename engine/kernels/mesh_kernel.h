@@ -115,10 +115,9 @@ struct SharedAxesTriangles {
 /// the lane-permute instruction (vpermps) from one load of the corner's 3 floats, where
 /// triangle_sheared picks them with two selects per coordinate: 3 loads and 9 permutes per
 /// triangle instead of 9 broadcasts and 18 selects. The same values, so the same bits.
-/// AVX2 and AVX-512 only (kAvailable); the SSE levels keep the selects.
+/// AVX2 and AVX-512 only; the SSE levels keep the selects.
 template <class B>
 struct LanePermutedTriangles {
-    static constexpr bool kAvailable = false;
     LanePermutedTriangles(const WatertightRay<B>&, const Vec3T<B>&) {}
     tri_detail::Sheared<B> sheared(const WatertightRay<B>& wr, const MeshView& m, std::uint32_t k) const {
         return triangle_sheared(wr, vertex<B>(m, k, 0), vertex<B>(m, k, 1), vertex<B>(m, k, 2));
@@ -128,7 +127,6 @@ struct LanePermutedTriangles {
 template <class B>
     requires(B::size == 8 || B::size == 16)
 struct LanePermutedTriangles<B> {
-    static constexpr bool kAvailable = true;
     using I = xsimd::batch<std::int32_t, typename B::arch_type>;
     I index[3];       ///< kx, ky, kz of each lane as 0, 1, 2
     Vec3T<B> o_perm;  ///< each lane's origin on its axes
@@ -142,14 +140,15 @@ struct LanePermutedTriangles<B> {
         o_perm = {tri_detail::pick(wr.kx0, wr.kx1, o), tri_detail::pick(wr.ky0, wr.ky1, o),
                   tri_detail::pick(wr.kz0, wr.kz1, o)};
     }
+    /// Lane l of the result: p[idx[l]], from a load of p[0 .. 3) alone (masked: the corner may
+    /// be the last 3 floats of the array).
     static B permute(const I& idx, const float* p) {
-        if constexpr (B::size == 16) {
 #if defined(__AVX512F__)
-            return B(_mm512_permutexvar_ps(idx, _mm512_maskz_loadu_ps(0x7, p)));
+        if constexpr (B::size == 16) return B(_mm512_permutexvar_ps(idx, _mm512_maskz_loadu_ps(0x7, p)));
 #endif
-        } else {
-            return B(_mm256_permutevar8x32_ps(_mm256_maskload_ps(p, _mm256_setr_epi32(-1, -1, -1, 0, 0, 0, 0, 0)), idx));
-        }
+        if constexpr (B::size == 8)
+            return B(_mm256_permutevar8x32_ps(_mm256_maskload_ps(p, _mm256_setr_epi32(-1, -1, -1, 0, 0, 0, 0, 0)),
+                                              idx));
     }
     Vec3T<B> corner(const MeshView& m, std::uint32_t k, int j) const {
         const float* p = m.tri + 9 * std::size_t(k) + 3 * j;
@@ -200,21 +199,19 @@ inline std::uint32_t scattered_packet_lanes(const Vec3T<B>& d, const M& live, st
     return xsimd::any(live && (cos_to_mean < B(kScatteredPacketCos))) ? lanes : 0u;
 }
 
-/// mesh_closest_packet's walk; Shared: the live lanes share the triangle test's axes, and the
-/// leaves read the permuted corners from `shared`.
-template <bool Shared, class B>
+/// mesh_closest_packet's walk; the leaves read each triangle's permuted corners through
+/// `corners` (SharedAxesTriangles or LanePermutedTriangles).
+template <class B, class Corners>
 inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, B& best,
                                      std::int32_t* prim, float* u, float* v, std::uint32_t single_lanes,
-                                     const WatertightRay<B>& wr, const mesh_detail::SharedAxesTriangles<B>& shared) {
+                                     const WatertightRay<B>& wr, const Corners& corners) {
     using namespace mesh_detail;
     using I = xsimd::batch<std::int32_t, typename B::arch_type>;
     using Archs = SingleRayArchs<typename B::arch_type>;
     constexpr std::size_t W = B::size;
-    if (!m.nodes) return;
     const B start = best;
     float best_max = lanes_max(best);
     const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
-    const LanePermutedTriangles<B> lane_permuted(wr, o);
     B bu(0.f), bv(0.f);
     I bprim(-1);
     // Lanes handed to the single-ray walk: rays, then the hits as arrays, loaded back after.
@@ -258,7 +255,7 @@ inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const
         }
         if (e.count > 0) {
             for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
-                const auto sheared = Shared ? shared.sheared(wr, m, k) : lane_permuted.sheared(wr, m, k);
+                const auto sheared = corners.sheared(wr, m, k);
                 if (!xsimd::any(triangle_may_hit(sheared, best))) continue;
                 const TriangleHit<B> h = triangle_hit_sheared(sheared, B(0.f), best);
                 const auto closer = h.t < best;
@@ -317,27 +314,23 @@ inline void mesh_closest_packet(const MeshView& m, const Vec3T<B>& o, const Vec3
                                 float* u, float* v, std::uint32_t single_lanes) {
     if (!m.nodes || !(lanes_max(best) > 0.f)) return;
     const WatertightRay<B> wr = watertight_ray(o, d);
-    int axes[3] = {0, 1, 2};
-    const bool shared = mesh_detail::shared_axes(wr, movemask_bits(best > B(0.f)), axes);
-    const mesh_detail::SharedAxesTriangles<B> corners(axes, o);
-    if (shared) {
-        mesh_closest_packet_walk<true>(m, o, d, best, prim, u, v, single_lanes, wr, corners);
-    } else {
-        mesh_closest_packet_walk<false>(m, o, d, best, prim, u, v, single_lanes, wr, corners);
-    }
+    using namespace mesh_detail;
+    int axes[3];
+    if (shared_axes(wr, movemask_bits(best > B(0.f)), axes))
+        mesh_closest_packet_walk(m, o, d, best, prim, u, v, single_lanes, wr, SharedAxesTriangles<B>(axes, o));
+    else
+        mesh_closest_packet_walk(m, o, d, best, prim, u, v, single_lanes, wr, LanePermutedTriangles<B>(wr, o));
 }
 
-/// mesh_any_packet's walk; Shared as for mesh_closest_packet_walk.
-template <bool Shared, class B, class M>
+/// mesh_any_packet's walk; `corners` as for mesh_closest_packet_walk.
+template <class B, class M, class Corners>
 inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d, const B& t_max, M open,
-                              std::uint32_t single_lanes, const WatertightRay<B>& wr,
-                              const mesh_detail::SharedAxesTriangles<B>& shared) {
+                              std::uint32_t single_lanes, const WatertightRay<B>& wr, const Corners& corners) {
     using namespace mesh_detail;
     using Archs = SingleRayArchs<typename B::arch_type>;
     constexpr std::size_t W = B::size;
     M blocked = B(0.f) != B(0.f);
     const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
-    const LanePermutedTriangles<B> lane_permuted(wr, o);
     const PacketLanes<B> lanes(o, d);
     // The open lanes of e, finished one by one by the single-ray walk.
     const auto hand_over = [&](const PacketEntry& e) {
@@ -364,9 +357,7 @@ inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<
         }
         if (e.count > 0) {
             for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
-                const auto now =
-                    open && triangle_blocks_sheared(Shared ? shared.sheared(wr, m, k) : lane_permuted.sheared(wr, m, k),
-                                                    t_max);
+                const auto now = open && triangle_blocks_sheared(corners.sheared(wr, m, k), t_max);
                 blocked = blocked || now;
                 open = open && !now;
             }
@@ -391,11 +382,11 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
                          std::uint32_t single_lanes) {
     if (!m.nodes || !xsimd::any(open)) return B(0.f) != B(0.f);
     const WatertightRay<B> wr = watertight_ray(o, d);
-    int axes[3] = {0, 1, 2};
-    const bool shared = mesh_detail::shared_axes(wr, movemask_bits(open), axes);
-    const mesh_detail::SharedAxesTriangles<B> corners(axes, o);
-    return shared ? mesh_any_packet_walk<true>(m, o, d, t_max, open, single_lanes, wr, corners)
-                  : mesh_any_packet_walk<false>(m, o, d, t_max, open, single_lanes, wr, corners);
+    using namespace mesh_detail;
+    int axes[3];
+    if (shared_axes(wr, movemask_bits(open), axes))
+        return mesh_any_packet_walk(m, o, d, t_max, open, single_lanes, wr, SharedAxesTriangles<B>(axes, o));
+    return mesh_any_packet_walk(m, o, d, t_max, open, single_lanes, wr, LanePermutedTriangles<B>(wr, o));
 }
 
 }  // namespace streamrt::STREAMRT_ISA_NAMESPACE
