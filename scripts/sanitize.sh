@@ -13,9 +13,9 @@
 #                                               build-tsan-std/ with the loops on std::thread
 #                                               instead of oneTBB (STREAMRT_STD_THREADS in
 #                                               engine/parallel/parallelism.h)
-# RelWithDebInfo: the top-level CMakeLists.txt sets its flags (-O3 -DNDEBUG, and -g1 with a
-# sanitizer: line tables, enough for file:line in reports), so the sanitizers see the code that
-# ships; the perf targets are not built.
+# RelWithDebInfo: the top-level CMakeLists.txt sets its flags (with a sanitizer -O1 -DNDEBUG
+# and -g1: line tables, enough for file:line in reports; -O1 as the sanitizers' documentation
+# advises, and the build takes a third of its -O3 time); the perf targets are not built.
 # JOBS (default 1) sets the build parallelism: sanitizer builds need much memory per job.
 set -euo pipefail
 cd "$(dirname "$0")/.."
