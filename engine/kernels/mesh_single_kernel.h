@@ -70,6 +70,7 @@ struct SingleRay {
     LB o_perm[3];  ///< origin's coordinates on those axes
     WatertightRay<LB> wr;  ///< sx, sy, sz used (the permutation masks are axis[] here)
 
+    SingleRay() = default;
     SingleRay(const Vec3f& o, const Vec3f& d) : ox(o.x), oy(o.y), oz(o.z), ix(1.f / d.x), iy(1.f / d.y), iz(1.f / d.z) {
         const float inv[3] = {1.f / d.x, 1.f / d.y, 1.f / d.z};
         for (int a = 0; a < 3; ++a) {
@@ -246,6 +247,44 @@ inline void walk_single(const MeshView& m, const SingleRay<NodeArch, LeafArch>& 
     }
 }
 
+/// One ray's closest-hit walk as a sequence of steps (a node or a leaf each), so that two
+/// walks can be interleaved: the same visits in the same order as walk_single with
+/// single_leaf_closest, so the same answer to the bit.
+template <class NodeArch, class LeafArch>
+struct ClosestWalk {
+    const MeshView* mesh;
+    SingleRay<NodeArch, LeafArch> r;
+    float best;
+    MeshHit hit;
+    Entry e;
+    int sp;
+    Entry stack[kStack];
+    void begin(const MeshView& m, const Vec3f& o, const Vec3f& d, float t_max, const MeshHit& h, Entry start) {
+        mesh = &m;
+        r = SingleRay<NodeArch, LeafArch>(o, d);
+        best = t_max;
+        hit = h;
+        e = {start.child, start.count, 0.f};
+        sp = 0;
+    }
+    /// Visits the current entry and moves to the next; false when the walk is over.
+    [[gnu::always_inline]] bool step() {
+        const MeshView& m = *mesh;
+        if (e.count > 0) {
+            single_leaf_closest(m, r, std::uint32_t(e.child), e.count, best, hit);
+        } else if (const int nh = single_node_hits(m, m.nodes[e.child], r, best, stack + sp); nh > 0) {
+            sp += nh - 1;
+            e = stack[sp];
+            return true;
+        }
+        do {
+            if (sp == 0) return false;
+            e = stack[--sp];
+        } while (e.t > best);
+        return true;
+    }
+};
+
 }  // namespace mesh_detail
 
 /// Closest hit of the ray (o, d) with the part of the mesh under `start` (the root: {0, 0,
@@ -264,6 +303,30 @@ template <class NodeArch, class LeafArch>
         return false;
     });
     return best;
+}
+
+/// mesh_closest_single for N rays at once, their walks interleaved step by step. A walk is a
+/// chain of dependent loads and compares (pop, node, child, leaf) that leaves most of the
+/// core idle; independent chains fill it. Each ray gets the answer it would get alone.
+template <int N, class NodeArch, class LeafArch>
+[[gnu::noinline]] inline void mesh_closest_single_group(const MeshView& m, const Vec3f* o, const Vec3f* d,
+                                                        float* best, MeshHit* hit, mesh_detail::Entry start) {
+    using namespace mesh_detail;
+    ClosestWalk<NodeArch, LeafArch> w[N];
+    bool more[N];
+    for (int i = 0; i < N; ++i) {
+        w[i].begin(m, o[i], d[i], best[i], hit[i], start);
+        more[i] = true;
+    }
+    for (bool any = true; any;) {
+        any = false;
+        for (int i = 0; i < N; ++i)
+            if (more[i]) any |= (more[i] = w[i].step());
+    }
+    for (int i = 0; i < N; ++i) {
+        best[i] = w[i].best;
+        hit[i] = w[i].hit;
+    }
 }
 
 /// Whether the mesh blocks the ray (o, d) for t in (0, t_max), under `start` as above.
