@@ -249,7 +249,9 @@ inline void walk_single(const MeshView& m, const SingleRay<NodeArch, LeafArch>& 
 
 /// One ray's closest-hit walk as a sequence of steps (a node or a leaf each), so that two
 /// walks can be interleaved: the same visits in the same order as walk_single with
-/// single_leaf_closest, so the same answer to the bit.
+/// single_leaf_closest, so the same answer to the bit. walk_single keeps its own loop:
+/// written as steps of a struct like this one, its position and stack pointer lived in
+/// memory beside the stack it writes, and the any-hit walk lost 12 - 15 % (measured).
 template <class NodeArch, class LeafArch>
 struct ClosestWalk {
     const MeshView* mesh;
