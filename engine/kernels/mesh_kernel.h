@@ -223,7 +223,7 @@ inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const
         bu.store_aligned(u_l);
         bv.store_aligned(v_l);
         bprim.store_aligned(p_l);
-        // The lanes to finish, walked in pairs (mesh_closest_single_group), the odd one alone.
+        // The lanes to finish, walked in pairs (mesh_closest_single_pair), the odd one alone.
         // Measured (docs/performance.md, "Two rays per single-ray walk"): pairs made the
         // single-ray walk 1.1 - 1.3x faster; groups of 4 gained nothing over pairs.
         int go[W], n_go = 0;
@@ -235,8 +235,8 @@ inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const
             const Vec3f o2[2] = {lanes.origin(l0), lanes.origin(l1)}, d2[2] = {lanes.direction(l0), lanes.direction(l1)};
             float t2[2] = {t_l[l0], t_l[l1]};
             MeshHit h2[2] = {{p_l[l0], u_l[l0], v_l[l0]}, {p_l[l1], u_l[l1], v_l[l1]}};
-            mesh_closest_single_group<2, typename Archs::node, typename Archs::leaf>(m, o2, d2, t2, h2,
-                                                                                    {e.child, e.count, 0.f});
+            mesh_closest_single_pair<typename Archs::node, typename Archs::leaf>(m, o2, d2, t2, h2,
+                                                                                {e.child, e.count, 0.f});
             for (int q = 0; q < 2; ++q) {
                 const int l = go[k + q];
                 t_l[l] = t2[q];

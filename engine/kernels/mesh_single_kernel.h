@@ -70,7 +70,6 @@ struct SingleRay {
     LB o_perm[3];  ///< origin's coordinates on those axes
     WatertightRay<LB> wr;  ///< sx, sy, sz used (the permutation masks are axis[] here)
 
-    SingleRay() = default;
     SingleRay(const Vec3f& o, const Vec3f& d) : ox(o.x), oy(o.y), oz(o.z), ix(1.f / d.x), iy(1.f / d.y), iz(1.f / d.z) {
         const float inv[3] = {1.f / d.x, 1.f / d.y, 1.f / d.z};
         for (int a = 0; a < 3; ++a) {
@@ -221,71 +220,41 @@ inline bool single_leaf_any(const MeshView& m, const SingleRay<NodeArch, LeafArc
     return false;
 }
 
-/// The walk itself, front to back from `start`: leaf(first, count) tests a leaf and returns
-/// true to stop; t_max (which the leaf may shrink) bounds the boxes, and a pop entered
-/// beyond it is skipped.
+/// One step of a walk, front to back: visits the entry e (a node or a leaf) and moves e to the
+/// next, popping from stack[0 .. sp). leaf(first, count) tests a leaf and returns true to
+/// stop; t_max (which the leaf may shrink) bounds the boxes, and a pop entered beyond it is
+/// skipped. False when the walk is over. The walk's position (e, sp, stack) belongs to the
+/// caller as local variables: kept in a struct, e and sp lived in memory beside the stack
+/// the step writes, and the any-hit walk lost 12 - 15 % (measured).
+template <class NodeArch, class LeafArch, class Leaf>
+[[gnu::always_inline]] inline bool walk_step(const MeshView& m, const SingleRay<NodeArch, LeafArch>& r,
+                                             const float& t_max, Leaf&& leaf, Entry& e, int& sp, Entry* stack) {
+    if (e.count > 0) {
+        if (leaf(std::uint32_t(e.child), e.count)) return false;
+    } else if (const int nh = single_node_hits(m, m.nodes[e.child], r, t_max, stack + sp); nh > 0) {
+        // The nearest child is the last one written: visit it now (its entry is within
+        // t_max), the others stay pushed.
+        sp += nh - 1;
+        e = stack[sp];
+        return true;
+    }
+    do {
+        if (sp == 0) return false;
+        e = stack[--sp];
+    } while (e.t > t_max);
+    return true;
+}
+
+/// The walk of one ray from `start` to its end (walk_step).
 template <class NodeArch, class LeafArch, class Leaf>
 inline void walk_single(const MeshView& m, const SingleRay<NodeArch, LeafArch>& r, Entry start, const float& t_max,
                         Leaf&& leaf) {
     Entry stack[kStack];
     int sp = 0;
     Entry e{start.child, start.count, 0.f};
-    for (;;) {
-        if (e.count > 0) {
-            if (leaf(std::uint32_t(e.child), e.count)) return;
-        } else if (const int nh = single_node_hits(m, m.nodes[e.child], r, t_max, stack + sp); nh > 0) {
-            // The nearest child is the last one written: visit it now (its entry is within
-            // t_max), the others stay pushed.
-            sp += nh - 1;
-            e = stack[sp];
-            continue;
-        }
-        do {
-            if (sp == 0) return;
-            e = stack[--sp];
-        } while (e.t > t_max);
+    while (walk_step(m, r, t_max, leaf, e, sp, stack)) {
     }
 }
-
-/// One ray's closest-hit walk as a sequence of steps (a node or a leaf each), so that two
-/// walks can be interleaved: the same visits in the same order as walk_single with
-/// single_leaf_closest, so the same answer to the bit. walk_single keeps its own loop:
-/// written as steps of a struct like this one, its position and stack pointer lived in
-/// memory beside the stack it writes, and the any-hit walk lost 12 - 15 % (measured).
-template <class NodeArch, class LeafArch>
-struct ClosestWalk {
-    const MeshView* mesh;
-    SingleRay<NodeArch, LeafArch> r;
-    float best;
-    MeshHit hit;
-    Entry e;
-    int sp;
-    Entry stack[kStack];
-    void begin(const MeshView& m, const Vec3f& o, const Vec3f& d, float t_max, const MeshHit& h, Entry start) {
-        mesh = &m;
-        r = SingleRay<NodeArch, LeafArch>(o, d);
-        best = t_max;
-        hit = h;
-        e = {start.child, start.count, 0.f};
-        sp = 0;
-    }
-    /// Visits the current entry and moves to the next; false when the walk is over.
-    [[gnu::always_inline]] bool step() {
-        const MeshView& m = *mesh;
-        if (e.count > 0) {
-            single_leaf_closest(m, r, std::uint32_t(e.child), e.count, best, hit);
-        } else if (const int nh = single_node_hits(m, m.nodes[e.child], r, best, stack + sp); nh > 0) {
-            sp += nh - 1;
-            e = stack[sp];
-            return true;
-        }
-        do {
-            if (sp == 0) return false;
-            e = stack[--sp];
-        } while (e.t > best);
-        return true;
-    }
-};
 
 }  // namespace mesh_detail
 
@@ -307,28 +276,39 @@ template <class NodeArch, class LeafArch>
     return best;
 }
 
-/// mesh_closest_single for N rays at once, their walks interleaved step by step. A walk is a
-/// chain of dependent loads and compares (pop, node, child, leaf) that leaves most of the
-/// core idle; independent chains fill it. Each ray gets the answer it would get alone.
-template <int N, class NodeArch, class LeafArch>
-[[gnu::noinline]] inline void mesh_closest_single_group(const MeshView& m, const Vec3f* o, const Vec3f* d,
-                                                        float* best, MeshHit* hit, mesh_detail::Entry start) {
+/// mesh_closest_single for two rays at once, their walks interleaved step by step (walk_step).
+/// A walk is a chain of dependent loads and compares (pop, node, child, leaf) that leaves most
+/// of the core idle; a second, independent chain fills it. Each ray visits what it would
+/// alone, in the same order, so it gets the same answer to the bit.
+template <class NodeArch, class LeafArch>
+[[gnu::noinline]] inline void mesh_closest_single_pair(const MeshView& m, const Vec3f* o, const Vec3f* d,
+                                                       float* best, MeshHit* hit, mesh_detail::Entry start) {
     using namespace mesh_detail;
-    ClosestWalk<NodeArch, LeafArch> w[N];
-    bool more[N];
-    for (int i = 0; i < N; ++i) {
-        w[i].begin(m, o[i], d[i], best[i], hit[i], start);
-        more[i] = true;
+    const SingleRay<NodeArch, LeafArch> ra(o[0], d[0]), rb(o[1], d[1]);
+    float best_a = best[0], best_b = best[1];
+    MeshHit hit_a = hit[0], hit_b = hit[1];
+    const auto leaf_a = [&](std::uint32_t first, std::uint32_t count) {
+        single_leaf_closest(m, ra, first, count, best_a, hit_a);
+        return false;
+    };
+    const auto leaf_b = [&](std::uint32_t first, std::uint32_t count) {
+        single_leaf_closest(m, rb, first, count, best_b, hit_b);
+        return false;
+    };
+    Entry stack_a[kStack], stack_b[kStack];
+    Entry ea{start.child, start.count, 0.f}, eb = ea;
+    int sp_a = 0, sp_b = 0;
+    bool more_a = true, more_b = true;
+    while (more_a && more_b) {
+        more_a = walk_step(m, ra, best_a, leaf_a, ea, sp_a, stack_a);
+        more_b = walk_step(m, rb, best_b, leaf_b, eb, sp_b, stack_b);
     }
-    for (bool any = true; any;) {
-        any = false;
-        for (int i = 0; i < N; ++i)
-            if (more[i]) any |= (more[i] = w[i].step());
-    }
-    for (int i = 0; i < N; ++i) {
-        best[i] = w[i].best;
-        hit[i] = w[i].hit;
-    }
+    while (more_a) more_a = walk_step(m, ra, best_a, leaf_a, ea, sp_a, stack_a);
+    while (more_b) more_b = walk_step(m, rb, best_b, leaf_b, eb, sp_b, stack_b);
+    best[0] = best_a;
+    best[1] = best_b;
+    hit[0] = hit_a;
+    hit[1] = hit_b;
 }
 
 /// Whether the mesh blocks the ray (o, d) for t in (0, t_max), under `start` as above.
