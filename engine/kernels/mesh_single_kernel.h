@@ -109,6 +109,21 @@ inline std::uint32_t movemask_bits(const xsimd::batch_bool<float, A>& m) {
     }
 }
 
+/// The mask whose lane l is true where bit l of `bits` is set (movemask_bits' inverse).
+template <class A>
+inline xsimd::batch_bool<float, A> mask_from_bits(std::uint32_t bits) {
+    using M = xsimd::batch_bool<float, A>;
+    if constexpr (sizeof(typename M::register_type) <= sizeof(std::uint64_t)) {
+        return M(typename M::register_type(bits));
+    } else {
+        using I = xsimd::batch<std::int32_t, A>;
+        alignas(64) std::int32_t bit[M::size];
+        for (std::size_t l = 0; l < M::size; ++l) bit[l] = std::int32_t(1u << l);
+        const I b = I::load_aligned(bit);
+        return xsimd::bool_cast((I(std::int32_t(bits)) & b) != I(0));
+    }
+}
+
 namespace mesh_detail {
 
 /// Starts loading a child the single-ray walk will visit: an inner node's boxes (the first
