@@ -383,12 +383,16 @@ inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<
             if (!xsimd::any(open)) break;  // every lane is blocked
             continue;
         }
+        // Every child's entry is written and the stack grows by one where a lane met it: no
+        // branch on the box test. Measured (docs/performance.md, "Shadow packets push without
+        // a branch"): 1.17x on the 1.3M mesh's shadow rays, renderer occlusion 0.92 - 0.94x;
+        // the bunny's shadow rays in the harness, whose branches predict well, 0.96x.
         const accel::WideNode& n = m.nodes[e.child];
         for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
             B tn;
-            const auto hit = robust_box(n, j, o, inv, t_max, tn) && open;
-            if (xsimd::any(hit))
-                stack[sp++] = {n.child[j], n.count[j], 0.f, single_lanes > 0 ? movemask_bits(hit) : ~0u};
+            const std::uint32_t bits = movemask_bits(robust_box(n, j, o, inv, t_max, tn) && open);
+            stack[sp] = {n.child[j], n.count[j], 0.f, bits};
+            sp += int(bits != 0);
         }
     }
     return blocked;
