@@ -3,12 +3,18 @@
 "Against POV-Ray and Embree").
 
 usage: /usr/bin/python3 scripts/fetch_bunny.py [-o perf/assets/bunny.ply] [--tgz FILE] [--force]
+                                              [--split N]
 
 The mesh comes from the npm package `bunny` (public domain: `exports.positions` and
 `exports.cells`, two JSON arrays in a JS file, 1 839 vertices and 3 674 triangles, closed and
 wound counter-clockwise seen from outside, +y up, standing on y = 0). `npm pack bunny` fetches
 the package's tarball (nothing is installed); --tgz reads one fetched before. The output is
 generated, not committed (perf/assets/ is ignored by git).
+
+--split N also writes the bunny with every triangle cut into four at its edges' midpoints, N
+times (the same surface, 3 674 * 4^N triangles), to perf/assets/bunny_split<N>.ply (or -o): N = 3
+gives the 235 136-triangle "bunny split three times" of issue 19, its ~200k-triangle scanned mesh
+for the comparison with Embree. It is made from bunny.ply (fetched first when missing).
 
 Exit status: 0 written (or already there), 3 npm is not installed or the package could not be
 fetched (the message says which; the peer benchmark then skips the bunny scene), 1 otherwise.
@@ -84,12 +90,74 @@ def write_ply(path, positions, cells):
     os.replace(tmp, path)
 
 
+def read_ply(path):
+    """(positions, cells) of a PLY file as write_ply writes it."""
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode("ascii")
+    nv = int(re.search(r"element vertex (\d+)", header).group(1))
+    nf = int(re.search(r"element face (\d+)", header).group(1))
+    positions = [struct.unpack_from("<3f", data, end + 12 * k) for k in range(nv)]
+    at = end + 12 * nv
+    cells = []
+    for _ in range(nf):
+        if data[at] != 3:
+            raise ValueError("%s: a face that is not a triangle" % path)
+        cells.append(struct.unpack_from("<3i", data, at + 1))
+        at += 13
+    return positions, cells
+
+
+def split(positions, cells):
+    """Every triangle cut into four at its edges' midpoints (shared edges share the midpoint, so
+    the mesh stays closed), the winding kept."""
+    positions = list(positions)
+    mid = {}
+
+    def midpoint(a, b):
+        key = (a, b) if a < b else (b, a)
+        if key not in mid:
+            pa, pb = positions[a], positions[b]
+            mid[key] = len(positions)
+            positions.append(tuple((pa[k] + pb[k]) / 2 for k in range(3)))
+        return mid[key]
+
+    out = []
+    for a, b, c in cells:
+        ab, bc, ca = midpoint(a, b), midpoint(b, c), midpoint(c, a)
+        out += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca)]
+    return positions, out
+
+
+def write_split(args):
+    if not os.path.exists(DEFAULT_OUT) and main(["--tgz", args.tgz] if args.tgz else []) != 0:
+        return UNAVAILABLE
+    out = args.output if args.output != DEFAULT_OUT else os.path.join(ROOT, "perf", "assets",
+                                                                      "bunny_split%d.ply" % args.split)
+    if os.path.exists(out) and not args.force:
+        print(out)
+        return 0
+    positions, cells = read_ply(DEFAULT_OUT)
+    for _ in range(args.split):
+        positions, cells = split(positions, cells)
+    write_ply(out, positions, cells)
+    print("%s: %d vertices, %d triangles" % (out, len(positions), len(cells)), file=sys.stderr)
+    print(out)
+    return 0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("-o", "--output", default=DEFAULT_OUT)
     ap.add_argument("--tgz", help="a tarball of the package fetched before (npm pack bunny)")
     ap.add_argument("--force", action="store_true", help="write it again when it is there")
+    ap.add_argument("--split", type=int, default=0, help="cut every triangle into four, N times (above)")
     args = ap.parse_args(argv)
+    if args.split < 0:
+        ap.error("--split must be at least 0")
+    if args.split > 0:
+        return write_split(args)
     if os.path.exists(args.output) and not args.force:
         print(args.output)
         return 0

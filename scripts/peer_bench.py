@@ -115,6 +115,60 @@ def lumpy_icosphere(path, level=LUMPY_LEVEL):
     return path
 
 
+def uv_sphere(path, rings=501, segments=1000):
+    """The unit UV sphere of issue 19's Embree table: `rings` bands of `segments` quads split in
+    two, fans at the poles, 2 * segments * (rings - 1) triangles (1 000 000 by default),
+    counter-clockwise seen from outside, as OBJ."""
+    if os.path.exists(path):
+        return path
+    lines = ["# UV sphere, %d rings x %d segments: %d triangles (scripts/peer_bench.py)" % (
+        rings, segments, 2 * segments * (rings - 1)), "v 0 1 0"]
+    for i in range(1, rings):
+        th = math.pi * i / rings
+        st, ct = math.sin(th), math.cos(th)
+        for j in range(segments):
+            ph = 2 * math.pi * j / segments
+            lines.append("v %.7f %.7f %.7f" % (st * math.cos(ph), ct, st * math.sin(ph)))
+    lines.append("v 0 -1 0")
+    south = 1 + (rings - 1) * segments + 1  # OBJ numbers from 1
+
+    def ring(i, j):
+        return 2 + (i - 1) * segments + j % segments
+
+    for j in range(segments):
+        lines.append("f 1 %d %d" % (ring(1, j + 1), ring(1, j)))
+        lines.append("f %d %d %d" % (south, ring(rings - 1, j), ring(rings - 1, j + 1)))
+    for i in range(1, rings - 1):
+        for j in range(segments):
+            a, b, c, d = ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), ring(i, j + 1)
+            lines.append("f %d %d %d" % (a, c, b))
+            lines.append("f %d %d %d" % (a, d, c))
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.replace(tmp, path)
+    return path
+
+
+def embree_meshes(dry_run):
+    """The meshes of the Embree table (docs/performance.md, "Ray traversal, Embree against
+    streamrt"), made when missing: the bunny, the bunny split three times (235k triangles: the
+    issue's ~200k-triangle scanned mesh), the 1M-triangle UV sphere and the 1.3M lumpy
+    icosphere (its 1M-triangle meshes)."""
+    bunny = os.path.join(ASSETS, "bunny.ply")
+    split3 = os.path.join(ASSETS, "bunny_split3.ply")
+    sphere = os.path.join(ASSETS, "uv_sphere_1m.obj")
+    lumpy = os.path.join(ASSETS, "lumpy_icosphere.obj")
+    if not dry_run:
+        if os.path.exists(bunny) and not os.path.exists(split3):
+            import fetch_bunny
+            fetch_bunny.main(["--split", "3"])
+        uv_sphere(sphere)
+        lumpy_icosphere(lumpy)
+    return [p for p in (bunny, split3, sphere, lumpy) if os.path.exists(p)]
+
+
 def ensure_assets(names, dry_run):
     """Makes the meshes the chosen scenes need; returns {scene: reason} for those to skip."""
     skip = {}
@@ -730,8 +784,7 @@ def main(argv=None):
 
     embree_text = None
     if embree_rays:
-        meshes = [p for p in (os.path.join(ASSETS, "bunny.ply"), os.path.join(ASSETS, "lumpy_icosphere.obj"))
-                  if os.path.exists(p)]
+        meshes = embree_meshes(False)
         if meshes:
             p = subprocess.run([embree_rays, "--reps", str(args.embree_reps)] + meshes, capture_output=True,
                                text=True)
