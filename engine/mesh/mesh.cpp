@@ -50,37 +50,41 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
         }
         if (ok) {
             kept.insert(kept.end(), {a, b, c});
-            kept_from.push_back(std::uint32_t(k / 3));
+            if (!corner_uv.empty()) kept_from.push_back(std::uint32_t(k / 3));
         } else {
             ++m->dropped;
         }
     }
     const std::size_t n_tris = kept.size() / 3;
 
-    // Area-weighted vertex normals (the cross product's length is twice the area).
-    std::vector<double> acc(3 * n_verts, 0.0);
-    for (std::size_t k = 0; k < n_tris; ++k) {
-        const std::uint32_t* t = &kept[3 * k];
-        const Vec3d n = cross(vertex(t[1]) - vertex(t[0]), vertex(t[2]) - vertex(t[0]));
-        for (int j = 0; j < 3; ++j) {
-            acc[3 * t[j]] += n.x;
-            acc[3 * t[j] + 1] += n.y;
-            acc[3 * t[j] + 2] += n.z;
+    // Area-weighted vertex normals (the cross product's length is twice the area). The sums
+    // are freed before the hierarchy is built: on a 10M-triangle mesh they are 120 MB of the
+    // peak (docs/performance.md, "A 10M-triangle mesh").
+    {
+        std::vector<double> acc(3 * n_verts, 0.0);
+        for (std::size_t k = 0; k < n_tris; ++k) {
+            const std::uint32_t* t = &kept[3 * k];
+            const Vec3d n = cross(vertex(t[1]) - vertex(t[0]), vertex(t[2]) - vertex(t[0]));
+            for (int j = 0; j < 3; ++j) {
+                acc[3 * t[j]] += n.x;
+                acc[3 * t[j] + 1] += n.y;
+                acc[3 * t[j] + 2] += n.z;
+            }
         }
-    }
-    m->vertex_normals.resize(3 * n_verts);
-    const bool given = normals.size() == 3 * n_verts;
-    for (std::size_t v = 0; v < n_verts; ++v) {
-        Vec3d n{acc[3 * v], acc[3 * v + 1], acc[3 * v + 2]};
-        if (given) {
-            const Vec3d g{normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]};
-            if (const double g_len = length(g); g_len > 0.0 && std::isfinite(g_len)) n = g;
+        m->vertex_normals.resize(3 * n_verts);
+        const bool given = normals.size() == 3 * n_verts;
+        for (std::size_t v = 0; v < n_verts; ++v) {
+            Vec3d n{acc[3 * v], acc[3 * v + 1], acc[3 * v + 2]};
+            if (given) {
+                const Vec3d g{normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]};
+                if (const double g_len = length(g); g_len > 0.0 && std::isfinite(g_len)) n = g;
+            }
+            const double len = length(n);
+            n = len > 0.0 ? n * (1.0 / len) : Vec3d{0, 0, 1};
+            m->vertex_normals[3 * v] = float(n.x);
+            m->vertex_normals[3 * v + 1] = float(n.y);
+            m->vertex_normals[3 * v + 2] = float(n.z);
         }
-        const double len = length(n);
-        n = len > 0.0 ? n * (1.0 / len) : Vec3d{0, 0, 1};
-        m->vertex_normals[3 * v] = float(n.x);
-        m->vertex_normals[3 * v + 1] = float(n.y);
-        m->vertex_normals[3 * v + 2] = float(n.z);
     }
 
     // Triangle boxes (padded outwards, accel::conservative_box) and the hierarchy.
@@ -110,6 +114,7 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
             for (int a = 0; a < 3; ++a) m->tri[9 * k + 3 * j + a] = positions[3 * v + a];
         }
     });
+    std::vector<std::uint32_t>().swap(kept);  // in m->index now: freed before the blocks are made
     if (!corner_uv.empty()) {
         m->corner_uv.resize(6 * n_tris);
         double uv_length = 0.0, length_sum = 0.0;
