@@ -54,6 +54,7 @@ PEER_DIR = os.path.join(pc.ROOT, "perf", "scenes", "peer")
 ASSETS = os.path.join(pc.ROOT, "perf", "assets")
 SCENES = {
     "bunny": os.path.join(PEER_DIR, "bunny_glass.cfg"),
+    "bunny235k": os.path.join(PEER_DIR, "bunny235k_glass.cfg"),
     "million": os.path.join(PEER_DIR, "million.cfg"),
     "whitted": os.path.join(pc.ROOT, "scenes", "whitted.cfg"),
 }
@@ -179,6 +180,13 @@ def ensure_assets(names, dry_run):
             import fetch_bunny
             if fetch_bunny.main([]) != 0:
                 skip["bunny"] = "no bunny mesh (scripts/fetch_bunny.py could not fetch it: see above)"
+    if "bunny235k" in names and not os.path.exists(os.path.join(ASSETS, "bunny_split3.ply")):
+        if dry_run:
+            skip["bunny235k"] = "perf/assets/bunny_split3.ply is not there (scripts/fetch_bunny.py --split 3 writes it)"
+        else:
+            import fetch_bunny
+            if fetch_bunny.main(["--split", "3"]) != 0:
+                skip["bunny235k"] = "no bunny mesh (scripts/fetch_bunny.py could not fetch it: see above)"
     lumpy = os.path.join(ASSETS, "lumpy_icosphere.obj")
     if "million" in names and not os.path.exists(lumpy):
         if dry_run:
@@ -652,7 +660,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"), help="build folder (default build/)")
     ap.add_argument("--runs", type=int, default=3, help="timed runs per program and case (median; default 3)")
-    ap.add_argument("--scenes", default="bunny,million,whitted")
+    ap.add_argument("--scenes", default="bunny,bunny235k,million,whitted")
     ap.add_argument("--modes", default="default,nopruning,matched")
     ap.add_argument("--size", default="1280x720", help="WxH of every picture (default 1280x720)")
     ap.add_argument("--povray", default=shutil.which("povray") or "/usr/bin/povray", help="the POV-Ray program")
