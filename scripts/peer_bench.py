@@ -108,12 +108,7 @@ def lumpy_icosphere(path, level=LUMPY_LEVEL):
         r = 1.0 + 0.10 * sin(5 * x + 1) * sin(4 * y + 2) * sin(6 * z) + 0.03 * sin(17 * x) * sin(13 * y + z)
         lines.append("v %.6f %.6f %.6f" % (x * r, y * r, z * r))
     lines += ["f %d %d %d" % (a + 1, b + 1, c + 1) for a, b, c in faces]
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write("\n".join(lines) + "\n")
-    os.replace(tmp, path)
-    return path
+    return pc.write_lines(path, lines)
 
 
 def uv_sphere(path, rings=501, segments=1000):
@@ -144,12 +139,7 @@ def uv_sphere(path, rings=501, segments=1000):
             a, b, c, d = ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), ring(i, j + 1)
             lines.append("f %d %d %d" % (a, c, b))
             lines.append("f %d %d %d" % (a, d, c))
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write("\n".join(lines) + "\n")
-    os.replace(tmp, path)
-    return path
+    return pc.write_lines(path, lines)
 
 
 def embree_meshes(dry_run):

@@ -192,6 +192,12 @@ def sphere_scene(n, path, width=1280, height=720, spp=1, depth=4, seed=1):
             mat = "diff=0.85 spec=0.2 shininess=40"
         lines.append("sphere color=%.2f,%.2f,%.2f %s scale=%.4f translate=%.4f,%.4f,%.4f"
                      % (rng.uniform(0.1, 1), rng.uniform(0.1, 1), rng.uniform(0.1, 1), mat, r, x, r, z))
+    return write_lines(path, lines)
+
+
+def write_lines(path, lines):
+    """Writes the lines to path through a temporary file renamed into place (never half a
+    file under the name); returns path."""
     os.makedirs(os.path.dirname(path), exist_ok=True)
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
