@@ -27,10 +27,12 @@ GNU_TIME = "/usr/bin/time"
 
 
 def sphere_shape(triangles):
-    """(rings, segments) with 2 * segments * (rings - 1) == triangles, segments near 1.25 x rings."""
-    for rings in range(int((triangles / 2.5) ** 0.5), 1, -1):
-        if (triangles // 2) % (rings - 1) == 0 and triangles % 2 == 0:
-            return rings, triangles // 2 // (rings - 1)
+    """(rings, segments) with 2 * segments * (rings - 1) == triangles, segments near 1.25 x rings
+    (bands = rings - 1 tried from sqrt(triangles / 2.5) down)."""
+    if triangles % 2 == 0:
+        for bands in range(int(round((triangles / 2.5) ** 0.5)), 0, -1):
+            if (triangles // 2) % bands == 0:
+                return bands + 1, triangles // 2 // bands
     raise SystemExit("big_mesh_bench: %d triangles is not 2 * segments * (rings - 1)" % triangles)
 
 
