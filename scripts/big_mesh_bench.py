@@ -40,24 +40,8 @@ def write_sphere(path, triangles):
     if os.path.exists(path):
         return
     rings, seg = sphere_shape(triangles)
-    th = np.pi * np.arange(1, rings) / rings
-    ph = 2 * np.pi * np.arange(seg) / seg
-    v = np.empty((2 + (rings - 1) * seg, 3), "<f4")
-    v[0], v[-1] = (0, 1, 0), (0, -1, 0)
-    v[1:-1, 0] = (np.sin(th)[:, None] * np.cos(ph)[None, :]).ravel()
-    v[1:-1, 1] = np.repeat(np.cos(th), seg)
-    v[1:-1, 2] = (np.sin(th)[:, None] * np.sin(ph)[None, :]).ravel()
-    south = len(v) - 1
-
-    def ring(i, j):
-        return 1 + (i - 1) * seg + j % seg
-
-    j = np.arange(seg)
-    fans = [np.stack([np.zeros(seg, np.int64), ring(1, j + 1), ring(1, j)], 1),
-            np.stack([np.full(seg, south), ring(rings - 1, j), ring(rings - 1, j + 1)], 1)]
-    i, j = (a.ravel() for a in np.meshgrid(np.arange(1, rings - 1), np.arange(seg), indexing="ij"))
-    a, b, c, d = ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), ring(i, j + 1)
-    t = np.concatenate(fans + [np.stack([a, c, b], 1), np.stack([a, d, c], 1)])  # counter-clockwise from outside
+    v, t = pc.uv_sphere_mesh(rings, seg)
+    v = v.astype("<f4")
     faces = np.empty(len(t), dtype=[("n", "u1"), ("i", "<i4", 3)])
     faces["n"], faces["i"] = 3, t
     header = ("ply\nformat binary_little_endian 1.0\ncomment UV sphere, %d rings x %d segments "

@@ -112,33 +112,16 @@ def lumpy_icosphere(path, level=LUMPY_LEVEL):
 
 
 def uv_sphere(path, rings=501, segments=1000):
-    """The unit UV sphere of issue 19's Embree table: `rings` bands of `segments` quads split in
-    two, fans at the poles, 2 * segments * (rings - 1) triangles (1 000 000 by default),
-    counter-clockwise seen from outside, as OBJ."""
+    """The unit UV sphere of issue 19's Embree table (perf_common.uv_sphere_mesh, 1 000 000
+    triangles by default), as OBJ."""
     if os.path.exists(path):
         return path
-    lines = ["# UV sphere, %d rings x %d segments: %d triangles (scripts/peer_bench.py)" % (
-        rings, segments, 2 * segments * (rings - 1)), "v 0 1 0"]
-    for i in range(1, rings):
-        th = math.pi * i / rings
-        st, ct = math.sin(th), math.cos(th)
-        for j in range(segments):
-            ph = 2 * math.pi * j / segments
-            lines.append("v %.7f %.7f %.7f" % (st * math.cos(ph), ct, st * math.sin(ph)))
+    v, t = pc.uv_sphere_mesh(rings, segments)
+    lines = ["# UV sphere, %d rings x %d segments: %d triangles (scripts/peer_bench.py)" % (rings, segments, len(t)),
+             "v 0 1 0"]
+    lines += ["v %.7f %.7f %.7f" % tuple(p) for p in v[1:-1].tolist()]
     lines.append("v 0 -1 0")
-    south = 1 + (rings - 1) * segments + 1  # OBJ numbers from 1
-
-    def ring(i, j):
-        return 2 + (i - 1) * segments + j % segments
-
-    for j in range(segments):
-        lines.append("f 1 %d %d" % (ring(1, j + 1), ring(1, j)))
-        lines.append("f %d %d %d" % (south, ring(rings - 1, j), ring(rings - 1, j + 1)))
-    for i in range(1, rings - 1):
-        for j in range(segments):
-            a, b, c, d = ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), ring(i, j + 1)
-            lines.append("f %d %d %d" % (a, c, b))
-            lines.append("f %d %d %d" % (a, d, c))
+    lines += ["f %d %d %d" % tuple(f) for f in (t + 1).tolist()]
     return pc.write_lines(path, lines)
 
 

@@ -195,6 +195,32 @@ def sphere_scene(n, path, width=1280, height=720, spp=1, depth=4, seed=1):
     return write_lines(path, lines)
 
 
+def uv_sphere_mesh(rings, segments):
+    """The unit UV sphere of the benchmarks (issue 19's 1M-triangle mesh at 501 x 1000): the
+    north pole, rings - 1 rings of `segments` vertices, the south pole (float64, N x 3), and
+    2 * segments * (rings - 1) triangles (0-based, M x 3): per segment the north and the south
+    fan's triangle, then per band and segment a quad's two, counter-clockwise from outside."""
+    th = np.pi * np.arange(1, rings) / rings
+    ph = 2 * np.pi * np.arange(segments) / segments
+    v = np.empty((2 + (rings - 1) * segments, 3))
+    v[0], v[-1] = (0, 1, 0), (0, -1, 0)
+    v[1:-1, 0] = (np.sin(th)[:, None] * np.cos(ph)[None, :]).ravel()
+    v[1:-1, 1] = np.repeat(np.cos(th), segments)
+    v[1:-1, 2] = (np.sin(th)[:, None] * np.sin(ph)[None, :]).ravel()
+    south = len(v) - 1
+
+    def ring(i, j):
+        return 1 + (i - 1) * segments + j % segments
+
+    j = np.arange(segments)
+    fans = np.stack([np.stack([np.zeros(segments, np.int64), ring(1, j + 1), ring(1, j)], 1),
+                     np.stack([np.full(segments, south), ring(rings - 1, j), ring(rings - 1, j + 1)], 1)], 1)
+    i, j = (a.ravel() for a in np.meshgrid(np.arange(1, rings - 1), np.arange(segments), indexing="ij"))
+    a, b, c, d = ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), ring(i, j + 1)
+    bands = np.stack([np.stack([a, c, b], 1), np.stack([a, d, c], 1)], 1)
+    return v, np.concatenate([fans.reshape(-1, 3), bands.reshape(-1, 3)])
+
+
 def write_lines(path, lines):
     """Writes the lines to path through a temporary file renamed into place (never half a
     file under the name); returns path."""
