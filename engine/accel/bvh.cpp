@@ -71,6 +71,15 @@ struct Box4 {
         hi = xsimd::max(hi, h);
     }
     void grow(const Box4& b) { grow(b.lo, b.hi); }
+    /// Aabb::half_area of a box that is not empty, without leaving the registers: the same
+    /// products summed in the same order, so the same float.
+    float half_area() const {
+        const B4 e = hi - lo;                                                // x y z 0
+        const B4 p = e * B4(_mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));  // xy yz zx 0
+        alignas(16) float v[4];
+        p.store_aligned(v);
+        return v[0] + v[1] + v[2];
+    }
     Aabb aabb() const {
         alignas(16) float l[4], h[4];
         lo.store_aligned(l);
@@ -104,6 +113,96 @@ struct Builder {
         }
     };
 
+    static constexpr int kMaxBins = 64;
+
+    /// Per axis and bin: the primitives' boxes and their count. Consecutive primitives of a
+    /// mesh mostly fall in the same bins, so growing one set of bins makes each step wait
+    /// for the last one's store; large nodes take two sets by turns, merged at the end.
+    /// (The children's centroid bounds come from the partition pass.)
+    struct Bins {
+        static constexpr std::uint32_t kTwoSets = 256;  // below, a second set costs about what it saves
+        Box4 box[3][kMaxBins];
+        std::uint32_t count[3][kMaxBins];
+
+        void fill(const Ref* r, std::uint32_t n, int nb, const BinOf& bin_of) {
+            for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < nb; ++b) {
+                    box[a][b] = Box4::empty();
+                    count[a][b] = 0;
+                }
+            const auto add = [&](Box4 (&to)[3][kMaxBins], std::uint32_t (&to_count)[3][kMaxBins], const Ref& x) {
+                const B4 lo = ref_lo(x), hi = ref_hi(x);
+                alignas(16) std::int32_t b[4];
+                bin_of(lo + hi).store_aligned(b);
+                for (int a = 0; a < 3; ++a) {
+                    to[a][b[a]].grow(lo, hi);
+                    ++to_count[a][b[a]];
+                }
+            };
+            if (n < kTwoSets) {
+                for (std::uint32_t k = 0; k < n; ++k) add(box, count, r[k]);
+                return;
+            }
+            Box4 other[3][kMaxBins];
+            std::uint32_t other_count[3][kMaxBins];
+            for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < nb; ++b) {
+                    other[a][b] = Box4::empty();
+                    other_count[a][b] = 0;
+                }
+            std::uint32_t k = 0;
+            for (; k + 1 < n; k += 2) {
+                add(box, count, r[k]);
+                add(other, other_count, r[k + 1]);
+            }
+            if (k < n) add(box, count, r[k]);
+            for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < nb; ++b) {
+                    box[a][b].grow(other[a][b]);
+                    count[a][b] += other_count[a][b];
+                }
+        }
+    };
+
+    /// Moves refs[first, first + count) whose bin on `axis` is at most `last_left` before the
+    /// others, and returns where the others start; csides get the doubled-centroid bounds of
+    /// each side. The order is std::partition's (libstdc++, bidirectional: swap the first
+    /// from the left that goes right with the first from the right that goes left), so the
+    /// tree is the one the builder made when its centroid bounds came from extra bins.
+    std::uint32_t partition(std::uint32_t first, std::uint32_t count, const BinOf& bin_of, int axis, int last_left,
+                            Box4 csides[2]) {
+        csides[0] = csides[1] = Box4::empty();
+        Ref* lo_it = refs.data() + first;
+        Ref* hi_it = lo_it + count;
+        const auto centre = [](const Ref& x) { return ref_lo(x) + ref_hi(x); };
+        const auto goes_left = [&](const B4& c) {
+            alignas(16) std::int32_t b[4];
+            bin_of(c).store_aligned(b);
+            return b[axis] <= last_left;
+        };
+        for (;;) {
+            B4 c_right;  // the centroid of *lo_it once it stops: the first from the left that goes right
+            for (;; ++lo_it) {
+                if (lo_it == hi_it) return std::uint32_t(lo_it - refs.data());
+                c_right = centre(*lo_it);
+                if (!goes_left(c_right)) break;
+                csides[0].grow(c_right, c_right);
+            }
+            csides[1].grow(c_right, c_right);
+            B4 c_left;
+            for (;;) {
+                --hi_it;
+                if (lo_it == hi_it) return std::uint32_t(lo_it - refs.data());
+                c_left = centre(*hi_it);
+                if (goes_left(c_left)) break;
+                csides[1].grow(c_left, c_left);
+            }
+            csides[0].grow(c_left, c_left);
+            std::swap(*lo_it, *hi_it);
+            ++lo_it;
+        }
+    }
+
     /// Bounds and doubled-centroid bounds of refs[begin, end).
     void bounds_of(std::uint32_t begin, std::uint32_t end, Aabb& box, Aabb& cbox) const {
         Box4 b = Box4::empty(), c = Box4::empty();
@@ -135,34 +234,18 @@ struct Builder {
         if (depth < kMedianDepth) {
             // Binned SAH over the three axes, one pass over the primitives; small nodes use
             // fewer bins (as many as primitives), so the bottom of the tree stays cheap.
-            constexpr int kMaxBins = 64;
             const int nb = std::clamp(std::min(opt.bins, int(count)), 2, kMaxBins);
-            float best_cost = std::numeric_limits<float>::infinity();
-            int best_axis = -1, best_bin = 0;
-            // Per axis and bin: the primitives' boxes, their doubled centroids, their count.
-            Box4 bb[3][kMaxBins], cb[3][kMaxBins];
-            std::uint32_t bc[3][kMaxBins];
             alignas(16) float scale[4] = {0.f, 0.f, 0.f, 0.f};
             for (int a = 0; a < 3; ++a) {
                 const float ext = cbox.hi[a] - cbox.lo[a];
                 scale[a] = ext > 0.f ? float(nb) / ext * 0.99999f : 0.f;
-                for (int b = 0; b < nb; ++b) {
-                    bb[a][b] = cb[a][b] = Box4::empty();
-                    bc[a][b] = 0;
-                }
             }
             alignas(16) const float origin[4] = {cbox.lo[0], cbox.lo[1], cbox.lo[2], 0.f};
             const BinOf bin_of{B4::load_aligned(origin), B4::load_aligned(scale), float(nb - 1)};
-            for (std::uint32_t k = first; k < first + count; ++k) {
-                const B4 lo = ref_lo(refs[k]), hi = ref_hi(refs[k]), c = lo + hi;
-                alignas(16) std::int32_t b[4];
-                bin_of(c).store_aligned(b);
-                for (int a = 0; a < 3; ++a) {
-                    bb[a][b[a]].grow(lo, hi);
-                    cb[a][b[a]].grow(c, c);
-                    ++bc[a][b[a]];
-                }
-            }
+            Bins bins;
+            bins.fill(refs.data() + first, count, nb, bin_of);
+            float best_cost = std::numeric_limits<float>::infinity();
+            int best_axis = -1, best_bin = 0;
             for (int a = 0; a < 3; ++a) {
                 if (!(scale[a] > 0.f)) continue;
                 float right_area[kMaxBins];
@@ -170,18 +253,18 @@ struct Builder {
                 Box4 acc = Box4::empty();
                 std::uint32_t cnt = 0;
                 for (int b = nb - 1; b > 0; --b) {
-                    acc.grow(bb[a][b]);
-                    cnt += bc[a][b];
-                    right_area[b] = acc.aabb().half_area();
+                    acc.grow(bins.box[a][b]);
+                    cnt += bins.count[a][b];
+                    right_area[b] = cnt ? acc.half_area() : 0.f;
                     right_count[b] = cnt;
                 }
                 acc = Box4::empty();
                 cnt = 0;
                 for (int b = 0; b < nb - 1; ++b) {
-                    acc.grow(bb[a][b]);
-                    cnt += bc[a][b];
+                    acc.grow(bins.box[a][b]);
+                    cnt += bins.count[a][b];
                     if (cnt == 0 || right_count[b + 1] == 0) continue;
-                    const float cost = acc.aabb().half_area() * float(cnt) + right_area[b + 1] * float(right_count[b + 1]);
+                    const float cost = acc.half_area() * float(cnt) + right_area[b + 1] * float(right_count[b + 1]);
                     if (cost < best_cost) {
                         best_cost = cost;
                         best_axis = a;
@@ -194,22 +277,14 @@ struct Builder {
                 const float split_cost = opt.traversal_cost * box.half_area() + best_cost;
                 if (count <= std::uint32_t(opt.max_leaf) && leaf_cost <= split_cost)
                     return make_leaf(node, first, count);
-                const int a = best_axis;
                 // The same bin rule as the binning pass, so the sides are exactly the bins'.
-                const auto it = std::partition(refs.begin() + first, refs.begin() + first + count, [&](const Ref& r) {
-                    alignas(16) std::int32_t b[4];
-                    bin_of(ref_lo(r) + ref_hi(r)).store_aligned(b);
-                    return b[a] <= best_bin;
-                });
-                mid = std::uint32_t(it - refs.begin());
+                Box4 csides[2];
+                mid = partition(first, count, bin_of, best_axis, best_bin, csides);
                 split = mid > first && mid < first + count;
                 // The children's bounds are the unions of their bins (the partition used the
                 // same bin rule), exactly what a pass over their primitives would give.
-                Box4 sides[2] = {Box4::empty(), Box4::empty()}, csides[2] = {Box4::empty(), Box4::empty()};
-                for (int b = 0; b < nb; ++b) {
-                    sides[b > best_bin].grow(bb[a][b]);
-                    csides[b > best_bin].grow(cb[a][b]);
-                }
+                Box4 sides[2] = {Box4::empty(), Box4::empty()};
+                for (int b = 0; b < nb; ++b) sides[b > best_bin].grow(bins.box[best_axis][b]);
                 lb = sides[0].aabb(), rb = sides[1].aabb(), lc = csides[0].aabb(), rc = csides[1].aabb();
             }
         }
