@@ -437,11 +437,13 @@ struct Collapser {
     }
 };
 
+/// The hierarchy over refs (the primitives with non-empty boxes, in their numbers' order).
+Bvh build_over(std::vector<Ref> refs, const BuildOptions& options, std::chrono::steady_clock::time_point start);
+
 }  // namespace
 
 Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    Bvh bvh;
     std::vector<Ref> refs;
     refs.reserve(boxes.size());
     want_huge_pages(refs.data(), refs.capacity());
@@ -450,6 +452,28 @@ Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
         if (!b.empty()) refs.push_back({{b.lo[0], b.lo[1], b.lo[2]}, 0.f, {b.hi[0], b.hi[1], b.hi[2]}, std::uint32_t(i)});
     }
     std::vector<Aabb>().swap(boxes);  // the refs hold them now: free the memory before building
+    return build_over(std::move(refs), options, start);
+}
+
+Bvh Bvh::build(std::size_t n, const std::function<Aabb(std::size_t)>& box_of, const BuildOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<Ref> refs(n);  // every Ref written below: value-initialised pages are touched once here anyway
+    want_huge_pages(refs.data(), refs.capacity());
+    std::atomic<bool> any_empty{false};
+    parallel_for_index(n, 16384, [&](std::size_t i) {
+        const Aabb b = box_of(i);
+        refs[i] = {{b.lo[0], b.lo[1], b.lo[2]}, 0.f, {b.hi[0], b.hi[1], b.hi[2]}, std::uint32_t(i)};
+        if (b.empty()) any_empty.store(true, std::memory_order_relaxed);
+    });
+    if (any_empty.load())  // rare: keep the others, in order, as the vector form does
+        std::erase_if(refs, [](const Ref& r) { return r.box().empty(); });
+    return build_over(std::move(refs), options, start);
+}
+
+namespace {
+
+Bvh build_over(std::vector<Ref> refs, const BuildOptions& options, std::chrono::steady_clock::time_point start) {
+    Bvh bvh;
     if (refs.empty()) return bvh;
     const std::size_t n = refs.size();
 
@@ -476,6 +500,8 @@ Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
     bvh.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }
+
+}  // namespace
 
 BvhLinks::BvhLinks(const Bvh& bvh, std::size_t prims)
     : parent(bvh.nodes.size(), -1), slot(bvh.nodes.size(), 0), leaf_node(prims, -1), leaf_slot(prims, 0) {

@@ -95,6 +95,9 @@ struct Bvh {
     /// Builds over boxes (empty boxes are left out). Taken by value: pass them with std::move
     /// and their memory is given back before the build proper starts.
     static Bvh build(std::vector<Aabb> boxes, const BuildOptions& options = {});
+    /// The same over primitives 0 .. n-1 whose boxes box_of(k) gives (called once each, from
+    /// several threads): no array of boxes is made, so a large mesh touches less memory.
+    static Bvh build(std::size_t n, const std::function<Aabb(std::size_t)>& box_of, const BuildOptions& options = {});
 };
 
 /// What refitting a hierarchy needs beside it (animation, scene/animation.h): each node's

@@ -87,21 +87,23 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
         }
     }
 
-    // Triangle boxes (padded outwards, accel::conservative_box) and the hierarchy.
-    std::vector<accel::Aabb> boxes(n_tris);
-    parallel_for_index(n_tris, 16384, [&](std::size_t k) {
-        double lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = hi[a] = positions[3 * kept[3 * k] + a];
-            for (int j = 1; j < 3; ++j) {
-                const double p = positions[3 * kept[3 * k + j] + a];
-                lo[a] = std::min(lo[a], p);
-                hi[a] = std::max(hi[a], p);
+    // The hierarchy over the triangles' boxes (padded outwards, accel::conservative_box),
+    // made as the builder reads them: no array of boxes (24 bytes a triangle) to fill and free.
+    m->bvh = accel::Bvh::build(
+        n_tris,
+        [&](std::size_t k) {
+            double lo[3], hi[3];
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = hi[a] = positions[3 * kept[3 * k] + a];
+                for (int j = 1; j < 3; ++j) {
+                    const double p = positions[3 * kept[3 * k + j] + a];
+                    lo[a] = std::min(lo[a], p);
+                    hi[a] = std::max(hi[a], p);
+                }
             }
-        }
-        boxes[k] = accel::conservative_box(lo, hi);
-    });
-    m->bvh = accel::Bvh::build(std::move(boxes), options);
+            return accel::conservative_box(lo, hi);
+        },
+        options);
 
     // Store the triangles in leaf order, so leaves address them directly.
     m->tri.resize(9 * n_tris);

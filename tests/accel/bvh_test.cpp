@@ -3,9 +3,11 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 
+#include "parallel/parallelism.h"
 #include "scene/scene_bvh.h"
 #include "kernels/accel_kernel_table.h"
 #include "shapes/shapes.h"
@@ -218,6 +220,38 @@ TEST_CASE("BVH: build of an empty set, a single box and many equal boxes") {
         for (int j = 0; j < accel::kNodeWidth; ++j) total += n.count[j];
     CHECK(total == 1000);
     CHECK(many.prim_index.size() == 1000);
+}
+
+TEST_CASE("BVH: the build from a box function leaves empty boxes out and makes the vector form's tree") {
+    // 40 unit cubes along x at 0, 2, 4, ...; every fifth primitive has an empty box (a
+    // default Aabb, lo > hi), as a degenerate primitive would.
+    const auto box_of = [](std::size_t k) {
+        accel::Aabb b;
+        if (k % 5 == 3) return b;
+        b.lo[0] = float(2 * k), b.hi[0] = float(2 * k + 1);
+        b.lo[1] = b.lo[2] = 0.f, b.hi[1] = b.hi[2] = 1.f;
+        return b;
+    };
+    std::vector<accel::Aabb> boxes;
+    for (std::size_t k = 0; k < 40; ++k) boxes.push_back(box_of(k));
+    for (const int jobs : {1, 2}) {
+        CAPTURE(jobs);
+        Parallelism par(jobs);
+        const accel::Bvh f = par.run([&] { return accel::Bvh::build(40, box_of); });
+        // The 32 non-empty primitives, none of 3, 8, 13, ...
+        REQUIRE(f.prim_index.size() == 32);
+        for (const std::uint32_t p : f.prim_index) CHECK(p % 5 != 3);
+        CHECK(f.bounds.lo[0] == 0.f);
+        CHECK(f.bounds.hi[0] == 79.f);  // cube 39 spans x = 78 .. 79
+        const accel::Bvh v = accel::Bvh::build(boxes);
+        CHECK(f.prim_index == v.prim_index);
+        REQUIRE(f.nodes.size() == v.nodes.size());
+        for (std::size_t i = 0; i < f.nodes.size(); ++i) {
+            CAPTURE(i);
+            CHECK(std::memcmp(&f.nodes[i], &v.nodes[i], sizeof(accel::WideNode)) == 0);
+        }
+    }
+    CHECK(accel::Bvh::build(0, box_of).empty());
 }
 
 TEST_CASE("BVH: the collapse into 8-wide nodes takes the least-cost cut (16 boxes in a row, by hand)") {
