@@ -2,6 +2,13 @@
 // POV-Ray and Embree"). Not a test; built only when CMake finds Embree 3 (perf/CMakeLists.txt).
 //
 //   embree_rays [--reps N] [--isa LEVEL] [--quality medium|high] [--rays KIND,...] MESH.{obj,ply} ...
+//   embree_rays [--reps N] [--isa LEVEL] [--quality medium|high] --spheres N
+//
+// --spheres N: instead of meshes, the field of N random spheres of perf/bvh_bench (perf/sphere_field.h:
+// camera rays in the stream engine's 16x16 tiles, mirror-reflected and shadow rays from their hits),
+// as an Embree scene of point spheres (RTC_GEOMETRY_TYPE_SPHERE_POINT: centre and radius) against
+// the stream engine's hierarchy kernels over its canonical spheres placed by their matrices
+// (AccelKernelTable: packet and single-ray walks; the plane is outside both).
 //
 // --rays keeps only the listed ray sets (primary, shadow, mirror, glass, diffuse), e.g. to
 // profile one of them with perf.
@@ -41,6 +48,7 @@
 #include "mesh/mesh.h"
 #include "mesh/ply_reader.h"
 #include "mesh_rays.h"
+#include "sphere_field.h"
 
 using namespace streamrt;
 using namespace streamrt::perf;
@@ -157,6 +165,72 @@ Result embree1(RTCScene scene, const Stream& st, bool any, int reps) {
     return r;
 }
 
+/// The spheres as Embree point spheres (x, y, z, radius), in the scene's order.
+RTCScene embree_spheres(RTCDevice dev, const std::vector<SphereRec>& sph, RTCBuildQuality quality) {
+    RTCScene scene = rtcNewScene(dev);
+    rtcSetSceneBuildQuality(scene, quality);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    rtcSetGeometryBuildQuality(g, quality);
+    auto* vb = static_cast<float*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), sph.size()));
+    for (std::size_t i = 0; i < sph.size(); ++i) {
+        vb[4 * i] = float(sph[i].x), vb[4 * i + 1] = float(sph[i].y), vb[4 * i + 2] = float(sph[i].z);
+        vb[4 * i + 3] = float(sph[i].r);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(scene);
+    return scene;
+}
+
+/// The chunks of a ray set as one stream padded to 16 lanes (the harness's form for Embree).
+template <class Chunk>
+Stream flat_stream(const std::vector<Chunk>& set) {
+    Stream st;
+    for (const Chunk& c : set)
+        for (std::size_t k = 0; k < c.count; ++k) st.add({c.ox[k], c.oy[k], c.oz[k]}, {c.dx[k], c.dy[k], c.dz[k]}, c.t_max[k]);
+    st.pad();
+    return st;
+}
+
+/// The sphere field: Embree16, Embree1 and the stream engine's hierarchy kernels on the same rays.
+int sphere_field(RTCDevice dev, Isa isa, std::size_t n, int reps, RTCBuildQuality quality) {
+    std::vector<SphereRec> sph;
+    const Scene s = random_spheres(n, &sph);
+    const KernelTable& kt = kernel_table(isa);
+    const AccelKernelTable& at = accel_kernel_table(isa);
+    const double t0 = now();
+    StreamAccel sa(s, accel::SceneBvh::build(s), accel::AccelConfig{});
+    const double t_ours = now() - t0;
+    SphereRays sets = sphere_rays(s, sph, sa, kt);
+    const double t1 = now();
+    RTCScene scene = embree_spheres(dev, sph, quality);
+    const double t_embree = now() - t1;
+    auto sb = accel::SceneBvh::build(s);
+    const std::vector<KernelObject> prims = leaf_objects(s, *sb);
+    const AccelView view{sb->bvh.nodes.data(), prims.data()};
+    std::printf("\n%zu random spheres (perf/bvh_bench's field); streamrt hierarchy %.2f s, Embree build (%s quality, "
+                "1 thread) %.2f s; 1280x720 camera rays\n",
+                n, t_ours, quality == RTC_BUILD_QUALITY_HIGH ? "high" : "medium", t_embree);
+    std::printf("%-9s %9s %10s %10s %10s %7s %10s   %s\n", "rays", "count", "Embree16", "Embree1", "streamrt", "ratio",
+                "single", "hits: Embree16 / Embree1 / streamrt");
+    const auto row = [&](const char* name, const Stream& flat, bool any, SetTiming ours, SetTiming single) {
+        const Result e16 = embree16(scene, flat, any, reps), e1 = embree1(scene, flat, any, reps);
+        std::printf("%-9s %9zu %10.2f %10.2f %10.2f %6.2fx %10.2f   %zu / %zu / %zu\n", name, flat.count, e16.mrays,
+                    e1.mrays, ours.mrays, ours.mrays / e16.mrays, single.mrays, e16.hits, e1.hits, ours.hits);
+        std::fflush(stdout);
+    };
+    row("primary", flat_stream(sets.primary), false, time_closest(sets.primary, at.closest_packet, view, reps),
+        time_closest(sets.primary, at.closest_single, view, reps));
+    row("shadow", flat_stream(sets.shadow), true, time_any(sets.shadow, at.any_packet, view, reps),
+        time_any(sets.shadow, at.any_single, view, reps));
+    row("reflected", flat_stream(sets.reflected), false, time_closest(sets.reflected, at.closest_packet, view, reps),
+        time_closest(sets.reflected, at.closest_single, view, reps));
+    rtcReleaseScene(scene);
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -165,6 +239,7 @@ int main(int argc, char** argv) {
     RTCBuildQuality quality = RTC_BUILD_QUALITY_HIGH;
     std::vector<std::string> files;
     std::string only;  // --rays: comma-separated kinds, empty = all
+    std::size_t spheres = 0;  // --spheres N: the sphere field instead of meshes
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--reps" && i + 1 < argc) {
@@ -177,15 +252,17 @@ int main(int argc, char** argv) {
             quality = q == "high" ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
         } else if (a == "--rays" && i + 1 < argc) {
             only = "," + std::string(argv[++i]) + ",";
+        } else if (a == "--spheres" && i + 1 < argc) {
+            spheres = std::size_t(std::max(1.0, std::atof(argv[++i])));
         } else if (a == "-h" || a == "--help" || a.rfind("--", 0) == 0) {
             std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa sse2|sse4.2|avx2|avx512] [--quality medium|high] "
-                                 "[--rays primary,shadow,mirror,glass,diffuse] MESH.{obj,ply} ...\n");
+                                 "[--rays primary,shadow,mirror,glass,diffuse] MESH.{obj,ply} ... | --spheres N\n");
             return a == "-h" || a == "--help" ? 0 : 2;
         } else {
             files.push_back(a);
         }
     }
-    if (files.empty()) return std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa LEVEL] [--quality medium|high] MESH.{obj,ply} ...\n"), 2;
+    if (files.empty() && spheres == 0) return std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa LEVEL] [--quality medium|high] MESH.{obj,ply} ...\n"), 2;
     // Embree's advice for its kernels (denormals flushed); the same mode for streamrt's below.
     _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
@@ -197,6 +274,11 @@ int main(int argc, char** argv) {
                 "median of %d, Mrays/s\n",
                 RTC_VERSION_STRING, rtcGetDeviceProperty(dev, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? "yes" : "no",
                 kt.name, kt.float_lanes, reps);
+    if (spheres) {
+        const int rc = sphere_field(dev, isa, spheres, reps, quality);
+        rtcReleaseDevice(dev);
+        return rc;
+    }
     for (const std::string& file : files) {
         std::shared_ptr<const Mesh> mesh;
         const double t_read = now();
