@@ -43,17 +43,28 @@ inline auto slab_test(const B& lox, const B& loy, const B& loz, const B& hix, co
                       const Vec3T<B>& o, const Vec3T<B>& inv, const B& t_max, B& t_near) {
     using T = typename B::value_type;
     B tn(T(0)), tf = t_max;
+    // min(x, y) / max(x, y) are the minps / maxps instructions, which give y when x is NaN:
+    // the same bits as select(x < y, x, y) and select(x > y, x, y), in one instruction.
     const auto slab = [&](const B& lo, const B& hi, const B& oc, const B& ic) {
         const B a = (lo - oc) * ic, b = (hi - oc) * ic;
-        const B mn = xsimd::select(a < b, a, b), mx = xsimd::select(a < b, b, a);
-        tn = xsimd::select(mn > tn, mn, tn);
-        tf = xsimd::select(mx < tf, mx, tf);
+        const B mn = xsimd::min(a, b), mx = xsimd::max(b, a);
+        tn = xsimd::max(mn, tn);  // NaN (0 * inf): the slab does not limit
+        tf = xsimd::min(mx, tf);
     };
     slab(lox, hix, o.x, inv.x);
     slab(loy, hiy, o.y, inv.y);
     slab(loz, hiz, o.z, inv.z);
     t_near = tn;
     return tn <= tf;
+}
+
+/// Starts loading the object records of a leaf that a walk has just met: with many objects
+/// the records (72 bytes each) miss the caches, and the walk would wait on them when it pops
+/// the leaf; the leaves nearer than it are tested meanwhile.
+inline void prefetch_leaf(const AccelView& bvh, std::int32_t first, std::uint32_t count) {
+    const char* p = reinterpret_cast<const char*>(bvh.prims + first);
+    const char* end = reinterpret_cast<const char*>(bvh.prims + first + count);
+    for (; p < end; p += 64) __builtin_prefetch(p);
 }
 
 /// Pushes the hit children of a node farthest first (so the nearest is popped first).
@@ -239,6 +250,7 @@ void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object
                 const auto hit = slab_test(B(n.lo_x[j]), B(n.lo_y[j]), B(n.lo_z[j]), B(n.hi_x[j]), B(n.hi_y[j]),
                                            B(n.hi_z[j]), o, inv, best, tn);
                 if (!xsimd::any(hit)) continue;
+                if (n.count[j] > 0) prefetch_leaf(bvh, n.child[j], n.count[j]);
                 const float t_min = lanes_min_where(tn, hit);
                 hits[nh++] = {n.child[j], n.count[j], t_min, movemask_bits(hit)};
             }
@@ -295,7 +307,9 @@ void bvh_any_packet(const AccelView& bvh, RayView rays) {
                 B tn;
                 const auto hit = slab_test(B(n.lo_x[j]), B(n.lo_y[j]), B(n.lo_z[j]), B(n.hi_x[j]), B(n.hi_y[j]),
                                            B(n.hi_z[j]), o, inv, t_max, tn) && open;
-                if (xsimd::any(hit)) stack[sp++] = {n.child[j], n.count[j], 0.f, movemask_bits(hit)};
+                if (!xsimd::any(hit)) continue;
+                if (n.count[j] > 0) prefetch_leaf(bvh, n.child[j], n.count[j]);
+                stack[sp++] = {n.child[j], n.count[j], 0.f, movemask_bits(hit)};
             }
         }
         alignas(64) float out[W];
@@ -307,8 +321,8 @@ void bvh_any_packet(const AccelView& bvh, RayView rays) {
 
 /// One ray against the 8 children of a node: hit children (entry distance) into hits[].
 template <class NodeArch>
-inline int node_hits_single(const accel::WideNode& n, const Vec3f& o, const Vec3f& inv, float t_max,
-                            accel_detail::StackEntry* hits) {
+inline int node_hits_single(const AccelView& bvh, const accel::WideNode& n, const Vec3f& o, const Vec3f& inv,
+                            float t_max, accel_detail::StackEntry* hits) {
     using namespace accel_detail;
     using NB = xsimd::batch<float, NodeArch>;
     constexpr std::size_t NW = NB::size;
@@ -323,7 +337,10 @@ inline int node_hits_single(const accel::WideNode& n, const Vec3f& o, const Vec3
     }
     int nh = 0;
     for (int j = 0; j < accel::kNodeWidth; ++j)
-        if (tn_out[j] < kInfF && n.child[j] >= 0) hits[nh++] = {n.child[j], n.count[j], tn_out[j]};
+        if (tn_out[j] < kInfF && n.child[j] >= 0) {
+            if (n.count[j] > 0) prefetch_leaf(bvh, n.child[j], n.count[j]);
+            hits[nh++] = {n.child[j], n.count[j], tn_out[j]};
+        }
     return nh;
 }
 
@@ -365,7 +382,7 @@ void bvh_closest_single(const AccelView& bvh, RayView rays, std::int32_t* object
                 continue;
             }
             StackEntry hits[accel::kNodeWidth];
-            const int nh = node_hits_single<NodeArch>(bvh.nodes[e.child], o, inv, best, hits);
+            const int nh = node_hits_single<NodeArch>(bvh, bvh.nodes[e.child], o, inv, best, hits);
             push_sorted(stack, sp, hits, nh);
         }
         if (best_id >= 0) {
@@ -404,7 +421,7 @@ void bvh_any_single(const AccelView& bvh, RayView rays) {
                 continue;
             }
             StackEntry hits[accel::kNodeWidth];
-            const int nh = node_hits_single<NodeArch>(bvh.nodes[e.child], o, inv, t_max, hits);
+            const int nh = node_hits_single<NodeArch>(bvh, bvh.nodes[e.child], o, inv, t_max, hits);
             for (int k = 0; k < nh; ++k) stack[sp++] = hits[k];
         }
         if (blocked) rays.t_max[i] = 0.f;
