@@ -169,6 +169,8 @@ inline xsimd::batch<float, Arch> object_t(const RayView& rays, std::size_t base,
                               {BF::load_aligned(rays.dx + base), BF::load_aligned(rays.dy + base),
                                BF::load_aligned(rays.dz + base)}};
         const RayPacket<BF> c = to_canonical<BF, float>(r, ob);
+        if constexpr (requires { Shape::may_hit(c.o, c.d); })
+            if (!xsimd::any(Shape::may_hit(c.o, c.d))) return BF(kInfF);  // every lane misses: skip the solve
         return Shape::template hit_t<BF>(c.o, c.d, BF(ob.param), BF(0.f), t_max);
     } else {
         using BD = xsimd::batch<double, Arch>;

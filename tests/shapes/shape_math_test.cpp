@@ -45,6 +45,44 @@ TEST_CASE("sphere: far origin keeps precision (closest-approach discriminant)") 
     CHECK(t == doctest::Approx(1e7 - 1).epsilon(1e-15));
 }
 
+TEST_CASE("sphere: the packet pre-test never rejects a ray that hits (grazing rays in float)") {
+    // Known answers: the line at distance h from the centre meets the unit sphere iff h <= 1.
+    CHECK(SphereMath::may_hit<float>({0.f, 2.f, 5.f}, {0.f, 0.f, -1.f}) == false);   // h = 2
+    CHECK(SphereMath::may_hit<float>({0.f, 1.1f, 5.f}, {0.f, 0.f, -1.f}) == false);  // h = 1.1
+    CHECK(SphereMath::may_hit<float>({0.f, 0.5f, 5.f}, {0.f, 0.f, -1.f}) == true);   // h = 0.5
+    CHECK(SphereMath::may_hit<float>({0.f, 0.5f, 5.f}, {0.f, 0.f, 1.f}) == true);    // the line, not the ray
+    // Far away the margin widens, in proportion to the distance (2^-17 (a |w| |o| + |w|^2 +
+    // a^2), by hand): at 1000 radii a line 1.01 radii from the centre is rejected (a^2 - |w|^2
+    // = -0.0201 a^2 against a margin of 0.0077 a^2), one 1.001 radii away is let through
+    // (-0.002 a^2); at 10 radii, 1.0002 radii away is rejected (-0.0004 a^2 against 0.0001 a^2).
+    CHECK(SphereMath::may_hit<float>({1.01f, 0.f, 1000.f}, {0.f, 0.f, -2.f}) == false);
+    CHECK(SphereMath::may_hit<float>({1.001f, 0.f, 1000.f}, {0.f, 0.f, -2.f}) == true);
+    CHECK(SphereMath::may_hit<float>({0.f, 1.0002f, 10.f}, {0.f, 0.f, -1.f}) == false);
+    // Rays from up to 1e4 away (unnormalised directions) aimed inside and outside the rim by
+    // 1e-7 to 1e-2, where b^2 - a c cancels: wherever the float solve finds a hit, the
+    // pre-test lets it through.
+    int hits = 0, rejected_hits = 0, misses_rejected = 0;
+    for (int k = 0; k < 4000; ++k) {
+        const double dist = std::pow(10.0, 0.5 + 3.5 * (k % 40) / 39.0);          // 3 .. 1e4 away
+        const int m = k / 40;  // 0 .. 99: inside and outside the rim by 1e-7 .. 1e-2
+        const double h = 1.0 + (m % 2 ? 1.0 : -1.0) * std::pow(10.0, -7.0 + 5.0 * (m / 2) / 49.0);
+        const double ang = 0.37 * k;
+        const Vec3f o{float(h * std::cos(ang)), float(h * std::sin(ang)), float(dist)};
+        const Vec3f d{0.f, 0.f, float(-(1.0 + (k % 7)))};  // |d| from 1 to 7
+        const float t = SphereMath::hit_t<float>(o, d, 0.f, 0.f, std::numeric_limits<float>::infinity());
+        const bool may = SphereMath::may_hit<float>(o, d);
+        if (t < std::numeric_limits<float>::infinity()) {
+            ++hits;
+            if (!may) ++rejected_hits;
+        } else if (!may) {
+            ++misses_rejected;
+        }
+    }
+    CHECK(hits > 1000);                 // the sweep does reach the rim from both sides
+    CHECK(rejected_hits == 0);          // never a hit thrown away
+    CHECK(misses_rejected > 100);       // and the pre-test does reject the clearer misses
+}
+
 TEST_CASE("plane: hit, from below, parallel, lying in the plane") {
     CHECK(hit<PlaneMath>({0, 2, 0}, {0, -1, 0}) == doctest::Approx(2.0));
     CHECK(hit<PlaneMath>({0, -2, 0}, {0, 1, 0}) == doctest::Approx(2.0));
