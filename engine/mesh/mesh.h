@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "accel/bvh.h"
+#include "core/default_init.h"
 #include "mesh/mesh_view.h"
 #include "simd/lanes.h"
 
@@ -29,7 +30,7 @@ struct Mesh {
     std::vector<float> vertex_normals;  ///< 3 per vertex
     std::vector<float> corner_uv;       ///< 6 per triangle (MeshView::uv), leaf order; empty: none
     accel::Bvh bvh;                     ///< prim_index is dropped: triangles are stored in leaf order
-    simd::AlignedVec<TriangleBlock> blocks;  ///< MeshView::blocks: the leaves' triangles, 4 to a block
+    AlignedFillLaterVec<TriangleBlock> blocks;  ///< MeshView::blocks: the leaves' triangles, 4 to a block
     std::vector<std::uint32_t> block_of;     ///< MeshView::block_of, one per triangle
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  ///< bounds of the vertices
     std::size_t dropped = 0;            ///< degenerate triangles left out

@@ -11,16 +11,32 @@ namespace streamrt {
 
 void Mesh::build_triangle_blocks() {
     // Leaves as (first triangle, count), in triangle order, so blocks follow the triangles.
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> leaves;
-    for (const accel::WideNode& n : bvh.nodes)
+    // The leaves cover the triangles in disjoint runs: their sizes marked at their first
+    // triangles and read back in one pass put them in order without a sort.
+    const std::size_t n = triangle_count();
+    std::vector<std::uint32_t> size_at(n, 0);
+    std::size_t n_leaves = 0;
+    for (const accel::WideNode& nd : bvh.nodes)
         for (int j = 0; j < accel::kNodeWidth; ++j)
-            if (n.child[j] >= 0 && n.count[j] > 0) leaves.emplace_back(std::uint32_t(n.child[j]), n.count[j]);
-    std::sort(leaves.begin(), leaves.end());
+            if (nd.child[j] >= 0 && nd.count[j] > 0) {
+                size_at[std::size_t(nd.child[j])] = nd.count[j];
+                ++n_leaves;
+            }
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> leaves;
+    leaves.reserve(n_leaves);
+    for (std::size_t t = 0; t < n;)
+        if (size_at[t] > 0) {
+            leaves.emplace_back(std::uint32_t(t), size_at[t]);
+            t += size_at[t];
+        } else {
+            ++t;  // not reached on a built mesh: every triangle is in a leaf
+        }
+    std::vector<std::uint32_t>().swap(size_at);
     std::vector<std::uint32_t> first_block(leaves.size() + 1, 0);
     for (std::size_t i = 0; i < leaves.size(); ++i)
         first_block[i + 1] = first_block[i] + (leaves[i].second + kBlockTriangles - 1) / kBlockTriangles;
-    block_of.assign(triangle_count(), 0);
-    blocks.assign(first_block.back(), TriangleBlock{});
+    block_of.assign(n, 0);
+    blocks.resize(first_block.back());  // every block is written in full below
     parallel_for_index(leaves.size(), 4096, [&](std::size_t i) {
         const auto [first, count] = leaves[i];
         block_of[first] = first_block[i];
