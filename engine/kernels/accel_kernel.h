@@ -198,6 +198,8 @@ inline float object_t_single(const Vec3f& o, const Vec3f& d, const ObjectXf& ob,
     using B = xsimd::batch<T, Arch>;
     const RayPacket<B> r{{B(T(o.x)), B(T(o.y)), B(T(o.z))}, {B(T(d.x)), B(T(d.y)), B(T(d.z))}};
     const RayPacket<B> c = to_canonical<B, T>(r, ob);
+    if constexpr (requires { Shape::may_hit(c.o, c.d); })
+        if (!xsimd::any(Shape::may_hit(c.o, c.d))) return kInfF;  // the line surely misses: skip the solve
     const B t = Shape::template hit_t<B>(c.o, c.d, B(T(ob.param)), B(T(0)), B(T(t_max)));
     return float(t.get(0));
 }
