@@ -42,7 +42,7 @@ struct SphereMath {
     /// hit_t's own discriminant, stays under about 24 eps a |w| |o| + 3 eps |w|^2 + 7 eps a^2
     /// (eps = 2^-24: the closest point carries an error of a few eps |o|); the margin is
     /// 2^-17 = 128 eps times the sum. At 1000 radii from the centre, lines passing more than
-    /// 1.002 radii away are rejected.
+    /// about 1.004 radii away are rejected.
     template <class V>
     static auto may_hit(const Vec3T<V>& o, const Vec3T<V>& d) {
         const V a = dot(d, d);
