@@ -62,9 +62,7 @@ inline auto slab_test(const B& lox, const B& loy, const B& loz, const B& hix, co
 /// the records (72 bytes each) miss the caches, and the walk would wait on them when it pops
 /// the leaf; the leaves nearer than it are tested meanwhile.
 inline void prefetch_leaf(const AccelView& bvh, std::int32_t first, std::uint32_t count) {
-    const char* p = reinterpret_cast<const char*>(bvh.prims + first);
-    const char* end = reinterpret_cast<const char*>(bvh.prims + first + count);
-    for (; p < end; p += 64) __builtin_prefetch(p);
+    simd::prefetch_lines(bvh.prims + first, sizeof(KernelObject) * count);
 }
 
 /// Pushes the hit children of a node farthest first (so the nearest is popped first).

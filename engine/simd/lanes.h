@@ -147,6 +147,13 @@ class FlushDenormals {
 
 STREAMRT_ISA_END
 
+/// Starts loading the cache lines of [p, p + bytes): for data a walk will read after testing
+/// nearer things (a leaf met now, popped later).
+inline void prefetch_lines(const void* p, std::size_t bytes) {
+    const char* c = static_cast<const char*>(p);
+    for (const char* end = c + bytes; c < end; c += 64) __builtin_prefetch(c);
+}
+
 /// Widest batch we build (AVX-512: 16 floats). Streams are padded to it in every build so the
 /// layout is the same at 4, 8 and 16 lanes and aligned loads are always legal.
 inline constexpr std::size_t kMaxLanes = 16;
