@@ -301,6 +301,7 @@ inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const
             const auto hit = robust_box(n, j, o, inv, best, tn);
             if (!xsimd::any(hit)) continue;
             if (n.count[j] > 0) prefetch_leaf_triangles(m, n.child[j], n.count[j]);
+            else simd::prefetch_lines(m.nodes + n.child[j], sizeof(accel::WideNode));  // an inner node: its 4 lines
             // farthest first, so the nearest is popped first
             const PacketEntry en{n.child[j], n.count[j], lanes_min_where(tn, hit),
                                  single_lanes > 0 ? movemask_bits(hit) : ~0u};
