@@ -128,14 +128,13 @@ namespace mesh_detail {
 
 /// Starts loading a child the single-ray walk will visit: an inner node's boxes (the first
 /// 192 of its 256 bytes) or a leaf's first block (144 bytes). The walk is a chain of dependent
-/// loads (pop, node, child, leaf), so without this it waits on memory at every step; the
-/// packet walk, which spends longer on each node, measured no gain from the same.
+/// loads (pop, node, child, leaf), so without this it waits on memory at every step. (The
+/// packet walk prefetches too, but only in the closest-hit walk and only what misses the
+/// caches on large meshes: docs/performance.md, "A leaf's triangles loaded".)
 inline void prefetch_child(const MeshView& m, const Entry& e) {
-    const char* p = e.count == 0 ? reinterpret_cast<const char*>(m.nodes + e.child)
-                                 : reinterpret_cast<const char*>(m.blocks + m.block_of[e.child]);
-    __builtin_prefetch(p);
-    __builtin_prefetch(p + 64);
-    __builtin_prefetch(p + 128);
+    const void* p = e.count == 0 ? static_cast<const void*>(m.nodes + e.child)
+                                 : static_cast<const void*>(m.blocks + m.block_of[e.child]);
+    simd::prefetch_lines(p, 192);
 }
 
 /// The children of node n the ray enters with t in [0, t_max] (far distance widened by
