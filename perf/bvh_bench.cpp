@@ -6,7 +6,6 @@
 //   bvh_bench traversal [N]           packet vs single-ray traversal per ray kind (one core, median of 3)
 //   bvh_bench threshold [-j J]        flat loops vs hierarchy for small N, both engines
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -27,8 +26,6 @@ using namespace streamrt;
 using namespace streamrt::perf;
 
 namespace {
-
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 int arg_jobs(int& argc, char** argv) {
     int jobs = 2;

@@ -12,7 +12,6 @@
 // (nodes, leaves, and its SAH cost: the same tree gives the same cost, so a faster builder
 // can be checked for the trees it makes as well as for its time).
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -23,12 +22,12 @@
 #include "mesh/obj_reader.h"
 #include "mesh/ply_reader.h"
 #include "parallel/parallelism.h"
+#include "bench_clock.h"
 
 using namespace streamrt;
+using streamrt::perf::now;
 
 namespace {
-
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());

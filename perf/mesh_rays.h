@@ -18,12 +18,9 @@
 #include "kernels/kernel_table.h"
 #include "mesh/mesh.h"
 #include "simd/lanes.h"
+#include "bench_clock.h"
 
 namespace streamrt::perf {
-
-inline double now() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 /// A ray stream padded to 16 lanes with inactive rays (t_max = 0).
 struct Stream {

@@ -2,7 +2,6 @@
 // A field of random spheres and its ray sets, shared by the sphere timing programs
 // (perf/bvh_bench.cpp, perf/peer/embree_rays.cpp). Not a test.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -17,6 +16,7 @@
 #include "scene/scene.h"
 #include "scene/scene_bvh.h"
 #include "stream/stream_accel.h"
+#include "bench_clock.h"
 
 namespace streamrt::perf {
 
@@ -168,9 +168,9 @@ SetTiming time_set(const std::vector<Stream>& set, int reps, Trace&& trace) {
         double t = 0;
         for (const Stream& r0 : set) {
             Stream r = r0;
-            const double t0 = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+            const double t0 = now();
             hits += trace(r);
-            t += std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count() - t0;
+            t += now() - t0;
             rays += r.count;
         }
         secs.push_back(t);
