@@ -16,7 +16,6 @@
 #include <ctime>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -30,16 +29,17 @@
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image_write.h>
 
+#include "bench_clock.h"
 #include "image/image_io.h"
 #include "parallel/parallelism.h"
 #include "driver/render.h"
 #include "scene/parser.h"
 
 using namespace streamrt;
+using streamrt::perf::now;
 
 namespace {
 
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 double cpu_now() {
     timespec t;

@@ -7,20 +7,20 @@
 // same view (1280x720, 1 spp, the sphere filling most of the image) of the mesh and of the
 // analytic unit sphere with both engines on J threads (default 1: per core), at degree 0
 // (primary rays only) and degree 5 (primary + shadow rays, one light), best of 3.
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
+#include "bench_clock.h"
 #include "mesh/mesh.h"
 #include "parallel/parallelism.h"
 #include "driver/render.h"
 
 using namespace streamrt;
+using streamrt::perf::now;
 
 namespace {
 
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 Scene view_of(const Object& o, const std::shared_ptr<const Mesh>& mesh, int degree, int width, int height) {
     Scene s;
