@@ -300,8 +300,10 @@ inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const
             B tn;
             const auto hit = robust_box(n, j, o, inv, best, tn);
             if (!xsimd::any(hit)) continue;
-            if (n.count[j] > 0) prefetch_leaf_triangles(m, n.child[j], n.count[j]);
-            else simd::prefetch_lines(m.nodes + n.child[j], sizeof(accel::WideNode));  // an inner node: its 4 lines
+            if (m.prefetched) {
+                if (n.count[j] > 0) prefetch_leaf_triangles(m, n.child[j], n.count[j]);
+                else simd::prefetch_lines(m.nodes + n.child[j], sizeof(accel::WideNode));  // an inner node: its 4 lines
+            }
             // farthest first, so the nearest is popped first
             const PacketEntry en{n.child[j], n.count[j], lanes_min_where(tn, hit),
                                  single_lanes > 0 ? movemask_bits(hit) : ~0u};
@@ -399,6 +401,18 @@ inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<
         for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
             B tn;
             const std::uint32_t bits = movemask_bits(robust_box(n, j, o, inv, t_max, tn) && open);
+            if (m.prefetched) {
+                // The met child's first 4 lines (a node, or a leaf's up to 4 triangles), and a
+                // the stack's first lines (in the cache) for a child no lane met: a select, not a branch on the box
+                // test (a branch cost 13 - 16 %, docs/performance.md "Shadow packets load ahead").
+                const char* ahead = n.count[j] > 0 ? reinterpret_cast<const char*>(m.tri + 9 * std::size_t(n.child[j]))
+                                                   : reinterpret_cast<const char*>(m.nodes + n.child[j]);
+                ahead = bits != 0 ? ahead : reinterpret_cast<const char*>(stack);
+                __builtin_prefetch(ahead);
+                __builtin_prefetch(ahead + 64);
+                __builtin_prefetch(ahead + 128);
+                __builtin_prefetch(ahead + 192);
+            }
             stack[sp] = {n.child[j], n.count[j], 0.f, bits};
             sp += int(bits != 0);
         }

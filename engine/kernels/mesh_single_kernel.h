@@ -129,8 +129,7 @@ namespace mesh_detail {
 /// Starts loading a child the single-ray walk will visit: an inner node's boxes (the first
 /// 192 of its 256 bytes) or a leaf's first block (144 bytes). The walk is a chain of dependent
 /// loads (pop, node, child, leaf), so without this it waits on memory at every step. (The
-/// packet walk prefetches too, but only in the closest-hit walk and only what misses the
-/// caches on large meshes: docs/performance.md, "A leaf's triangles loaded".)
+/// packet walks prefetch too, but only on meshes larger than the caches, MeshView::prefetched.)
 inline void prefetch_child(const MeshView& m, const Entry& e) {
     const void* p = e.count == 0 ? static_cast<const void*>(m.nodes + e.child)
                                  : static_cast<const void*>(m.blocks + m.block_of[e.child]);
