@@ -379,6 +379,7 @@ inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<
     stack[sp++] = {0, 0, 0.f, movemask_bits(open)};
     while (sp > 0) {
         const PacketEntry e = stack[--sp];
+        if ((e.lanes & movemask_bits(open)) == 0) continue;  // the lanes that met it have been blocked since
         if (single_lanes > 0 && std::uint32_t(std::popcount(e.lanes & movemask_bits(open))) <= single_lanes) {
             hand_over(e);
             if (!xsimd::any(open)) break;
