@@ -403,9 +403,9 @@ inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<
             B tn;
             const std::uint32_t bits = movemask_bits(robust_box(n, j, o, inv, t_max, tn) && open);
             if (m.prefetched) {
-                // The met child's first 4 lines (a node, or a leaf's up to 4 triangles), and a
-                // the stack's first lines (in the cache) for a child no lane met: a select, not a branch on the box
-                // test (a branch cost 13 - 16 %, docs/performance.md "Shadow packets load ahead").
+                // The met child's first 4 lines (a node, or a leaf's up to 4 triangles), or for
+                // a child no lane met the stack's own first lines (in the cache): a select, not
+                // a branch on the box test (docs/performance.md, "Shadow packets load ahead").
                 const char* ahead = n.count[j] > 0 ? reinterpret_cast<const char*>(m.tri + 9 * std::size_t(n.child[j]))
                                                    : reinterpret_cast<const char*>(m.nodes + n.child[j]);
                 ahead = bits != 0 ? ahead : reinterpret_cast<const char*>(stack);
