@@ -408,11 +408,7 @@ inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<
                 // a branch on the box test (docs/performance.md, "Shadow packets load ahead").
                 const char* ahead = n.count[j] > 0 ? reinterpret_cast<const char*>(m.tri + 9 * std::size_t(n.child[j]))
                                                    : reinterpret_cast<const char*>(m.nodes + n.child[j]);
-                ahead = bits != 0 ? ahead : reinterpret_cast<const char*>(stack);
-                __builtin_prefetch(ahead);
-                __builtin_prefetch(ahead + 64);
-                __builtin_prefetch(ahead + 128);
-                __builtin_prefetch(ahead + 192);
+                simd::prefetch_lines(bits != 0 ? ahead : reinterpret_cast<const char*>(stack), sizeof(accel::WideNode));
             }
             stack[sp] = {n.child[j], n.count[j], 0.f, bits};
             sp += int(bits != 0);
