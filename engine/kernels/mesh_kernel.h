@@ -46,10 +46,16 @@ struct PacketLanes {
     Vec3f direction(std::size_t l) const { return {dx[l], dy[l], dz[l]}; }
 };
 
-/// Starts loading the triangles of a leaf a packet walk has just met (9 floats each, in leaf
-/// order): on a large mesh they miss the caches, and the nearer children are tested first.
-inline void prefetch_leaf_triangles(const MeshView& m, std::int32_t first, std::uint32_t count) {
-    simd::prefetch_lines(m.tri + 9 * std::size_t(first), 9 * sizeof(float) * count);
+/// Starts loading child j of node n, met by the lanes `bits` of a packet walk on a mesh larger
+/// than the caches (MeshView::prefetched): the first 4 lines at its address (an inner node's
+/// 256 bytes, or a leaf's first triangles, 36 bytes each, in leaf order), or for a child no lane
+/// met, `cached` (lines in the cache already). A select rather than a branch on the box test:
+/// on a tree that does not fit the cache a mispredicted branch waits on the node's load.
+inline void prefetch_met_child(const MeshView& m, const accel::WideNode& n, int j, std::uint32_t bits,
+                               const void* cached) {
+    const void* child = n.count[j] > 0 ? static_cast<const void*>(m.tri + 9 * std::size_t(n.child[j]))
+                                       : static_cast<const void*>(m.nodes + n.child[j]);
+    simd::prefetch_lines(bits != 0 ? child : cached, sizeof(accel::WideNode));
 }
 
 /// Box test for the mesh walk. Boxes are padded outwards (accel::conservative_box) and the
@@ -296,23 +302,44 @@ inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const
         const accel::WideNode& n = m.nodes[e.child];
         PacketEntry hits[accel::kNodeWidth];
         int nh = 0;
-        for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
-            B tn;
-            const auto hit = robust_box(n, j, o, inv, best, tn);
-            if (!xsimd::any(hit)) continue;
-            if (m.prefetched) {
-                if (n.count[j] > 0) prefetch_leaf_triangles(m, n.child[j], n.count[j]);
-                else simd::prefetch_lines(m.nodes + n.child[j], sizeof(accel::WideNode));  // an inner node: its 4 lines
+        // The met children, farthest first (so the nearest is popped first), equal distances in
+        // the children's order. On a mesh larger than the caches every child's entry is written
+        // and the count moves on where a lane met it, then the entries are sorted once: the
+        // same order as inserting each as met, which smaller meshes keep (their branches
+        // predict well; written as one loop body for both, the small form lost 3 - 9 %:
+        // docs/performance.md, "The closest walk on large meshes").
+        if (m.prefetched) {
+            for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
+                B tn;
+                const auto hit = robust_box(n, j, o, inv, best, tn);
+                const std::uint32_t bits = movemask_bits(hit);
+                prefetch_met_child(m, n, j, bits, hits);
+                hits[nh] = {n.child[j], n.count[j], lanes_min_where(tn, hit), single_lanes > 0 ? bits : ~0u};
+                nh += int(bits != 0);
             }
-            // farthest first, so the nearest is popped first
-            const PacketEntry en{n.child[j], n.count[j], lanes_min_where(tn, hit),
-                                 single_lanes > 0 ? movemask_bits(hit) : ~0u};
-            int k = nh++;
-            while (k > 0 && hits[k - 1].t < en.t) {
-                hits[k] = hits[k - 1];
-                --k;
+            for (int i = 1; i < nh; ++i) {
+                const PacketEntry en = hits[i];
+                int k = i;
+                while (k > 0 && hits[k - 1].t < en.t) {
+                    hits[k] = hits[k - 1];
+                    --k;
+                }
+                hits[k] = en;
             }
-            hits[k] = en;
+        } else {
+            for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
+                B tn;
+                const auto hit = robust_box(n, j, o, inv, best, tn);
+                if (!xsimd::any(hit)) continue;
+                const PacketEntry en{n.child[j], n.count[j], lanes_min_where(tn, hit),
+                                     single_lanes > 0 ? movemask_bits(hit) : ~0u};
+                int k = nh++;
+                while (k > 0 && hits[k - 1].t < en.t) {
+                    hits[k] = hits[k - 1];
+                    --k;
+                }
+                hits[k] = en;
+            }
         }
         for (int k = 0; k < nh; ++k) stack[sp++] = hits[k];
     }
@@ -402,14 +429,8 @@ inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<
         for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
             B tn;
             const std::uint32_t bits = movemask_bits(robust_box(n, j, o, inv, t_max, tn) && open);
-            if (m.prefetched) {
-                // The met child's first 4 lines (a node, or a leaf's up to 4 triangles), or for
-                // a child no lane met the stack's own first lines (in the cache): a select, not
-                // a branch on the box test (docs/performance.md, "Shadow packets load ahead").
-                const char* ahead = n.count[j] > 0 ? reinterpret_cast<const char*>(m.tri + 9 * std::size_t(n.child[j]))
-                                                   : reinterpret_cast<const char*>(m.nodes + n.child[j]);
-                simd::prefetch_lines(bits != 0 ? ahead : reinterpret_cast<const char*>(stack), sizeof(accel::WideNode));
-            }
+            // docs/performance.md, "Shadow packets load ahead"
+            if (m.prefetched) prefetch_met_child(m, n, j, bits, stack);
             stack[sp] = {n.child[j], n.count[j], 0.f, bits};
             sp += int(bits != 0);
         }

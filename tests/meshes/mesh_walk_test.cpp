@@ -2,7 +2,8 @@
 // single-ray with triangle blocks, and the scene hierarchy's single-ray walk through a mesh
 // leaf) against a brute-force oracle: every triangle of the mesh in double precision with the
 // Moller-Trumbore test written here (no code shared with the engine). Every SIMD level the
-// CPU has, closest and any hit, leaves of 1 to 4 triangles (the blocks' padding lanes), and
+// CPU has, closest and any hit, the packet walks' forms for small and large meshes
+// (MeshView::prefetched), leaves of 1 to 4 triangles (the blocks' padding lanes), and
 // the hybrid's hand-over both ways: full coherent packets, and packets with one live lane.
 // Watertightness at shared edges and vertices is in mesh_test.cpp (check_all_hit, which also
 // runs these three walks).
@@ -151,21 +152,25 @@ void check_against_oracle(const std::shared_ptr<const Mesh>& mesh, const Case& c
         const std::string isa_str = isa_name(isa);
         CAPTURE(isa_str);
         const KernelTable& kt = kernel_table(isa);
-        for (std::uint32_t lanes : {0u, 1u, 2u, 64u}) {
-            CAPTURE(lanes);
-            const auto walk = mesh->with_single_ray_lanes(lanes);
-            ObjectXf xf{};
-            xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
-            xf.id = 0;
-            xf.mesh = &walk->view();
-            Traced tr(c);
-            kt.closest[int(ShapeKind::Mesh)](tr.view, tr.id.data(), &xf, 1);
-            CHECK(count_bad(tr.rs, tr.id.data(), tr.prim.data(), false) == 0);
-            RayStream sh;
-            fill(sh, c);
-            kt.any[int(ShapeKind::Mesh)](view_of(sh), &xf, 1);
-            CHECK(count_bad(sh, nullptr, nullptr, true) == 0);
-        }
+        for (std::uint32_t lanes : {0u, 1u, 2u, 64u})
+            for (bool prefetched : {false, true}) {  // the packet walks' two forms (MeshView::prefetched)
+                CAPTURE(lanes);
+                CAPTURE(prefetched);
+                const auto walk = mesh->with_single_ray_lanes(lanes);
+                MeshView view = walk->view();
+                view.prefetched = prefetched;
+                ObjectXf xf{};
+                xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
+                xf.id = 0;
+                xf.mesh = &view;
+                Traced tr(c);
+                kt.closest[int(ShapeKind::Mesh)](tr.view, tr.id.data(), &xf, 1);
+                CHECK(count_bad(tr.rs, tr.id.data(), tr.prim.data(), false) == 0);
+                RayStream sh;
+                fill(sh, c);
+                kt.any[int(ShapeKind::Mesh)](view_of(sh), &xf, 1);
+                CHECK(count_bad(sh, nullptr, nullptr, true) == 0);
+            }
         // The scene hierarchy's single-ray walk reaches the mesh through a leaf.
         accel::AccelConfig single;
         single.primary = single.secondary = single.shadow = accel::Traversal::Single;
