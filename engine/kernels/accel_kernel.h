@@ -65,20 +65,6 @@ inline void prefetch_leaf(const AccelView& bvh, std::int32_t first, std::uint32_
     simd::prefetch_lines(bvh.prims + first, sizeof(KernelObject) * count);
 }
 
-/// Pushes the hit children of a node farthest first (so the nearest is popped first).
-inline void push_sorted(StackEntry* stack, int& sp, StackEntry* hits, int nh) {
-    for (int a = 1; a < nh; ++a) {
-        const StackEntry e = hits[a];
-        int k = a;
-        while (k > 0 && hits[k - 1].t < e.t) {
-            hits[k] = hits[k - 1];
-            --k;
-        }
-        hits[k] = e;
-    }
-    for (int k = 0; k < nh; ++k) stack[sp++] = hits[k];
-}
-
 /// Runs f(ShapeMath{}) for a stored kind (shapes/shapes.h's generated switch). Meshes are
 /// not closed-form: the leaf loops call the mesh walk instead, before this.
 template <class F>

@@ -16,6 +16,7 @@
 
 #include "kernels/lane_extremes.h"
 #include "kernels/mesh_single_kernel.h"
+#include "kernels/walk_stack.h"
 #include "mesh/mesh_view.h"
 #include "shapes/triangle_math.h"
 
@@ -317,29 +318,21 @@ inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const
                 hits[nh] = {n.child[j], n.count[j], lanes_min_where(tn, hit), single_lanes > 0 ? bits : ~0u};
                 nh += int(bits != 0);
             }
-            for (int i = 1; i < nh; ++i) {
-                const PacketEntry en = hits[i];
-                int k = i;
-                while (k > 0 && hits[k - 1].t < en.t) {
-                    hits[k] = hits[k - 1];
-                    --k;
-                }
-                hits[k] = en;
+            push_sorted(stack, sp, hits, nh);
+            continue;
+        }
+        for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
+            B tn;
+            const auto hit = robust_box(n, j, o, inv, best, tn);
+            if (!xsimd::any(hit)) continue;
+            const PacketEntry en{n.child[j], n.count[j], lanes_min_where(tn, hit),
+                                 single_lanes > 0 ? movemask_bits(hit) : ~0u};
+            int k = nh++;
+            while (k > 0 && hits[k - 1].t < en.t) {
+                hits[k] = hits[k - 1];
+                --k;
             }
-        } else {
-            for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
-                B tn;
-                const auto hit = robust_box(n, j, o, inv, best, tn);
-                if (!xsimd::any(hit)) continue;
-                const PacketEntry en{n.child[j], n.count[j], lanes_min_where(tn, hit),
-                                     single_lanes > 0 ? movemask_bits(hit) : ~0u};
-                int k = nh++;
-                while (k > 0 && hits[k - 1].t < en.t) {
-                    hits[k] = hits[k - 1];
-                    --k;
-                }
-                hits[k] = en;
-            }
+            hits[k] = en;
         }
         for (int k = 0; k < nh; ++k) stack[sp++] = hits[k];
     }
