@@ -40,7 +40,6 @@ using streamrt::perf::now;
 
 namespace {
 
-
 double cpu_now() {
     timespec t;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);

@@ -21,7 +21,6 @@ using streamrt::perf::now;
 
 namespace {
 
-
 Scene view_of(const Object& o, const std::shared_ptr<const Mesh>& mesh, int degree, int width, int height) {
     Scene s;
     if (mesh) s.meshes.push_back(mesh);  // Object::mesh 0

@@ -8,7 +8,6 @@
 // (uniform over the hemisphere: incoherent) (closest hit). Each stream is padded to 16 lanes
 // with inactive rays (t_max = 0).
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
