@@ -214,13 +214,13 @@ void bvh_closest_packet(const AccelView& bvh, RayView rays, std::int32_t* object
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count; ++k) {
                     const KernelObject& ob = bvh.prims[k];
-                    if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
+                    if (ob.xf.kind == std::uint32_t(ShapeKind::Mesh)) {
                         const B before = best;
                         mesh_leaf_closest<Arch>(rays, i, ob.xf, best, e.lanes);
                         best_id = xsimd::select(best < before, B(float(ob.xf.id)), best_id);
                         continue;
                     }
-                    with_shape(ob.kind, [&](auto shape) {
+                    with_shape(ob.xf.kind, [&](auto shape) {
                         const B t = object_t<Arch, decltype(shape)>(rays, i, ob.xf, best);
                         const auto closer = t < best;
                         best = xsimd::select(closer, t, best);
@@ -269,7 +269,7 @@ void bvh_any_packet(const AccelView& bvh, RayView rays) {
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count && xsimd::any(open); ++k) {
                     const KernelObject& ob = bvh.prims[k];
-                    if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
+                    if (ob.xf.kind == std::uint32_t(ShapeKind::Mesh)) {
                         const RayPacket<B> r{{B::load_aligned(rays.ox + i), B::load_aligned(rays.oy + i),
                                               B::load_aligned(rays.oz + i)},
                                              {B::load_aligned(rays.dx + i), B::load_aligned(rays.dy + i),
@@ -281,7 +281,7 @@ void bvh_any_packet(const AccelView& bvh, RayView rays) {
                         t_max = xsimd::select(open, t_max, B(0.f));
                         continue;
                     }
-                    with_shape(ob.kind, [&](auto shape) {
+                    with_shape(ob.xf.kind, [&](auto shape) {
                         const B t = object_t<Arch, decltype(shape)>(rays, i, ob.xf, t_max);
                         open = open && !(t < t_max);
                         t_max = xsimd::select(open, t_max, B(0.f));
@@ -351,7 +351,7 @@ void bvh_closest_single(const AccelView& bvh, RayView rays, std::int32_t* object
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count; ++k) {
                     const KernelObject& ob = bvh.prims[k];
-                    if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
+                    if (ob.xf.kind == std::uint32_t(ShapeKind::Mesh)) {
                         const float t = mesh_single_closest<Arch>(rays, i, o, d, ob.xf, best);
                         if (t < best) {
                             best = t;
@@ -359,7 +359,7 @@ void bvh_closest_single(const AccelView& bvh, RayView rays, std::int32_t* object
                         }
                         continue;
                     }
-                    with_shape(ob.kind, [&](auto shape) {
+                    with_shape(ob.xf.kind, [&](auto shape) {
                         const float t = object_t_single<Arch, decltype(shape)>(o, d, ob.xf, best);
                         if (t < best) {
                             best = t;
@@ -398,11 +398,11 @@ void bvh_any_single(const AccelView& bvh, RayView rays) {
             if (e.count > 0) {
                 for (std::uint32_t k = e.child; k < e.child + e.count && !blocked; ++k) {
                     const KernelObject& ob = bvh.prims[k];
-                    if (ob.kind == std::uint32_t(ShapeKind::Mesh)) {
+                    if (ob.xf.kind == std::uint32_t(ShapeKind::Mesh)) {
                         blocked = mesh_single_any<Arch>(o, d, ob.xf, t_max);
                         continue;
                     }
-                    with_shape(ob.kind, [&](auto shape) {
+                    with_shape(ob.xf.kind, [&](auto shape) {
                         blocked = object_t_single<Arch, decltype(shape)>(o, d, ob.xf, t_max) < t_max;
                     });
                 }

@@ -262,9 +262,9 @@ void shade_run(const ShadeJob& job) {
     constexpr std::size_t W = B::size;
     const simd::FlushDenormals ftz;  // see simd/lanes.h
     const ObjectXf& ob = kGathered ? job.objects[0].xf : job.object->xf;
-    const ShapeKind kind = kGathered ? job.kind : ShapeKind(job.object->kind);
-    // Gather strides, in floats: a KernelObject is 18, a SurfaceRecord 4.
-    static_assert(sizeof(KernelObject) == 18 * sizeof(float) && sizeof(SurfaceRecord) == 4 * sizeof(float));
+    const ShapeKind kind = kGathered ? job.kind : ShapeKind(job.object->xf.kind);
+    // Gather strides, in floats: a KernelObject is 16, a SurfaceRecord 4.
+    static_assert(sizeof(KernelObject) == 16 * sizeof(float) && sizeof(SurfaceRecord) == 4 * sizeof(float));
     const float* object_floats = reinterpret_cast<const float*>(kGathered ? job.objects : job.object);
     const float* surface_floats = reinterpret_cast<const float*>(job.surfaces);
     const MaterialT<float>& m = *job.material;
@@ -294,7 +294,7 @@ void shade_run(const ShadeJob& job) {
         ColorT<B> color;
         if constexpr (kGathered) {
             const I ids = run_field<Arch>(job, i, job.ids);  // padding lanes read a hit's id
-            const I at = ids * I(18), sat = ids * I(4);
+            const I at = ids * I(16), sat = ids * I(4);
             for (int k = 0; k < 12; ++k) rows.v[k] = gather_floats(object_floats + k, at);
             param = gather_floats(object_floats + 12, at);
             color = {gather_floats(surface_floats, sat), gather_floats(surface_floats + 1, sat),

@@ -145,6 +145,7 @@ glm::dquat Parser::rotation(const Statement& st, const Arg& a) {
 }
 
 void Parser::finish() {
+    scene.check_object_count();
     if (!animation_) return;
     scene.animation = std::move(animation_);
     try {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <string>
 
 namespace streamrt {
 
@@ -50,6 +51,14 @@ std::uint32_t Scene::intern_material(const Material& m) {
     const auto [it, added] = material_index_.try_emplace(m, std::uint32_t(materials.size()));
     if (added) materials.push_back(m);
     return it->second;
+}
+
+void Scene::check_object_count(std::size_t limit) const {
+    if (objects.size() <= limit) return;
+    const std::string msg = "the scene holds " + std::to_string(objects.size()) + " objects, more than the " +
+                            std::to_string(limit) + " streamrt supports; this is object " + std::to_string(limit + 1);
+    if (limit < object_locs.size() && object_locs[limit].file < files.size()) throw SceneError(where(limit), msg);
+    throw SceneError(SourceLoc{path.empty() ? std::string("<scene>") : path, 0, 0}, msg);
 }
 
 void Scene::add_object(Object o, const Material& m, const ObjectLoc& loc) {

@@ -131,6 +131,10 @@ inline Light rendered_light(Light l, const RenderSettings& s) {
     return l;
 }
 
+/// The most objects a scene may hold: the stream engine's kernels carry the closest object's
+/// number in float lanes, which are exact up to 2^24.
+inline constexpr std::size_t kMaxSceneObjects = std::size_t(1) << 24;
+
 struct Scene {
     std::string path;  ///< the file it was read from
     RenderSettings settings;
@@ -158,6 +162,9 @@ struct Scene {
         const ObjectLoc& l = object_locs[i];
         return SourceLoc{files[l.file], l.line, l.column};
     }
+    /// Throws SceneError at the statement of the first object beyond `limit` (kMaxSceneObjects
+    /// unless a test asks for less) when the scene holds more.
+    void check_object_count(std::size_t limit = kMaxSceneObjects) const;
     /// Adds an object; its material is deduplicated against those already here.
     void add_object(Object o, const Material& m = {}, const ObjectLoc& loc = {});
     /// The index of material m in `materials`, added if no equal one is there.

@@ -188,7 +188,7 @@ struct ShadeStage {
             const KernelObject& ob = sc.objects[std::size_t(id)];
             const SurfaceRecord& sf = sc.surfaces[std::size_t(id)];
             const MaterialT<float>& m = sc.materials[sf.material];
-            const ShapeKind kind = ShapeKind(ob.kind);
+            const ShapeKind kind = ShapeKind(ob.xf.kind);
             const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
             const float t = rays.t_max[i];
             // The canonical hit point (the kernels keep only t and the object) gives the
@@ -236,7 +236,7 @@ struct ShadeStage {
         // The run key of a hit: its object, or (gathered) its material and shape kind.
         const auto key_of = [&](std::int32_t id) -> std::size_t {
             if (!gathered) return std::size_t(id);
-            return std::size_t(sc.surfaces[std::size_t(id)].material) * kShapeKindCount + sc.objects[id].kind;
+            return std::size_t(sc.surfaces[std::size_t(id)].material) * kShapeKindCount + sc.objects[id].xf.kind;
         };
         const std::size_t n_keys = gathered ? sc.materials.size() * kShapeKindCount : sc.object_count;
         h.run_start.assign(n_keys + 1, 0);

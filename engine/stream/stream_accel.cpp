@@ -15,10 +15,10 @@ KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t i
     for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 4; ++c) k.xf.m[r * 4 + c] = float(mi[c][r]);  // glm is column-major
     k.xf.param = float(o.param);
-    k.xf.id = id;
+    k.xf.id = std::uint32_t(id);
     const Mesh* mesh = scene.mesh_of(o);
     k.xf.mesh = mesh ? &mesh->view() : nullptr;
-    k.kind = std::uint32_t(o.kind);
+    k.xf.kind = std::uint32_t(o.kind);
     return k;
 }
 
@@ -43,7 +43,7 @@ StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bv
     parallel_for_index(order_.size(), 4096, [&](std::size_t id) {
         objects_[id] = kernel_object(scene, order_[id], std::int32_t(id), shift);
     });
-    for (std::size_t id = n_bounded; id < order_.size(); ++id) unbounded_[objects_[id].kind].push_back(objects_[id].xf);
+    for (std::size_t id = n_bounded; id < order_.size(); ++id) unbounded_[objects_[id].xf.kind].push_back(objects_[id].xf);
 }
 
 std::size_t StreamAccel::memory_bytes() const {
@@ -92,7 +92,7 @@ bool StreamAccel::update(const Scene& scene, std::span<const std::uint32_t> move
     if (planes) {
         for (auto& u : unbounded_) u.clear();
         for (std::size_t id = n_bounded; id < order_.size(); ++id)
-            unbounded_[objects_[id].kind].push_back(objects_[id].xf);
+            unbounded_[objects_[id].xf.kind].push_back(objects_[id].xf);
     }
     bvh_->refit(scene, moved, std::span<const std::uint32_t>(order_.data(), n_bounded), shift);
     return true;

@@ -46,6 +46,7 @@ glm::vec3 cell_offset(const Material& m, const glm::dvec3& eye) {
 StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settings,
                          const accel::AccelConfig& accel_config)
     : settings(render_settings), accel_config_(accel_config) {
+    scene.check_object_count();  // a scene made in code (the Python module) is checked here
     // Objects are moved as they are converted (no copy of the scene: at 1e6 objects that copy
     // doubled the memory and the set-up time).
     glm::dvec3 eye;

@@ -670,3 +670,32 @@ TEST_CASE("parser: disk statements (shapes/shapes.h registry), keys and errors a
     CHECK(parse("torus minor=0.4").objects[0].param == doctest::Approx(0.4));
     expect_error("torus minor=0", 1, 13, "'minor' must be > 0");
 }
+
+TEST_CASE("parser: a scene beyond the object limit is refused at the first object past it") {
+    // The stream engine carries object numbers in float lanes, exact to 2^24 (kMaxSceneObjects);
+    // the check takes its limit as an argument so that a three-object scene can stand in.
+    const Scene s = parse("sphere\n\n  cube scale=2\nplane\n");
+    s.check_object_count();  // far below the real limit
+    s.check_object_count(3);
+    bool thrown = false;
+    try {
+        s.check_object_count(2);
+    } catch (const SceneError& e) {
+        thrown = true;
+        CHECK(e.where().file == "t.cfg");
+        CHECK(e.where().line == 4);  // the third object: `plane`
+        CHECK(e.where().column == 1);
+        CHECK(e.message() == "the scene holds 3 objects, more than the 2 streamrt supports; this is object 3");
+    }
+    CHECK(thrown);
+    thrown = false;
+    try {
+        s.check_object_count(1);
+    } catch (const SceneError& e) {
+        thrown = true;
+        CHECK(e.where().line == 3);  // `cube`, indented by two
+        CHECK(e.where().column == 3);
+    }
+    CHECK(thrown);
+    CHECK(kMaxSceneObjects == 16777216);
+}
