@@ -77,14 +77,23 @@ std::string quoted(std::string_view s) {
     return q;
 }
 
+bool is_index_list(const PlyElement& e, const PlyProperty& p) {
+    return e.name == "face" && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
+}
+
+/// A face's per-corner texture coordinates (MeshLab's `property list uchar float texcoord`:
+/// u and v of each corner, in the order of its vertex list).
+bool is_texcoord_list(const PlyElement& e, const PlyProperty& p) {
+    return e.name == "face" && p.is_list && (p.name == "texcoord" || p.name == "texcoords");
+}
+
 /// The fewest body bytes one item of `e` can take: its exact size in binary without lists,
 /// two characters per value in ASCII (a digit and a separator); a face's index list has at
-/// least 3 entries.
+/// least 3 entries (other lists may be empty).
 std::uint64_t min_item_bytes(const PlyElement& e, bool ascii) {
     std::uint64_t n = 0;
     for (const PlyProperty& p : e.props) {
-        const bool face_list = e.name == "face" && p.is_list;
-        const std::uint64_t items = face_list ? 3 : 0;
+        const std::uint64_t items = is_index_list(e, p) ? 3 : 0;
         if (ascii) n += 2 * (1 + (p.is_list ? items : 0));
         else n += p.is_list ? std::uint64_t(p.count_type.size) + items * std::uint64_t(p.type.size)
                             : std::uint64_t(p.type.size);
@@ -360,25 +369,41 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
         // (a count the header check cannot bound: looping over 4e9 empty items took minutes).
         if (e.props.empty()) continue;
         const bool vertex = e.name == "vertex", face = e.name == "face";
-        // Per property: where a vertex keeps it (0-2 position, 3-5 normal, -1 skipped).
+        // Per property: where a vertex keeps it (0-2 position, 3-5 normal, 6-7 texture
+        // coordinates under any of their usual names, -1 skipped).
         std::vector<int> slot(e.props.size(), -1);
-        bool normals = true;
+        bool normals = true, uvs = true;
         if (vertex) {
-            static const char* kSlots[] = {"x", "y", "z", "nx", "ny", "nz"};
+            static const struct {
+                const char* name;
+                int slot;
+            } kSlots[] = {{"x", 0},         {"y", 1},         {"z", 2},         {"nx", 3},        {"ny", 4},
+                          {"nz", 5},        {"u", 6},         {"s", 6},         {"texture_u", 6}, {"texture_s", 6},
+                          {"v", 7},         {"t", 7},         {"texture_v", 7}, {"texture_t", 7}};
             for (std::size_t p = 0; p < e.props.size(); ++p)
-                for (int s = 0; s < 6; ++s)
-                    if (!e.props[p].is_list && e.props[p].name == kSlots[s]) slot[p] = s;
+                for (const auto& k : kSlots)
+                    if (!e.props[p].is_list && e.props[p].name == k.name) slot[p] = k.slot;
             for (int s = 3; s < 6; ++s) normals = normals && std::count(slot.begin(), slot.end(), s) == 1;
+            for (int s = 6; s < 8; ++s) uvs = uvs && std::count(slot.begin(), slot.end(), s) == 1;
             out.positions.reserve(3 * std::size_t(e.count));  // bounded by the file's length (parse_header)
             if (normals) out.normals.reserve(3 * std::size_t(e.count));
+            if (uvs) out.uvs.reserve(2 * std::size_t(e.count));
         }
-        const PlyProperty* indices = nullptr;  // the first index list of a face
-        for (const PlyProperty& p : e.props)
-            if (face && !indices && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) indices = &p;
+        const PlyProperty* indices = nullptr;    // the first index list of a face
+        const PlyProperty* texcoords = nullptr;  // and its first texture coordinate list
+        for (const PlyProperty& p : e.props) {
+            if (!indices && is_index_list(e, p)) indices = &p;
+            if (!texcoords && is_texcoord_list(e, p)) texcoords = &p;
+        }
         if (face) out.triangles.reserve(3 * std::size_t(e.count));
+        if (texcoords) out.corner_uv.reserve(6 * std::size_t(e.count));
+        std::vector<std::uint32_t> corners;  // one face's vertex numbers, then its texture coordinates
+        std::vector<float> corner_uv;
         for (std::uint64_t k = 0; k < e.count; ++k) {
             body.begin_item(e.name, k);
-            double v[6] = {0, 0, 0, 0, 0, 0};
+            double v[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+            corners.clear();
+            corner_uv.clear();
             for (std::size_t p = 0; p < e.props.size(); ++p) {
                 const PlyProperty& prop = e.props[p];
                 if (!prop.is_list) {
@@ -388,29 +413,52 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
                 }
                 const std::int64_t n = body.read_int(prop.count_type);
                 if (n < 0) body.fail("a list of " + std::to_string(n) + " items");
+                if (&prop == texcoords) {
+                    for (std::int64_t j = 0; j < n; ++j) {
+                        const float c = float(body.read_number(prop.type));
+                        if (!std::isfinite(c)) body.fail("texture coordinate is not finite");
+                        corner_uv.push_back(c);
+                    }
+                    continue;
+                }
                 if (&prop != indices) {
                     body.skip_list(std::uint64_t(n), prop.type);
                     continue;
                 }
                 if (n < 3) body.fail("a face needs at least 3 vertices, got " + std::to_string(n));
-                // Fan triangulation: (first, previous, current) for every corner after the second.
-                std::uint32_t first = 0, previous = 0;
                 for (std::int64_t j = 0; j < n; ++j) {
                     const std::int64_t index = body.read_int(prop.type);
                     if (index < 0 || std::uint64_t(index) >= vertex_count)
                         body.fail("vertex index " + std::to_string(index) + " is not one of the " +
                                   std::to_string(vertex_count) + " vertices");
-                    const auto current = std::uint32_t(index);
-                    if (j == 0) first = current;
-                    else if (j >= 2) out.triangles.insert(out.triangles.end(), {first, previous, current});
-                    previous = current;
+                    corners.push_back(std::uint32_t(index));
                 }
+            }
+            if (face) {
+                if (texcoords && corner_uv.size() != 2 * corners.size())
+                    body.fail("a face of " + std::to_string(corners.size()) + " vertices needs " +
+                              std::to_string(2 * corners.size()) + " texture coordinates, got " +
+                              std::to_string(corner_uv.size()));
+                // Fan triangulation: (first, previous, current) for every corner after the second.
+                for (std::size_t j = 2; j < corners.size(); ++j) {
+                    out.triangles.insert(out.triangles.end(), {corners[0], corners[j - 1], corners[j]});
+                    if (texcoords)
+                        out.corner_uv.insert(out.corner_uv.end(), {corner_uv[0], corner_uv[1], corner_uv[2 * j - 2],
+                                                                   corner_uv[2 * j - 1], corner_uv[2 * j],
+                                                                   corner_uv[2 * j + 1]});
+                }
+                continue;
             }
             if (!vertex) continue;
             for (int a = 0; a < 3; ++a)
                 if (!std::isfinite(float(v[a]))) body.fail("vertex position is not finite");
             out.positions.insert(out.positions.end(), {float(v[0]), float(v[1]), float(v[2])});
             if (normals) out.normals.insert(out.normals.end(), {float(v[3]), float(v[4]), float(v[5])});
+            if (uvs) {
+                if (!std::isfinite(float(v[6])) || !std::isfinite(float(v[7])))
+                    body.fail("texture coordinate is not finite");
+                out.uvs.insert(out.uvs.end(), {float(v[6]), float(v[7])});
+            }
         }
     }
 }
@@ -430,14 +478,28 @@ PlyData parse_ply(std::string_view bytes, const std::string& name) {
     return out;
 }
 
-std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path) {
+std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw std::runtime_error("cannot open mesh file");
     const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     if (in.bad()) throw std::runtime_error("cannot read mesh file");
     const PlyData data = parse_ply(bytes, path);
     const std::size_t faces = data.triangles.size() / 3;
-    auto mesh = Mesh::build(path, data.positions, data.triangles, {}, {}, data.normals);
+    std::vector<float> corner_uv;
+    if (with_uv) {
+        if (!data.corner_uv.empty()) {
+            corner_uv = data.corner_uv;
+        } else if (!data.uvs.empty()) {
+            corner_uv.reserve(6 * faces);
+            for (const std::uint32_t i : data.triangles)
+                corner_uv.insert(corner_uv.end(), {data.uvs[2 * std::size_t(i)], data.uvs[2 * std::size_t(i) + 1]});
+        } else {
+            throw std::runtime_error(
+                "a texture needs texture coordinates, and this PLY file has none (vertex properties u v, s t or "
+                "texture_u texture_v, or a face list 'texcoord')");
+        }
+    }
+    auto mesh = Mesh::build(path, data.positions, data.triangles, {}, corner_uv, data.normals);
     if (mesh->triangle_count() == 0)
         throw std::runtime_error(faces == 0 ? "PLY file has no faces"
                                             : "PLY file has no triangles of non-zero area (" + std::to_string(faces) +
@@ -454,9 +516,7 @@ bool is_ply_path(const std::string& path) {
 
 std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv) {
     if (!is_ply_path(path)) return load_obj_mesh(path, with_uv);
-    if (with_uv)
-        throw std::runtime_error("a texture needs texture coordinates, which PLY meshes are not read with (use an OBJ file)");
-    return load_ply_mesh(path);
+    return load_ply_mesh(path, with_uv);
 }
 
 }  // namespace streamrt

@@ -1,7 +1,9 @@
 #pragma once
 // Stanford PLY meshes (ASCII, binary little and big endian): the `vertex` element's x y z
-// (and nx ny nz when all three are present) and the `face` element's vertex index lists,
-// polygons fan-triangulated; every other element and property is skipped by its size.
+// (and nx ny nz when all three are present; texture coordinates u v, s t, texture_u
+// texture_v or texture_s texture_t when one pair is) and the `face` element's vertex index
+// lists, polygons fan-triangulated, with the faces' per-corner `texcoord` lists when present
+// (MeshLab's form); every other element and property is skipped by its size.
 // Debian ships no maintained PLY library, hence this reader. Every count and size in the
 // header is checked against the file's length before anything is allocated.
 #include <cstdint>
@@ -19,6 +21,8 @@ struct PlyData {
     std::vector<float> positions;          ///< 3 per vertex
     std::vector<float> normals;            ///< 3 per vertex, or empty (no nx ny nz)
     std::vector<std::uint32_t> triangles;  ///< 3 vertex numbers per triangle
+    std::vector<float> uvs;                ///< 2 per vertex (u, v), or empty
+    std::vector<float> corner_uv;          ///< 6 per triangle (its corners' u, v) from face texcoord lists, or empty
 };
 
 /// Parses the bytes of a PLY file named `name` (for messages). Throws std::runtime_error
@@ -28,11 +32,14 @@ struct PlyData {
 PlyData parse_ply(std::string_view bytes, const std::string& name);
 
 /// Reads a PLY file into a mesh (its normals, when present, are the mesh's vertex normals).
-/// Throws std::runtime_error like parse_ply, and for a file with no triangle of non-zero area.
-std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path);
+/// With `with_uv` (a textured object) the mesh keeps texture coordinates: the faces'
+/// texcoord lists when the file has them, else the vertices' u v. Throws std::runtime_error
+/// like parse_ply, for a file with no triangle of non-zero area, and with `with_uv` for a
+/// file without texture coordinates.
+std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv = false);
 
 /// The mesh of a file by its extension: `.ply` (any case) with load_ply_mesh, anything else
-/// as a Wavefront OBJ file (load_obj_mesh). `with_uv` (a textured object) is refused for PLY.
+/// as a Wavefront OBJ file (load_obj_mesh); `with_uv` as for those.
 std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv);
 
 /// True when `path` names a PLY file (extension `.ply`, any case).

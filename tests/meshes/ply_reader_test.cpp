@@ -2,7 +2,8 @@
 // and without normals, a quad to fan, elements and properties to skip) against the triangles
 // and positions written; every header error at its line and column, body errors at their
 // line/column or item and byte offset; absurd counts refused from the header alone; a scene
-// with a PLY mesh renders the very picture of the same mesh read from OBJ.
+// with a PLY mesh renders the very picture of the same mesh read from OBJ, textured too
+// (texture coordinates per vertex or per face corner).
 #include <doctest/doctest.h>
 
 #include <bit>
@@ -276,5 +277,123 @@ TEST_CASE("ply: a mesh keeps the file's normals, a scene renders a PLY mesh as t
     std::ofstream(dir / "bad.ply", std::ios::binary) << "ply\nformat ascii 1.0\nelement vertex x\n";
     CHECK(scene_error("mesh file=bad.ply\n").find("bad.ply:3:16: expected a count of items") != std::string::npos);
     CHECK(scene_error("mesh file=bad.ply\n").rfind(where + "11: ", 0) == 0);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("ply: texture coordinates, per vertex under each usual name and per face corner, read as written") {
+    // Per vertex: u v, s t, texture_u texture_v, texture_s texture_t.
+    const std::string vertex_uv_tail = "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                       "0 0 0 0.25 0.5\n1 0 0 0.75 0.5\n0 1 0 0.25 1\n3 0 1 2\n";
+    for (const auto& [u, v] : {std::pair{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}}) {
+        CAPTURE(u);
+        const PlyData d = parse_ply(kHeadAscii + "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                                 "property float " + u + "\nproperty float " + v + "\n" + vertex_uv_tail,
+                                    "uv.ply");
+        CHECK(d.uvs == std::vector<float>{0.25f, 0.5f, 0.75f, 0.5f, 0.25f, 1.f});
+        CHECK(d.corner_uv.empty());
+    }
+    // Only one of the pair: no texture coordinates, and the lone value is skipped.
+    const PlyData lone = parse_ply(kHeadAscii + "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                                "property float u\nproperty float w\n" + vertex_uv_tail, "uv.ply");
+    CHECK(lone.uvs.empty());
+    CHECK(lone.positions == std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0});
+
+    // Binary, both byte orders: uv between the position and a skipped property.
+    for (bool big : {false, true}) {
+        CAPTURE(big);
+        Body b{big, {}};
+        const float uv[4][2] = {{0.f, 0.f}, {1.f, 0.f}, {1.f, 0.5f}, {0.f, 0.5f}};
+        for (int k = 0; k < 4; ++k) b.put(kX[k]).put(float(kY[k])).put(0.f).put(uv[k][0]).put(double(uv[k][1])).put(std::uint8_t(9));
+        b.put(std::uint8_t(4)).put(std::int32_t(0)).put(std::int32_t(1)).put(std::int32_t(2)).put(std::int32_t(3));
+        const PlyData d = parse_ply(std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+                                        " 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                                        "property float s\nproperty double t\nproperty uchar red\nelement face 1\n"
+                                        "property list uchar int vertex_indices\nend_header\n" + b.bytes,
+                                    "b.ply");
+        CHECK(d.uvs == std::vector<float>{0, 0, 1, 0, 1, 0.5f, 0, 0.5f});
+        CHECK(d.triangles == std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3});
+    }
+
+    // Per face corner (MeshLab's texcoord list), before or after the vertex list: the fan's
+    // triangles (0 1 2) and (0 2 3) take the corners' pairs in the same order.
+    const std::string faces_head = kHeadAscii + "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                                                "element face 1\n";
+    const std::string verts = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n";
+    const std::vector<float> fan_uv = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.1f, 0.2f, 0.5f, 0.6f, 0.7f, 0.8f};
+    const PlyData after = parse_ply(faces_head + "property list uchar int vertex_indices\nproperty list uchar float texcoord\n"
+                                                 "end_header\n" + verts + "4 0 1 2 3 8 0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8\n",
+                                    "f.ply");
+    CHECK(after.corner_uv == fan_uv);
+    CHECK(after.uvs.empty());
+    const PlyData before = parse_ply(faces_head + "property list uchar float texcoord\nproperty list uchar int vertex_indices\n"
+                                                  "end_header\n" + verts + "8 0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8 4 0 1 2 3\n",
+                                     "f.ply");
+    CHECK(before.corner_uv == fan_uv);
+    CHECK(before.triangles == std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3});
+    // An empty list on a face is allowed by the header's size check (only the index list has a minimum).
+    CHECK(parse_ply(faces_head + "property list uchar int vertex_indices\nproperty list uchar int flags\nend_header\n" +
+                        verts + "3 0 1 2 0\n",
+                    "f.ply").triangles.size() == 3);
+
+    // Errors: a texcoord list of the wrong length, a non-finite coordinate.
+    CHECK(error_of(faces_head + "property list uchar int vertex_indices\nproperty list uchar float texcoord\nend_header\n" +
+                   verts + "4 0 1 2 3 6 0 0 1 0 1 1\n") == "t.ply:15:23: a face of 4 vertices needs 8 texture coordinates, got 6");
+    CHECK(error_of(kHeadAscii + "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float u\n"
+                                "property float v\n" + vertex_uv_tail.substr(0, vertex_uv_tail.find("0 0 0")) +
+                   "0 0 0 nan 0\n1 0 0 0 0\n0 1 0 0 0\n3 0 1 2\n") == "t.ply:12:11: texture coordinate is not finite");
+}
+
+TEST_CASE("ply: a textured PLY mesh renders as the same OBJ mesh with vt, and one without coordinates is refused") {
+    const fs::path dir = fs::temp_directory_path() / ("streamrt_ply_uv_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    // One quad, as OBJ with vt and as PLY with per-vertex u v and with per-corner texcoord lists.
+    // (The OBJ reader clips ears where the PLY reader fans: the OBJ file lists the fan's two
+    // triangles, so both hold the same corners in the same order.)
+    std::ofstream(dir / "quad.obj") << "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"
+                                       "vt 0 0\nvt 3 0\nvt 3 2\nvt 0 2\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+    const std::string head = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n";
+    std::ofstream(dir / "vertex_uv.ply") << head << "property float u\nproperty float v\nelement face 1\n"
+                                                    "property list uchar int vertex_indices\nend_header\n"
+                                                    "-1 0 -1 0 0\n1 0 -1 3 0\n1 0 1 3 2\n-1 0 1 0 2\n4 0 1 2 3\n";
+    std::ofstream(dir / "corner_uv.ply") << head << "element face 1\nproperty list uchar int vertex_indices\n"
+                                                    "property list uchar float texcoord\nend_header\n"
+                                                    "-1 0 -1\n1 0 -1\n1 0 1\n-1 0 1\n4 0 1 2 3 8 0 0 3 0 3 2 0 2\n";
+    std::ofstream(dir / "bare.ply") << head << "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                               "-1 0 -1\n1 0 -1\n1 0 1\n-1 0 1\n4 0 1 2 3\n";
+    // The project's own texture (scenes/textures/tiles.png), repeated 3 x 2 times on the quad.
+    const fs::path tiles = fs::path(STREAMRT_SOURCE_DIR) / "scenes" / "textures" / "tiles.png";
+    REQUIRE(fs::exists(tiles));
+    const auto scene_with = [&](const std::string& file) {
+        const std::string text = "image width=48 height=36 spp=1 depth=2\ncamera eye=0,2,2.5 look=0,0,0\n"
+                                 "light point pos=2,4,3\nmaterial tiles texture=" + tiles.string() + " diff=0.8\n"
+                                 "mesh file=" + file + " material=tiles\n";
+        return parse_scene(text, (dir / "scene.cfg").string());
+    };
+    const Scene from_obj = scene_with("quad.obj");
+    Parallelism par(2);
+    for (const char* ply : {"vertex_uv.ply", "corner_uv.ply"}) {
+        CAPTURE(ply);
+        const Scene from_ply = scene_with(ply);
+        REQUIRE(from_ply.meshes.size() == 1);
+        REQUIRE(from_ply.meshes[0]->view().uv != nullptr);
+        for (EngineKind e : {EngineKind::Stream, EngineKind::Recursive}) {
+            const Framebuffer a = render_scene(from_obj, e, par).image;
+            const Framebuffer b = render_scene(from_ply, e, par).image;
+            CHECK(std::equal(a.rgb.begin(), a.rgb.end(), b.rgb.begin(), b.rgb.end()));
+        }
+    }
+    // Untextured, the bare PLY reads as before; textured, it is refused at the path.
+    CHECK(parse_scene("mesh file=bare.ply\n", (dir / "scene.cfg").string()).meshes[0]->view().uv == nullptr);
+    try {
+        scene_with("bare.ply");
+        FAIL("a textured PLY mesh without texture coordinates was read");
+    } catch (const SceneError& e) {
+        CHECK(e.where().line == 5);
+        CHECK(e.where().column == 11);
+        const std::string tail = "bare.ply': a texture needs texture coordinates, and this PLY file has none (vertex "
+                                 "properties u v, s t or texture_u texture_v, or a face list 'texcoord')";
+        CHECK(e.message().size() > tail.size());
+        CHECK(e.message().compare(e.message().size() - tail.size(), tail.size(), tail) == 0);
+    }
     fs::remove_all(dir);
 }
