@@ -182,9 +182,13 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     // Weight 1: the caller multiplies what this ray brings back by its weight.
     const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
     const MaterialT<double>& material = materials_[object.material];
-    // The texture replaces the object's colour (render/texture.h).
-    const ColorT<double> object_color = material.texture ? texture_color_at(material, ray, hit)
-                                                         : ColorT<double>{object.color.x, object.color.y, object.color.z};
+    // The texture, or a mesh's vertex colours, replace the object's colour (render/texture.h).
+    const PreparedObject& hit_object = objects_[std::size_t(hit.object)];
+    const ColorT<double> object_color =
+        material.texture ? texture_color_at(material, ray, hit)
+        : material.vertex_colors && hit_object.mesh && hit_object.mesh->view().vertex_colors
+            ? mesh_vertex_color(hit_object.mesh->view(), hit.tri, hit.bu, hit.bv)
+            : ColorT<double>{object.color.x, object.color.y, object.color.z};
     RecursiveSink sink{*this, depth, counts, key};
     // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
     const PreparedObject& ob = objects_[std::size_t(hit.object)];

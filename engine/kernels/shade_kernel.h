@@ -182,6 +182,28 @@ inline ColorT<B> texture_colors(const ShadeJob& job, std::size_t i, const Materi
                             footprint);
 }
 
+/// Each lane's interpolated vertex colour (render/texture.h, mesh_vertex_color), gathered lane
+/// by lane as texture_colors does; a lane past the run, or on a mesh read without colours,
+/// keeps `fallback` (the object's colour).
+template <class B, bool kGathered>
+inline ColorT<B> vertex_colors(const ShadeJob& job, std::size_t i, const ColorT<B>& fallback) {
+    constexpr std::size_t W = B::size;
+    alignas(64) float r[W], g[W], b[W];
+    fallback.x.store_aligned(r);
+    fallback.y.store_aligned(g);
+    fallback.z.store_aligned(b);
+    for (std::size_t l = 0; l < W && i + l < job.end; ++l) {
+        const MeshView* mv = lane_object<kGathered>(job, i, l).mesh;
+        if (!mv || !mv->vertex_colors) continue;
+        const std::size_t ray = std::size_t(job.order[i + l]);
+        const ColorT<float> c = mesh_vertex_color(*mv, std::uint32_t(job.prim[ray]), job.bu[ray], job.bv[ray]);
+        r[l] = c.x;
+        g[l] = c.y;
+        b[l] = c.z;
+    }
+    return {B::load_aligned(r), B::load_aligned(g), B::load_aligned(b)};
+}
+
 /// Appends the active lanes' rays to the next generation's stream, compacted.
 template <class B, class M>
 inline void append(const ShadeJob& job, std::size_t i, const M& active, const Vec3T<B>& o, const Vec3T<B>& d,
@@ -317,6 +339,8 @@ void shade_run(const ShadeJob& job) {
             const B footprint = footprint_width(arriving.cone, B(job.rules.spread), t, dot(d, n_out));
             color = texture_colors<B, kGathered>(job, i, m, kind, kind == ShapeKind::Mesh, pc, param, rows, run_scale,
                                                  footprint);
+        } else if (m.vertex_colors && kind == ShapeKind::Mesh) {  // so do a mesh's vertex colours
+            color = vertex_colors<B, kGathered>(job, i, color);
         }
         SimdSink<B> sink{job, i};
         // A smooth mesh's shadow rays start from its curved patch, not the flat triangle (one

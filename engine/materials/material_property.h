@@ -45,6 +45,7 @@ struct PropertyInfo {
     std::string_view key;
     ValueKind kind;
     Bound bound = Bound::Any;
+    bool meshes_only = false;  ///< the scene reader refuses it on the closed-form shapes
 };
 
 /// A material property declares

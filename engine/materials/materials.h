@@ -45,7 +45,8 @@ struct PropertyList {
 namespace property {
 /// THE registration list: every material property, in the order messages list their keys.
 using Registered =
-    PropertyList<Ambi, Diff, Spec, Shininess, Refl, Trans, Ior, Checker, Cell, Fresnel, Texture, UvScale, Emission>;
+    PropertyList<Ambi, Diff, Spec, Shininess, Refl, Trans, Ior, Checker, Cell, Fresnel, Texture, UvScale, VertexColors,
+                 Emission>;
 }  // namespace property
 using MaterialProperties = property::Registered;
 static_assert(MaterialProperties::distinct_keys(), "two material properties share a key");

@@ -1,6 +1,6 @@
 #pragma once
 // What replaces the object's colour on the surface: the checker pattern (render/shading.h,
-// surface_color) and the texture image (render/texture.h).
+// surface_color), the texture image and a mesh's vertex colours (render/texture.h).
 #include "materials/material_property.h"
 
 namespace streamrt::property {
@@ -25,6 +25,14 @@ struct Texture {
     static constexpr PropertyInfo info{"texture", ValueKind::Image};
     std::int32_t texture = -1;  ///< index into Scene::textures; -1: the object's colour
     static constexpr auto field = &Texture::texture;
+};
+
+/// vertex_colors=true: a mesh's colours at its vertices (a PLY file's red green blue),
+/// interpolated across each triangle, replace the object's colour (render/texture.h).
+struct VertexColors {
+    static constexpr PropertyInfo info{"vertex_colors", ValueKind::Flag, Bound::Any, true};
+    bool vertex_colors = false;
+    static constexpr auto field = &VertexColors::vertex_colors;
 };
 
 struct UvScale {

@@ -22,14 +22,16 @@ namespace streamrt {
 std::size_t Mesh::memory_bytes() const {
     return tri.size() * sizeof(float) + blocks.size() * sizeof(TriangleBlock) +
            block_of.size() * sizeof(std::uint32_t) + index.size() * sizeof(std::uint32_t) +
-           vertex_normals.size() * sizeof(float) + corner_uv.size() * sizeof(float) + bvh.memory_bytes();
+           vertex_normals.size() * sizeof(float) + corner_uv.size() * sizeof(float) +
+           vertex_colors.size() * sizeof(float) + bvh.memory_bytes();
 }
 
 std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<float>& positions,
                                         const std::vector<std::uint32_t>& triangles,
                                         const accel::BuildOptions& options,
                                         const std::vector<float>& corner_uv,
-                                        const std::vector<float>& normals) {
+                                        const std::vector<float>& normals,
+                                        const std::vector<float>& colors) {
     auto m = std::make_shared<Mesh>();
     m->name = std::move(name);
     const std::size_t n_verts = positions.size() / 3;
@@ -56,6 +58,7 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
         }
     }
     const std::size_t n_tris = kept.size() / 3;
+    if (colors.size() == 3 * n_verts) m->vertex_colors = colors;
 
     // Area-weighted vertex normals (the cross product's length is twice the area). The sums
     // are freed before the hierarchy is built: on a 10M-triangle mesh they are 120 MB of the

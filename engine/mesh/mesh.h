@@ -29,6 +29,7 @@ struct Mesh {
     std::vector<std::uint32_t> index;   ///< 3 per triangle, leaf order
     std::vector<float> vertex_normals;  ///< 3 per vertex
     std::vector<float> corner_uv;       ///< 6 per triangle (MeshView::uv), leaf order; empty: none
+    std::vector<float> vertex_colors;   ///< 3 per vertex (MeshView::vertex_colors); empty: none
     accel::Bvh bvh;                     ///< prim_index is dropped: triangles are stored in leaf order
     AlignedFillLaterVec<TriangleBlock> blocks;  ///< MeshView::blocks: the leaves' triangles, 4 to a block
     std::vector<std::uint32_t> block_of;     ///< MeshView::block_of, one per triangle
@@ -56,11 +57,13 @@ struct Mesh {
     /// texture coordinates), kept with the triangles. `normals`, when it holds 3 floats per
     /// vertex (a PLY file's nx ny nz), gives the vertex normals (normalised; a zero or
     /// non-finite one is replaced by the computed one); otherwise they are area-weighted.
+    /// `colors`, when it holds 3 floats per vertex, gives the vertex colours (linear RGB).
     static std::shared_ptr<const Mesh> build(std::string name, const std::vector<float>& positions,
                                              const std::vector<std::uint32_t>& triangles,
                                              const accel::BuildOptions& options = {},
                                              const std::vector<float>& corner_uv = {},
-                                             const std::vector<float>& normals = {});
+                                             const std::vector<float>& normals = {},
+                                             const std::vector<float>& colors = {});
 };
 
 /// Reads a Wavefront OBJ file (mesh/obj_reader.h; polygons are triangulated, materials and

@@ -58,7 +58,8 @@ void Mesh::set_view(std::uint32_t single_ray_lanes) {
     kernel_view = {bvh.nodes.empty() ? nullptr : bvh.nodes.data(), tri.data(), index.data(), vertex_normals.data(),
                    std::uint32_t(triangle_count()), corner_uv.empty() ? nullptr : corner_uv.data(), uv_density,
                    blocks.data(), block_of.data(), single_ray_lanes,
-                   tri.size() * sizeof(float) + bvh.nodes.size() * sizeof(accel::WideNode) > kPrefetchedMeshBytes};
+                   tri.size() * sizeof(float) + bvh.nodes.size() * sizeof(accel::WideNode) > kPrefetchedMeshBytes,
+                   vertex_colors.empty() ? nullptr : vertex_colors.data()};
 }
 
 std::shared_ptr<const Mesh> Mesh::with_single_ray_lanes(std::uint32_t lanes) const {

@@ -46,6 +46,9 @@ struct MeshView {
     /// The mesh's triangles and nodes outgrow a core's share of the caches (kPrefetchedMeshBytes):
     /// the packet walks then start loading each child they will visit when they meet it.
     bool prefetched = false;
+    /// Colours at the vertices (linear RGB, 3 floats per vertex, indexed like vertex_normals);
+    /// nullptr when the mesh was read without them (no vertex_colors=true object uses it).
+    const float* vertex_colors = nullptr;
 };
 
 /// Triangles plus BVH nodes above which a mesh is walked with prefetches (MeshView::prefetched):

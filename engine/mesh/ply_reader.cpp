@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "image/display.h"
 #include "mesh/mesh.h"
 
 namespace streamrt {
@@ -358,6 +359,18 @@ private:
     std::uint64_t item_ = 0;
 };
 
+/// A vertex colour component as linear light: an integer type holds an sRGB code (0 - 255 for
+/// uchar, 0 - 65535 for ushort: the full range of its type is white), a float type a linear
+/// value, as written. Negative or non-finite values are errors.
+template <class Body>
+float linear_color(Body& body, double value, const PlyType& t) {
+    if (!std::isfinite(value) || value < 0.0) body.fail("vertex colour " + std::to_string(value) + " is not a finite value >= 0");
+    if (t.is_float) return float(value);
+    if (t.size == 1 && !t.is_signed) return srgb_to_linear(std::uint8_t(value));
+    const double top = std::ldexp(1.0, 8 * t.size - (t.is_signed ? 1 : 0)) - 1.0;
+    return float(srgb_eotf(std::min(1.0, value / top)));
+}
+
 /// Reads the body's elements in header order into `out`.
 template <class Body>
 void read_body(Body& body, const PlyHeader& h, PlyData& out) {
@@ -370,24 +383,28 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
         if (e.props.empty()) continue;
         const bool vertex = e.name == "vertex", face = e.name == "face";
         // Per property: where a vertex keeps it (0-2 position, 3-5 normal, 6-7 texture
-        // coordinates under any of their usual names, -1 skipped).
+        // coordinates under any of their usual names, 8-10 colour, -1 skipped).
         std::vector<int> slot(e.props.size(), -1);
-        bool normals = true, uvs = true;
+        bool normals = true, uvs = true, colors = true;
         if (vertex) {
             static const struct {
                 const char* name;
                 int slot;
             } kSlots[] = {{"x", 0},         {"y", 1},         {"z", 2},         {"nx", 3},        {"ny", 4},
                           {"nz", 5},        {"u", 6},         {"s", 6},         {"texture_u", 6}, {"texture_s", 6},
-                          {"v", 7},         {"t", 7},         {"texture_v", 7}, {"texture_t", 7}};
+                          {"v", 7},         {"t", 7},         {"texture_v", 7}, {"texture_t", 7},
+                          {"red", 8},       {"green", 9},     {"blue", 10},     {"diffuse_red", 8},
+                          {"diffuse_green", 9}, {"diffuse_blue", 10}};
             for (std::size_t p = 0; p < e.props.size(); ++p)
                 for (const auto& k : kSlots)
                     if (!e.props[p].is_list && e.props[p].name == k.name) slot[p] = k.slot;
             for (int s = 3; s < 6; ++s) normals = normals && std::count(slot.begin(), slot.end(), s) == 1;
             for (int s = 6; s < 8; ++s) uvs = uvs && std::count(slot.begin(), slot.end(), s) == 1;
+            for (int s = 8; s < 11; ++s) colors = colors && std::count(slot.begin(), slot.end(), s) == 1;
             out.positions.reserve(3 * std::size_t(e.count));  // bounded by the file's length (parse_header)
             if (normals) out.normals.reserve(3 * std::size_t(e.count));
             if (uvs) out.uvs.reserve(2 * std::size_t(e.count));
+            if (colors) out.colors.reserve(3 * std::size_t(e.count));
         }
         const PlyProperty* indices = nullptr;    // the first index list of a face
         const PlyProperty* texcoords = nullptr;  // and its first texture coordinate list
@@ -401,7 +418,8 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
         std::vector<float> corner_uv;
         for (std::uint64_t k = 0; k < e.count; ++k) {
             body.begin_item(e.name, k);
-            double v[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+            double v[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+            const PlyType* color_type[3] = {nullptr, nullptr, nullptr};
             corners.clear();
             corner_uv.clear();
             for (std::size_t p = 0; p < e.props.size(); ++p) {
@@ -409,6 +427,7 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
                 if (!prop.is_list) {
                     if (slot[p] >= 0) v[slot[p]] = body.read_number(prop.type);
                     else body.skip(prop.type);
+                    if (slot[p] >= 8) color_type[slot[p] - 8] = &prop.type;
                     continue;
                 }
                 const std::int64_t n = body.read_int(prop.count_type);
@@ -459,6 +478,8 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
                     body.fail("texture coordinate is not finite");
                 out.uvs.insert(out.uvs.end(), {float(v[6]), float(v[7])});
             }
+            if (colors)
+                for (int c = 0; c < 3; ++c) out.colors.push_back(linear_color(body, v[8 + c], *color_type[c]));
         }
     }
 }
@@ -478,7 +499,7 @@ PlyData parse_ply(std::string_view bytes, const std::string& name) {
     return out;
 }
 
-std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv) {
+std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv, bool with_colors) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw std::runtime_error("cannot open mesh file");
     const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -499,7 +520,12 @@ std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv)
                 "texture_u texture_v, or a face list 'texcoord')");
         }
     }
-    auto mesh = Mesh::build(path, data.positions, data.triangles, {}, corner_uv, data.normals);
+    if (with_colors && data.colors.empty())
+        throw std::runtime_error(
+            "vertex_colors=true needs colours at the vertices, and this PLY file has none (vertex properties red "
+            "green blue)");
+    auto mesh = Mesh::build(path, data.positions, data.triangles, {}, corner_uv, data.normals,
+                            with_colors ? data.colors : std::vector<float>{});
     if (mesh->triangle_count() == 0)
         throw std::runtime_error(faces == 0 ? "PLY file has no faces"
                                             : "PLY file has no triangles of non-zero area (" + std::to_string(faces) +
@@ -514,9 +540,12 @@ bool is_ply_path(const std::string& path) {
     return ext == ".ply";
 }
 
-std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv) {
-    if (!is_ply_path(path)) return load_obj_mesh(path, with_uv);
-    return load_ply_mesh(path, with_uv);
+std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv, bool with_colors) {
+    if (is_ply_path(path)) return load_ply_mesh(path, with_uv, with_colors);
+    if (with_colors)
+        throw std::runtime_error("vertex_colors=true needs a PLY file with red green blue at its vertices (OBJ "
+                                 "files are read without vertex colours)");
+    return load_obj_mesh(path, with_uv);
 }
 
 }  // namespace streamrt

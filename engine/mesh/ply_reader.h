@@ -1,7 +1,8 @@
 #pragma once
 // Stanford PLY meshes (ASCII, binary little and big endian): the `vertex` element's x y z
 // (and nx ny nz when all three are present; texture coordinates u v, s t, texture_u
-// texture_v or texture_s texture_t when one pair is) and the `face` element's vertex index
+// texture_v or texture_s texture_t when one pair is; red green blue colours when all three
+// are, as linear light) and the `face` element's vertex index
 // lists, polygons fan-triangulated, with the faces' per-corner `texcoord` lists when present
 // (MeshLab's form); every other element and property is skipped by its size.
 // Debian ships no maintained PLY library, hence this reader. Every count and size in the
@@ -23,6 +24,7 @@ struct PlyData {
     std::vector<std::uint32_t> triangles;  ///< 3 vertex numbers per triangle
     std::vector<float> uvs;                ///< 2 per vertex (u, v), or empty
     std::vector<float> corner_uv;          ///< 6 per triangle (its corners' u, v) from face texcoord lists, or empty
+    std::vector<float> colors;             ///< 3 per vertex (red green blue as linear light), or empty
 };
 
 /// Parses the bytes of a PLY file named `name` (for messages). Throws std::runtime_error
@@ -35,12 +37,14 @@ PlyData parse_ply(std::string_view bytes, const std::string& name);
 /// With `with_uv` (a textured object) the mesh keeps texture coordinates: the faces'
 /// texcoord lists when the file has them, else the vertices' u v. Throws std::runtime_error
 /// like parse_ply, for a file with no triangle of non-zero area, and with `with_uv` for a
-/// file without texture coordinates.
-std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv = false);
+/// file without texture coordinates. With `with_colors` (a vertex_colors=true object) it keeps
+/// the vertices' red green blue (MeshView::vertex_colors), and refuses a file without them.
+std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv = false, bool with_colors = false);
 
 /// The mesh of a file by its extension: `.ply` (any case) with load_ply_mesh, anything else
-/// as a Wavefront OBJ file (load_obj_mesh); `with_uv` as for those.
-std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv);
+/// as a Wavefront OBJ file (load_obj_mesh); `with_uv` as for those; `with_colors` for PLY
+/// files only (an OBJ file is refused with it).
+std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv, bool with_colors = false);
 
 /// True when `path` names a PLY file (extension `.ply`, any case).
 bool is_ply_path(const std::string& path);

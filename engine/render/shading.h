@@ -41,6 +41,9 @@ struct MaterialT {
     // each engine from Scene::textures (empty: no texture, today's code).
     TextureView texture{};
     T uv_scale = T(1);
+    /// vertex_colors=true: a mesh's interpolated vertex colours replace the object's colour
+    /// (the scene reader allows it on meshes only, without a texture).
+    bool vertex_colors = false;
     /// emission=: the surface's own radiance, added at every hit from degree 1 (shade_hit);
     /// `emits` when it is not black.
     ColorT<T> emission{T(0), T(0), T(0)};
@@ -67,6 +70,7 @@ struct MaterialT {
         const double r0 = (m.ior - 1.0) / (m.ior + 1.0);
         r.r0 = T(r.fresnel ? r0 * r0 : 0.0);
         r.uv_scale = T(m.uv_scale);
+        r.vertex_colors = m.vertex_colors;
         r.emission = {T(m.emission.x), T(m.emission.y), T(m.emission.z)};
         r.emits = m.emission != glm::dvec3(0.0);
         return r;

@@ -178,6 +178,19 @@ inline UvT<T> mesh_uv(const MeshView& m, std::uint32_t tri, T bu, T bv) {
     return {T(c[0]) * w + T(c[2]) * bu + T(c[4]) * bv, T(c[1]) * w + T(c[3]) * bu + T(c[5]) * bv};
 }
 
+/// A mesh's colour at barycentrics (bu, bv) of triangle tri (vertex_colors=true): its
+/// vertices' colours (MeshView::vertex_colors, linear) weighted as the vertex normals are,
+/// (1 - bu - bv) c0 + bu c1 + bv c2. Interpolated in linear light, like every other colour.
+template <class T>
+inline ColorT<T> mesh_vertex_color(const MeshView& m, std::uint32_t tri, T bu, T bv) {
+    const std::uint32_t* v = m.index + 3 * std::size_t(tri);
+    const float *c0 = m.vertex_colors + 3 * std::size_t(v[0]), *c1 = m.vertex_colors + 3 * std::size_t(v[1]),
+                *c2 = m.vertex_colors + 3 * std::size_t(v[2]);
+    const T w = T(1) - bu - bv;
+    return {T(c0[0]) * w + T(c1[0]) * bu + T(c2[0]) * bv, T(c0[1]) * w + T(c1[1]) * bu + T(c2[1]) * bv,
+            T(c0[2]) * w + T(c1[2]) * bu + T(c2[2]) * bv};
+}
+
 /// The surface colour of a textured material on a mesh (one hit; the SIMD kernel gathers
 /// mesh_uv lane by lane and calls texture_color_at).
 template <class T>

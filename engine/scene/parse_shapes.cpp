@@ -70,10 +70,24 @@ std::optional<Arg> Parser::shape(Statement& st, const std::vector<Token>& toks, 
             obj_materials = true;
         }
     }
+    if (f.look.m.vertex_colors) {
+        // At the key, or at material= when the material brought it.
+        const Arg* at = st.find("vertex_colors");
+        if (!at) at = st.find("material");
+        const int col = at ? at->key_col : st.where().column;
+        if (kind != ShapeKind::Mesh)
+            st.fail(col, "vertex_colors=true needs a mesh (a PLY file with red green blue at its vertices), not a " +
+                             std::string(st.word()));
+        if (f.look.m.texture >= 0)
+            st.fail(col, "vertex_colors=true and texture= both replace the object's colour: give one of them");
+    }
     if (file_arg && obj_materials) {
         if (is_ply_path(std::string(file_arg->value)))
             st.fail(file_arg->value_col, "materials=obj needs an OBJ file (a PLY file has no material library), got " +
                                              quote(file_arg->value));
+        if (f.look.m.vertex_colors)
+            st.fail(file_arg->value_col, "vertex_colors=true needs a PLY file with red green blue at its vertices, "
+                                         "and materials=obj an OBJ file");
         if (singular(f.md))
             st.fail_here(std::string(st.word()) + ": the composed transform is singular (or not finite)");
         // One object per part (usemtl group), each with its part's material over the
@@ -94,7 +108,7 @@ std::optional<Arg> Parser::shape(Statement& st, const std::vector<Token>& toks, 
         if (const Arg* n = st.find("name")) return *n;
         return std::nullopt;
     }
-    if (file_arg) f.mesh = mesh_file(st, *file_arg, f.look.m.texture >= 0);
+    if (file_arg) f.mesh = mesh_file(st, *file_arg, f.look.m.texture >= 0, f.look.m.vertex_colors);
     if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ or PLY file)");
     if (singular(f.md))
         st.fail_here(std::string(st.word()) +
@@ -108,7 +122,7 @@ fs::path Parser::target_of(const Statement& st, const Arg& a) {
     return (fs::path(st.file()).parent_path() / fs::path(std::string(a.value))).lexically_normal();
 }
 
-std::uint32_t Parser::mesh_file(const Statement& st, const Arg& a, bool with_uv) {
+std::uint32_t Parser::mesh_file(const Statement& st, const Arg& a, bool with_uv, bool with_colors) {
     constexpr std::string_view kMemory = "memory:";
     if (options_.memory_meshes && a.value.substr(0, kMemory.size()) == kMemory) {
         // A mesh held by the front end, added to the scene once (its texture coordinates, if
@@ -123,8 +137,8 @@ std::uint32_t Parser::mesh_file(const Statement& st, const Arg& a, bool with_uv)
     }
     return read_once(
         st, a.value_col, target_of(st, a), "mesh", meshes_, scene.meshes,
-        [&](fs::path id) { return std::pair{std::move(id), with_uv}; },
-        [&](const std::string& path) { return load_mesh_file(path, with_uv); });
+        [&](fs::path id) { return std::tuple{std::move(id), with_uv, with_colors}; },
+        [&](const std::string& path) { return load_mesh_file(path, with_uv, with_colors); });
 }
 
 std::int32_t Parser::texture_file(const Statement& st, int col, const fs::path& target) {

@@ -8,6 +8,7 @@
 #include <exception>
 #include <filesystem>
 #include <map>
+#include <tuple>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -117,9 +118,9 @@ class Parser {
     Scratch scratch_;       // the sequential pass's
     std::map<std::string, MaterialDef, std::less<>> materials_;
     std::vector<fs::path> open_;  // the include chain being read
-    // By file identity and whether its texture coordinates are kept: loaded once, shared
-    // (index in scene.meshes).
-    std::map<std::pair<fs::path, bool>, std::uint32_t> meshes_;
+    // By file identity and whether its texture coordinates and vertex colours are kept:
+    // loaded once, shared (index in scene.meshes).
+    std::map<std::tuple<fs::path, bool, bool>, std::uint32_t> meshes_;
     std::map<std::size_t, std::uint32_t> memory_mesh_index_;  // ReadOptions::memory_meshes -> scene.meshes
     MaterialList scene_materials_{&scene};  // the one-pass reader's: straight into the scene
     int files_ = 0;
@@ -225,9 +226,10 @@ class Parser {
         }
     }
 
-    /// The mesh of an OBJ file, read once per file (twice when both untextured objects and
-    /// textured ones, which need its texture coordinates, use it): its index in Scene::meshes.
-    std::uint32_t mesh_file(const Statement& st, const Arg& a, bool with_uv);
+    /// The mesh of an OBJ or PLY file, read once per file and per need (texture coordinates
+    /// for textured objects, vertex colours for vertex_colors=true ones): its index in
+    /// Scene::meshes.
+    std::uint32_t mesh_file(const Statement& st, const Arg& a, bool with_uv, bool with_colors);
 
     /// The texture of an image file, read once per file: its index in Scene::textures.
     /// Shapes of the chunked reader call it from several threads, hence the lock.

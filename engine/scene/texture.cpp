@@ -16,19 +16,9 @@
 #include <stb_image.h>
 #pragma GCC diagnostic pop
 
-namespace streamrt {
+#include "image/display.h"
 
-float srgb_to_linear(std::uint8_t code) {
-    static const std::array<float, 256> table = [] {
-        std::array<float, 256> t{};
-        for (int i = 0; i < 256; ++i) {
-            const double c = i / 255.0;
-            t[std::size_t(i)] = float(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-        }
-        return t;
-    }();
-    return table[code];
-}
+namespace streamrt {
 
 std::size_t Texture::memory_bytes() const {
     std::size_t b = 0;

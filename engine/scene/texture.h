@@ -46,11 +46,6 @@ struct Texture {
     static std::shared_ptr<const Texture> build(std::string name, int width, int height, std::vector<float> rgb);
 };
 
-/// The linear value of an 8-bit sRGB code (IEC 61966-2-1): c / 12.92 below 0.04045 (c in
-/// [0,1]), ((c + 0.055) / 1.055)^2.4 above. Texels are colour data, stored in sRGB by
-/// image files; shading works in linear light.
-float srgb_to_linear(std::uint8_t code);
-
 /// Reads a PNG or JPEG file (stb_image) into a texture, its texels converted from 8-bit sRGB
 /// to linear float (alpha ignored, grey expanded to RGB). Throws std::runtime_error with a
 /// message (no location) for a missing, unreadable or undecodable file, or one larger than

@@ -211,6 +211,8 @@ struct ShadeStage {
                             ? mesh_texture_color(m, *ob.xf.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i],
                                                  mesh_hits.v[i], scale, footprint)
                             : texture_color(m, kind, pc, ob.xf.param, scale, footprint);
+            } else if (m.vertex_colors && kind == ShapeKind::Mesh && ob.xf.mesh->vertex_colors) {
+                color = mesh_vertex_color(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i]), mesh_hits.u[i], mesh_hits.v[i]);
             }
             // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
             const bool smooth = kind == ShapeKind::Mesh && ob.xf.param != 0.f;

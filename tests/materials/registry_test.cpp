@@ -157,8 +157,10 @@ TEST_CASE("material registry: every property is read by material and shape state
         const std::string key(P::info.key);
         CAPTURE(key);
         const auto [text, value] = other_value<P>();
-        const Scene s = parse_scene("material m " + key + "=" + text + "\nsphere material=m\nsphere " + key + "=" +
-                                        text + "\nsphere\n",
+        // A property for meshes only (vertex_colors) is tried on a mesh with what it needs.
+        const std::string shape = P::info.meshes_only ? "mesh file=meshes/colored_sphere.ply" : "sphere";
+        const Scene s = parse_scene("material m " + key + "=" + text + "\n" + shape + " material=m\n" + shape + " " +
+                                        key + "=" + text + "\n" + shape + "\n",
                                     kScenePath);
         REQUIRE(s.objects.size() == 3);
         for (int i : {0, 1}) {
@@ -179,9 +181,10 @@ TEST_CASE("material registry: every property is read by material and shape state
         CHECK(s.material_of(s.objects[2]).*P::field == default_of<P>());
         CHECK(s.material_of(s.objects[2]) == Material{});
         CHECK(s.materials.size() == 2);
-        // The property's check, at its value's column ("sphere " + key + "=").
+        // The property's check, at its value's column (shape + " " + key + "=").
         const auto [bad, message] = refused_value<P>();
-        test::expect_error_in(kScenePath, "sphere " + key + "=" + bad, 1, int(8 + key.size() + 1), message);
+        test::expect_error_in(kScenePath, shape + " " + key + "=" + bad, 1, int(shape.size() + 2 + key.size() + 1),
+                              message);
     });
 }
 

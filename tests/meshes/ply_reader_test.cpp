@@ -397,3 +397,114 @@ TEST_CASE("ply: a textured PLY mesh renders as the same OBJ mesh with vt, and on
     }
     fs::remove_all(dir);
 }
+
+TEST_CASE("ply: vertex colours, 8-bit and 16-bit sRGB codes or linear floats, read as linear light") {
+    const std::string head = kHeadAscii + "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+    const std::string faces = "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    // uchar: the sRGB codes decoded (IEC 61966-2-1: 128 -> 0.2158605, 10 -> 10 / 255 / 12.92).
+    const PlyData u8 = parse_ply(head + "property uchar red\nproperty uchar green\nproperty uchar blue\n" + faces +
+                                     "0 0 0 255 128 0\n1 0 0 10 0 0\n0 1 0 0 0 255\n3 0 1 2\n",
+                                 "c.ply");
+    REQUIRE(u8.colors.size() == 9);
+    CHECK(u8.colors[0] == 1.f);
+    CHECK(u8.colors[1] == doctest::Approx(0.2158605).epsilon(1e-6));
+    CHECK(u8.colors[2] == 0.f);
+    CHECK(u8.colors[3] == doctest::Approx(10.0 / 255.0 / 12.92).epsilon(1e-6));
+    CHECK(u8.colors[8] == 1.f);
+    // ushort under MeshLab's other names: 65535 is white, 32768 about the 8-bit 128.
+    const PlyData u16 = parse_ply(head + "property ushort diffuse_red\nproperty ushort diffuse_green\n"
+                                         "property ushort diffuse_blue\n" + faces +
+                                      "0 0 0 65535 32768 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n",
+                                  "c.ply");
+    REQUIRE(u16.colors.size() == 9);
+    CHECK(u16.colors[0] == 1.f);
+    CHECK(u16.colors[1] == doctest::Approx(std::pow((32768.0 / 65535.0 + 0.055) / 1.055, 2.4)).epsilon(1e-6));
+    // float: linear values as written.
+    const PlyData f32 = parse_ply(head + "property float red\nproperty float green\nproperty float blue\n" + faces +
+                                      "0 0 0 0.25 0.5 2\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n",
+                                  "c.ply");
+    CHECK(std::vector<float>(f32.colors.begin(), f32.colors.begin() + 3) == std::vector<float>{0.25f, 0.5f, 2.f});
+    // Two of the three: no colours.
+    CHECK(parse_ply(head + "property uchar red\nproperty uchar green\n" + faces + "0 0 0 1 2\n1 0 0 1 2\n0 1 0 1 2\n3 0 1 2\n",
+                    "c.ply").colors.empty());
+    CHECK(error_of(head + "property float red\nproperty float green\nproperty float blue\n" + faces +
+                   "0 0 0 0 -0.5 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n") ==
+          "t.ply:13:14: vertex colour -0.500000 is not a finite value >= 0");
+}
+
+TEST_CASE("ply: vertex_colors=true renders a mesh's interpolated vertex colours, in both engines") {
+    const fs::path dir = fs::temp_directory_path() / ("streamrt_ply_color_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                             "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+                             "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    // A triangle that covers the whole view, one colour at every vertex, then red, green, blue.
+    std::ofstream(dir / "one.ply") << head << "-9 -9 0 128 64 32\n9 -9 0 128 64 32\n0 9 0 128 64 32\n3 0 1 2\n";
+    std::ofstream(dir / "rgb.ply") << head << "-9 -9 0 255 0 0\n9 -9 0 0 255 0\n0 9 0 0 0 255\n3 0 1 2\n";
+    std::ofstream(dir / "bare.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                       "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                       "end_header\n-9 -9 0\n9 -9 0\n0 9 0\n3 0 1 2\n";
+    std::ofstream(dir / "tri.obj") << "v -9 -9 0\nv 9 -9 0\nv 0 9 0\nf 1 2 3\n";
+    const auto scene_with = [&](const std::string& mesh_line) {
+        // degree 0: each pixel is its hit's flat colour, nothing else.
+        return parse_scene("image width=16 height=12 spp=1 degree=0\ncamera eye=0,0,3 look=0,0,0\n" + mesh_line + "\n",
+                           (dir / "scene.cfg").string());
+    };
+    Parallelism par(2);
+    const Scene one = scene_with("mesh file=one.ply vertex_colors=true color=0.9,0.9,0.9");
+    const Scene rgb = scene_with("mesh file=rgb.ply vertex_colors=true");
+    const Scene plain = scene_with("mesh file=one.ply color=0.9,0.8,0.7");
+    REQUIRE(one.meshes[0]->view().vertex_colors != nullptr);
+    CHECK(plain.meshes[0]->view().vertex_colors == nullptr);  // read without them: nobody asked
+    for (EngineKind e : {EngineKind::Stream, EngineKind::Recursive}) {
+        CAPTURE(int(e));
+        const Framebuffer a = render_scene(one, e, par).image;
+        for (std::size_t p = 0; p < a.rgb.size(); p += 3) {  // the vertices' colour, not color=
+            CHECK(a.rgb[p] == doctest::Approx(0.2158605).epsilon(1e-5));
+            CHECK(a.rgb[p + 1] == doctest::Approx(std::pow((64 / 255.0 + 0.055) / 1.055, 2.4)).epsilon(1e-5));
+            CHECK(a.rgb[p + 2] == doctest::Approx(std::pow((32 / 255.0 + 0.055) / 1.055, 2.4)).epsilon(1e-5));
+        }
+        // Red, green and blue corners (bottom left, bottom right, top): the weights sum to one
+        // everywhere, red falls from left to right, green rises, blue rises upwards.
+        const Framebuffer b = render_scene(rgb, e, par).image;
+        for (std::size_t p = 0; p < b.rgb.size(); p += 3)
+            CHECK(b.rgb[p] + b.rgb[p + 1] + b.rgb[p + 2] == doctest::Approx(1.0).epsilon(1e-5));
+        const auto px = [&](int x, int y) { return b.pixel(x, y); };
+        CHECK(px(0, 11)[0] > px(15, 11)[0] + 0.05f);
+        CHECK(px(15, 11)[1] > px(0, 11)[1] + 0.05f);
+        CHECK(px(8, 0)[2] > px(8, 11)[2] + 0.05f);
+        const Framebuffer c = render_scene(plain, e, par).image;
+        CHECK(c.rgb[0] == doctest::Approx(0.9));
+        CHECK(c.rgb[1] == doctest::Approx(0.8));
+    }
+    // The two engines agree on the blend, pixel for pixel.
+    const Framebuffer s = render_scene(rgb, EngineKind::Stream, par).image;
+    const Framebuffer r = render_scene(rgb, EngineKind::Recursive, par).image;
+    for (std::size_t p = 0; p < s.rgb.size(); ++p) CHECK(s.rgb[p] == doctest::Approx(r.rgb[p]).epsilon(1e-5));
+
+    const auto scene_error = [&](const std::string& text) {
+        try {
+            parse_scene(text, (dir / "scene.cfg").string());
+        } catch (const SceneError& e) {
+            return std::to_string(e.where().line) + ":" + std::to_string(e.where().column) + ": " + e.message();
+        }
+        return std::string("no error");
+    };
+    CHECK(scene_error("sphere vertex_colors=true\n") ==
+          "1:8: vertex_colors=true needs a mesh (a PLY file with red green blue at its vertices), not a sphere");
+    CHECK(scene_error("material m vertex_colors=true\n\n  cube material=m\n") ==
+          "3:8: vertex_colors=true needs a mesh (a PLY file with red green blue at its vertices), not a cube");
+    const fs::path tiles = fs::path(STREAMRT_SOURCE_DIR) / "scenes" / "textures" / "tiles.png";
+    CHECK(scene_error("mesh file=rgb.ply texture=" + tiles.string() + " vertex_colors=true\n") ==
+          "1:" + std::to_string(28 + tiles.string().size()) +
+              ": vertex_colors=true and texture= both replace the object's colour: give one of them");
+    CHECK(scene_error("mesh file=tri.obj vertex_colors=true\n").find(
+              "1:11: '" + (dir / "tri.obj").string() + "': vertex_colors=true needs a PLY file") == 0);
+    CHECK(scene_error("mesh file=bare.ply vertex_colors=true\n") ==
+          "1:11: '" + (dir / "bare.ply").string() +
+              "': vertex_colors=true needs colours at the vertices, and this PLY file has none (vertex properties "
+              "red green blue)");
+    CHECK(scene_error("mesh file=tri.obj materials=obj vertex_colors=true\n") ==
+          "1:11: vertex_colors=true needs a PLY file with red green blue at its vertices, and materials=obj an OBJ file");
+    fs::remove_all(dir);
+}

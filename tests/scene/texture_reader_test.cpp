@@ -8,6 +8,7 @@
 #include <string>
 
 #include "mesh/mesh.h"
+#include "image/display.h"
 #include "render/texture.h"
 #include "scene/parser.h"
 #include "scene/expect_error.h"
