@@ -14,6 +14,7 @@
 
 #include "core/mapped_file.h"
 #include "core/vec3.h"
+#include "image/display.h"
 #include "mesh/obj_reader.h"
 #include "parallel/parallelism.h"
 
@@ -174,9 +175,10 @@ void append_corner_uv(const ObjData& d, std::size_t first, std::size_t count, st
 }
 
 std::shared_ptr<const Mesh> build_checked(const std::string& path, const std::vector<float>& positions,
-                                          const std::vector<std::uint32_t>& tris, const std::vector<float>& corner_uv) {
+                                          const std::vector<std::uint32_t>& tris, const std::vector<float>& corner_uv,
+                                          const std::vector<float>& colors = {}) {
     const std::size_t faces = tris.size() / 3;
-    auto mesh = Mesh::build(path, positions, tris, {}, corner_uv);
+    auto mesh = Mesh::build(path, positions, tris, {}, corner_uv, {}, colors);
     if (mesh->triangle_count() == 0)
         throw std::runtime_error(faces == 0 ? "OBJ file has no faces"
                                             : "OBJ file has no triangles of non-zero area (" +
@@ -186,17 +188,25 @@ std::shared_ptr<const Mesh> build_checked(const std::string& path, const std::ve
 
 }  // namespace
 
-std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv) {
+std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv, bool with_colors) {
     MappedFile file;
     if (!file.open(path)) throw std::runtime_error("cannot open mesh file");
-    ObjData d = parse_obj(file.text(), path, {.keep_uv = with_uv});
+    ObjData d = parse_obj(file.text(), path, {.keep_uv = with_uv, .keep_colors = with_colors});
     std::vector<float> corner_uv;
     if (with_uv) {
         if (!d.uv_gaps.empty()) obj_fail_at(file.text(), path, d.uv_gaps.front().offset, kNeedsUv);
         corner_uv.reserve(2 * d.triangle_uv.size());
         append_corner_uv(d, 0, d.triangles.size() / 3, corner_uv);
     }
-    return build_checked(path, d.positions, d.triangles, corner_uv);
+    if (with_colors) {
+        if (d.colorless_offset != std::size_t(-1))
+            obj_fail_at(file.text(), path, d.colorless_offset,
+                        "vertex without a colour (v x y z r g b), which vertex_colors=true needs");
+        // An OBJ file's colours are display values in [0, 1] (8-bit codes over 255, as the
+        // tools that write them store them): decoded from sRGB to linear light, clamped first.
+        for (float& c : d.colors) c = float(srgb_eotf(std::clamp(double(c), 0.0, 1.0)));
+    }
+    return build_checked(path, d.positions, d.triangles, corner_uv, d.colors);
 }
 
 ObjModel load_obj_model(const std::string& path, bool with_uv) {

@@ -68,11 +68,13 @@ struct Mesh {
 
 /// Reads a Wavefront OBJ file (mesh/obj_reader.h; polygons are triangulated, materials and
 /// normals in the file are ignored). Texture coordinates (vt) are kept only when `with_uv`
-/// (a textured object uses the mesh); then every face must have them. Throws
+/// (a textured object uses the mesh); then every face must have them. Vertex colours (`v x y
+/// z r g b`, display values in [0, 1], decoded from sRGB) only when `with_colors` (a
+/// vertex_colors=true object); then every vertex must have one. Throws
 /// std::runtime_error for a missing or unreadable file (no location), a malformed one or
 /// (with_uv) a face without texture coordinates (`file:line:col: message`), or one with no
 /// triangles of non-zero area.
-std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv = false);
+std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv = false, bool with_colors = false);
 
 /// One material of an OBJ file's material library (MTL), as read (docs/scene-format.md,
 /// "OBJ materials" maps it onto the material keys).

@@ -93,6 +93,7 @@ struct Chunk {
     std::vector<Gap> gaps;
     const char* mtllib_at = nullptr;
     std::string_view mtllib;
+    const char* colorless_at = nullptr;  // keep_colors: the chunk's first v line without a colour
     const char* error_at = nullptr;  // the chunk's first error
     std::string error;
 };
@@ -135,7 +136,8 @@ class ChunkReader {
   public:
     ChunkReader(Chunk& c, const Totals& totals, ObjData& out, bool keep_uv)
         : c_(c), p_(c.begin), end_(c.end), totals_(totals), positions_(out.positions.data()),
-          texcoords_(out.texcoords.data()), keep_uv_(keep_uv) {}
+          texcoords_(out.texcoords.data()), colors_(out.colors.empty() ? nullptr : out.colors.data()),
+          keep_uv_(keep_uv) {}
 
     void run() {
         while (p_ < end_) {
@@ -147,7 +149,7 @@ class ChunkReader {
             }
             const char* word = p_;
             switch (statement_word(p_, end_, &p_)) {
-            case Word::V: vertex(); break;
+            case Word::V: vertex(word); break;
             case Word::Vt: texcoord(); break;
             case Word::F: face(word); break;
             case Word::Vn:
@@ -282,15 +284,37 @@ class ChunkReader {
                     count_of(seen, k) + " so far)");
     }
 
-    void vertex() {
+    void vertex(const char* word) {
         if (v_ == c_.v) fail(p_, "internal error: more vertex lines than counted");  // memory safety only
         float* out = positions_ + 3 * (c_.v_before + v_);
         for (int a = 0; a < 3; ++a) out[a] = number("a vertex coordinate (v x y z)");
-        for (int extra = 0; !line_done(); ++extra) {
-            if (extra == 4) fail(p_, "unexpected " + quote_at(p_, end_) + " after a vertex's x y z and 4 more numbers (w or a colour)");
-            number("a number (a vertex's w or colour)");
+        if (colors_) {
+            vertex_color(word, colors_ + 3 * (c_.v_before + v_));
+        } else {
+            for (int extra = 0; !line_done(); ++extra) {
+                if (extra == 4) fail(p_, "unexpected " + quote_at(p_, end_) + " after a vertex's x y z and 4 more numbers (w or a colour)");
+                number("a number (a vertex's w or colour)");
+            }
         }
         ++v_;
+    }
+
+    /// The numbers after a vertex's x y z when colours are kept: `r g b` (and an alpha, not
+    /// kept), the extension MeshLab and others write; a single one is the w of homogeneous
+    /// coordinates, no colour. Out of vertex(): its loop stays as tight as before without them.
+    [[gnu::noinline]] void vertex_color(const char* word, float* rgb) {
+        float extra[4];
+        int n = 0;
+        for (; !line_done(); ++n) {
+            if (n == 4) fail(p_, "unexpected " + quote_at(p_, end_) + " after a vertex's x y z and 4 more numbers (w or a colour)");
+            extra[n] = number("a number (a vertex's w or colour)");
+        }
+        if (n >= 3) {
+            std::copy_n(extra, 3, rgb);
+        } else {
+            std::fill_n(rgb, 3, 0.f);
+            if (!c_.colorless_at) c_.colorless_at = word;
+        }
     }
 
     void texcoord() {
@@ -347,6 +371,7 @@ class ChunkReader {
     const Totals& totals_;
     float* const positions_;
     float* const texcoords_;
+    float* const colors_;  // keep_colors only
     const bool keep_uv_;
     std::size_t v_ = 0, vt_ = 0, vn_ = 0;  // lines of each kind read so far in the chunk
     bool gap_seen_ = false;                // a gap recorded since the chunk's start or the last usemtl
@@ -525,6 +550,7 @@ ObjData parse_obj(std::string_view bytes, const std::string& name, const ObjRead
     };
     fresh(out.positions, 3 * totals.v);
     out.texcoords.resize(2 * totals.vt);
+    if (options.keep_colors) fresh(out.colors, 3 * totals.v);
     out.normal_count = totals.vn;
     parallel_for_index(chunks.size(), 1, [&](std::size_t k) {
         Chunk& c = chunks[k];
@@ -539,6 +565,11 @@ ObjData parse_obj(std::string_view bytes, const std::string& name, const ObjRead
     });
     for (const Chunk& c : chunks)  // the first error in the file
         if (c.error_at) obj_fail_at(bytes, name, std::size_t(c.error_at - bytes.data()), c.error);
+    for (const Chunk& c : chunks)  // the first vertex without a colour in the file
+        if (c.colorless_at) {
+            out.colorless_offset = std::size_t(c.colorless_at - bytes.data());
+            break;
+        }
 
     std::size_t triangles = 0;
     for (Chunk& c : chunks) {

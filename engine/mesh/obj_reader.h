@@ -20,7 +20,11 @@ namespace streamrt {
 /// their values are not read: the renderer computes its normals (Mesh::build).
 struct ObjData {
     static constexpr std::uint32_t kNoUv = 0xffffffffu;
-    std::vector<float> positions;          ///< 3 per `v` (a w or a colour after x y z is not kept)
+    std::vector<float> positions;          ///< 3 per `v` (a w or a colour after x y z is not kept here)
+    /// ObjReadOptions::keep_colors only: 3 per `v`, the r g b of a `v x y z r g b [a]` line as
+    /// written (0 where a line has none; colorless_offset names the first such line).
+    std::vector<float> colors;
+    std::size_t colorless_offset = std::size_t(-1);  ///< keep_colors: the first `v` without a colour, or -1
     std::vector<float> texcoords;          ///< 2 per `vt` (a missing second value is 0)
     std::size_t normal_count = 0;          ///< `vn` lines
     std::vector<std::uint32_t> triangles;  ///< 3 vertex numbers (from 0) per triangle, file order
@@ -46,6 +50,7 @@ struct ObjData {
 
 struct ObjReadOptions {
     bool keep_uv = false;              ///< fill triangle_uv and uv_gaps
+    bool keep_colors = false;          ///< fill colors and colorless_offset
     std::size_t chunk_bytes = 1 << 20;  ///< a chunk's size, extended to the next line end (tests: tiny)
     std::size_t max_vertices = 0xffffffffu;  ///< more are refused (vertex numbers are 32-bit)
 };

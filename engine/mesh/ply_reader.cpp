@@ -542,10 +542,7 @@ bool is_ply_path(const std::string& path) {
 
 std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv, bool with_colors) {
     if (is_ply_path(path)) return load_ply_mesh(path, with_uv, with_colors);
-    if (with_colors)
-        throw std::runtime_error("vertex_colors=true needs a PLY file with red green blue at its vertices (OBJ "
-                                 "files are read without vertex colours)");
-    return load_obj_mesh(path, with_uv);
+    return load_obj_mesh(path, with_uv, with_colors);
 }
 
 }  // namespace streamrt

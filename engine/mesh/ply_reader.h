@@ -42,8 +42,7 @@ PlyData parse_ply(std::string_view bytes, const std::string& name);
 std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv = false, bool with_colors = false);
 
 /// The mesh of a file by its extension: `.ply` (any case) with load_ply_mesh, anything else
-/// as a Wavefront OBJ file (load_obj_mesh); `with_uv` as for those; `with_colors` for PLY
-/// files only (an OBJ file is refused with it).
+/// as a Wavefront OBJ file (load_obj_mesh); `with_uv` and `with_colors` as for those.
 std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv, bool with_colors = false);
 
 /// True when `path` names a PLY file (extension `.ply`, any case).

@@ -76,7 +76,7 @@ std::optional<Arg> Parser::shape(Statement& st, const std::vector<Token>& toks, 
         if (!at) at = st.find("material");
         const int col = at ? at->key_col : st.where().column;
         if (kind != ShapeKind::Mesh)
-            st.fail(col, "vertex_colors=true needs a mesh (a PLY file with red green blue at its vertices), not a " +
+            st.fail(col, "vertex_colors=true needs a mesh whose file colours its vertices, not a " +
                              std::string(st.word()));
         if (f.look.m.texture >= 0)
             st.fail(col, "vertex_colors=true and texture= both replace the object's colour: give one of them");
@@ -86,8 +86,8 @@ std::optional<Arg> Parser::shape(Statement& st, const std::vector<Token>& toks, 
             st.fail(file_arg->value_col, "materials=obj needs an OBJ file (a PLY file has no material library), got " +
                                              quote(file_arg->value));
         if (f.look.m.vertex_colors)
-            st.fail(file_arg->value_col, "vertex_colors=true needs a PLY file with red green blue at its vertices, "
-                                         "and materials=obj an OBJ file");
+            st.fail(file_arg->value_col, "vertex_colors=true and materials=obj both give the object's colour: give "
+                                         "one of them");
         if (singular(f.md))
             st.fail_here(std::string(st.word()) + ": the composed transform is singular (or not finite)");
         // One object per part (usemtl group), each with its part's material over the

@@ -502,3 +502,25 @@ TEST_CASE("obj reader: through load_obj_mesh and the scene, with the file's loca
         CHECK(std::string(e.what()) == "cannot open mesh file");
     }
 }
+
+TEST_CASE("obj reader: vertex colours (v x y z r g b [a]) kept on request, the first vertex without one found") {
+    // Vertex 3 has a w only, vertex 5 nothing after x y z: the first of them is line 4.
+    const std::string text = "# colours\nv 0 0 0 1 0.5 0.25\nv 1 0 0 0.125 0 1 0.5\nv 0 1 0 2\nv 1 1 0 0 0 0\nv 2 2 0\n"
+                             "f 1 2 3\nf 2 4 3\n";
+    const std::size_t line4 = text.find("v 0 1 0 2");
+    for (const int jobs : {1, 2})
+        for (const std::size_t chunk : {std::size_t(1), std::size_t(9), std::size_t(40), std::size_t(1) << 20}) {
+            INFO("-j", jobs, ", chunk bytes ", chunk);
+            Parallelism par(jobs);
+            const ObjData d = par.run([&] { return parse_obj(text, "c.obj", {.keep_colors = true, .chunk_bytes = chunk}); });
+            CHECK(d.colors == std::vector<float>{1, 0.5f, 0.25f, 0.125f, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0});
+            CHECK(d.colorless_offset == line4);
+            CHECK(d.positions.size() == 15);
+            const ObjData plain = par.run([&] { return parse_obj(text, "c.obj", {.chunk_bytes = chunk}); });
+            CHECK(plain.colors.empty());  // not asked for: nothing kept
+            CHECK(plain.colorless_offset == std::size_t(-1));
+        }
+    const ObjData all = parse_obj("v 0 0 0 1 1 1\nv 1 0 0 0 0 0\nv 0 1 0 0.5 0.5 0.5\nf 1 2 3\n", "c.obj", {.keep_colors = true});
+    CHECK(all.colorless_offset == std::size_t(-1));
+    CHECK(all.colors.size() == 9);
+}

@@ -445,6 +445,9 @@ TEST_CASE("ply: vertex_colors=true renders a mesh's interpolated vertex colours,
                                        "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
                                        "end_header\n-9 -9 0\n9 -9 0\n0 9 0\n3 0 1 2\n";
     std::ofstream(dir / "tri.obj") << "v -9 -9 0\nv 9 -9 0\nv 0 9 0\nf 1 2 3\n";
+    // The same colour in an OBJ file: display values (the 8-bit codes over 255), decoded as sRGB.
+    std::ofstream(dir / "one.obj") << "v -9 -9 0 0.50196078 0.25098039 0.1254902\nv 9 -9 0 0.50196078 0.25098039 "
+                                      "0.1254902\nv 0 9 0 0.50196078 0.25098039 0.1254902\nf 1 2 3\n";
     const auto scene_with = [&](const std::string& mesh_line) {
         // degree 0: each pixel is its hit's flat colour, nothing else.
         return parse_scene("image width=16 height=12 spp=1 degree=0\ncamera eye=0,0,3 look=0,0,0\n" + mesh_line + "\n",
@@ -452,17 +455,20 @@ TEST_CASE("ply: vertex_colors=true renders a mesh's interpolated vertex colours,
     };
     Parallelism par(2);
     const Scene one = scene_with("mesh file=one.ply vertex_colors=true color=0.9,0.9,0.9");
+    const Scene one_obj = scene_with("mesh file=one.obj vertex_colors=true");
     const Scene rgb = scene_with("mesh file=rgb.ply vertex_colors=true");
     const Scene plain = scene_with("mesh file=one.ply color=0.9,0.8,0.7");
     REQUIRE(one.meshes[0]->view().vertex_colors != nullptr);
     CHECK(plain.meshes[0]->view().vertex_colors == nullptr);  // read without them: nobody asked
     for (EngineKind e : {EngineKind::Stream, EngineKind::Recursive}) {
         CAPTURE(int(e));
-        const Framebuffer a = render_scene(one, e, par).image;
-        for (std::size_t p = 0; p < a.rgb.size(); p += 3) {  // the vertices' colour, not color=
-            CHECK(a.rgb[p] == doctest::Approx(0.2158605).epsilon(1e-5));
-            CHECK(a.rgb[p + 1] == doctest::Approx(std::pow((64 / 255.0 + 0.055) / 1.055, 2.4)).epsilon(1e-5));
-            CHECK(a.rgb[p + 2] == doctest::Approx(std::pow((32 / 255.0 + 0.055) / 1.055, 2.4)).epsilon(1e-5));
+        for (const Scene* sc : {&one, &one_obj}) {  // the vertices' colour, not color=
+            const Framebuffer a = render_scene(*sc, e, par).image;
+            for (std::size_t p = 0; p < a.rgb.size(); p += 3) {
+                CHECK(a.rgb[p] == doctest::Approx(0.2158605).epsilon(1e-5));
+                CHECK(a.rgb[p + 1] == doctest::Approx(std::pow((64 / 255.0 + 0.055) / 1.055, 2.4)).epsilon(1e-5));
+                CHECK(a.rgb[p + 2] == doctest::Approx(std::pow((32 / 255.0 + 0.055) / 1.055, 2.4)).epsilon(1e-5));
+            }
         }
         // Red, green and blue corners (bottom left, bottom right, top): the weights sum to one
         // everywhere, red falls from left to right, green rises, blue rises upwards.
@@ -491,20 +497,22 @@ TEST_CASE("ply: vertex_colors=true renders a mesh's interpolated vertex colours,
         return std::string("no error");
     };
     CHECK(scene_error("sphere vertex_colors=true\n") ==
-          "1:8: vertex_colors=true needs a mesh (a PLY file with red green blue at its vertices), not a sphere");
+          "1:8: vertex_colors=true needs a mesh whose file colours its vertices, not a sphere");
     CHECK(scene_error("material m vertex_colors=true\n\n  cube material=m\n") ==
-          "3:8: vertex_colors=true needs a mesh (a PLY file with red green blue at its vertices), not a cube");
+          "3:8: vertex_colors=true needs a mesh whose file colours its vertices, not a cube");
     const fs::path tiles = fs::path(STREAMRT_SOURCE_DIR) / "scenes" / "textures" / "tiles.png";
     CHECK(scene_error("mesh file=rgb.ply texture=" + tiles.string() + " vertex_colors=true\n") ==
           "1:" + std::to_string(28 + tiles.string().size()) +
               ": vertex_colors=true and texture= both replace the object's colour: give one of them");
-    CHECK(scene_error("mesh file=tri.obj vertex_colors=true\n").find(
-              "1:11: '" + (dir / "tri.obj").string() + "': vertex_colors=true needs a PLY file") == 0);
+    // An OBJ file without colours: at its first vertex line.
+    CHECK(scene_error("mesh file=tri.obj vertex_colors=true\n") ==
+          "1:11: '" + (dir / "tri.obj").string() + "': " + (dir / "tri.obj").string() +
+              ":1:1: vertex without a colour (v x y z r g b), which vertex_colors=true needs");
     CHECK(scene_error("mesh file=bare.ply vertex_colors=true\n") ==
           "1:11: '" + (dir / "bare.ply").string() +
               "': vertex_colors=true needs colours at the vertices, and this PLY file has none (vertex properties "
               "red green blue)");
     CHECK(scene_error("mesh file=tri.obj materials=obj vertex_colors=true\n") ==
-          "1:11: vertex_colors=true needs a PLY file with red green blue at its vertices, and materials=obj an OBJ file");
+          "1:11: vertex_colors=true and materials=obj both give the object's colour: give one of them");
     fs::remove_all(dir);
 }
