@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <exception>
 #include <filesystem>
 #include <memory>
@@ -319,7 +320,7 @@ PYBIND11_MODULE(streamrt, m) {
             }, py::arg("word"), "Appends one statement from keywords: statement('sphere', color=(1, 0, 0), translate=(0, 1, 0)).")
         .def("mesh", [](PyScene& s, py::array_t<float, py::array::c_style | py::array::forcecast> vertices,
                         py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast> triangles,
-                        const py::kwargs& kw) {
+                        const py::object& colors_arg, const py::kwargs& kw) {
                 if (vertices.ndim() != 2 || vertices.shape(1) != 3)
                     throw py::value_error("vertices: expected an array of shape (n, 3)");
                 if (triangles.ndim() != 2 || triangles.shape(1) != 3)
@@ -329,18 +330,28 @@ PYBIND11_MODULE(streamrt, m) {
                 for (const std::uint32_t v : tris)
                     if (v >= std::uint32_t(vertices.shape(0)))
                         throw py::value_error("triangles: vertex number " + std::to_string(v) + " out of range");
+                std::vector<float> colors;
+                if (!colors_arg.is_none()) {
+                    const auto c = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(colors_arg);
+                    if (!c || c.ndim() != 2 || c.shape(1) != 3 || c.shape(0) != vertices.shape(0))
+                        throw py::value_error("colors: expected an array of shape (n, 3), one linear RGB colour per vertex");
+                    colors.assign(c.data(), c.data() + c.size());
+                    for (const float x : colors)
+                        if (!std::isfinite(x) || x < 0.f) throw py::value_error("colors: components must be finite and >= 0");
+                }
                 const std::string name = "memory:" + std::to_string(s.meshes.size());
                 std::shared_ptr<const Mesh> mesh;
                 {
                     py::gil_scoped_release release;
-                    mesh = Mesh::build(name, positions, tris);
+                    mesh = Mesh::build(name, positions, tris, {}, {}, {}, colors);
                 }
                 if (mesh->triangle_count() == 0) throw py::value_error("the mesh has no non-degenerate triangle");
                 s.meshes.push_back(std::move(mesh));
                 s.lines.push_back(statement("mesh file=" + name, kw));
-            }, py::arg("vertices"), py::arg("triangles"),
+            }, py::arg("vertices"), py::arg("triangles"), py::kw_only(), py::arg("colors") = py::none(),
             "Appends a mesh object from arrays (vertices (n, 3), triangles (m, 3), counter-clockwise seen\n"
-            "from outside) with the mesh statement's other keys: mesh(v, t, smooth=True, color=(1, 0, 0)).")
+            "from outside) with the mesh statement's other keys: mesh(v, t, smooth=True, color=(1, 0, 0)).\n"
+            "colors: (n, 3) linear RGB per vertex, shown with vertex_colors=True.")
         .def_property_readonly("text", &PyScene::text, "The statements as .cfg text (meshes as file=memory:K).");
 
     m.def("render", &render, py::arg("scene"),

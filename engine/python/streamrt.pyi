@@ -18,7 +18,8 @@ class Scene:
         """Appends statements (one or more lines of .cfg text)."""
     def statement(self, word: str, **keys: Any) -> None:
         """Appends one statement: statement('sphere', color=(1, 0, 0), translate=(0, 1, 0))."""
-    def mesh(self, vertices: npt.ArrayLike, triangles: npt.ArrayLike, **keys: Any) -> None:
+    def mesh(self, vertices: npt.ArrayLike, triangles: npt.ArrayLike, *, colors: Optional[npt.ArrayLike] = None,
+             **keys: Any) -> None:
         """Appends a mesh object: vertices (n, 3), triangles (m, 3), and the mesh statement's keys."""
     @property
     def text(self) -> str:

@@ -131,6 +131,9 @@ std::uint32_t Parser::mesh_file(const Statement& st, const Arg& a, bool with_uv,
         const std::size_t n = options_.memory_meshes->size();
         if (!k || *k != std::floor(*k) || !(*k >= 0 && *k < double(n)))
             st.fail(a.value_col, "no in-memory mesh " + quote(a.value) + " (there are " + std::to_string(n) + ")");
+        if (with_colors && !(*options_.memory_meshes)[std::size_t(*k)]->view().vertex_colors)
+            st.fail(a.value_col, "vertex_colors=true needs colours at the vertices, and in-memory mesh " + quote(a.value) +
+                                     " was made without them (Scene.mesh(..., colors=...))");
         const auto [it, added] = memory_mesh_index_.try_emplace(std::size_t(*k), std::uint32_t(scene.meshes.size()));
         if (added) scene.meshes.push_back((*options_.memory_meshes)[std::size_t(*k)]);
         return it->second;

@@ -197,3 +197,30 @@ def test_a_scene_built_from_arrays_renders_like_the_cfg_file():
         streamrt.render("image width=8 height=8\nmesh file=memory:0\n")
     with pytest.raises(ValueError, match="out of range"):
         streamrt.Scene().mesh(v, t + 10000)
+
+
+def test_a_mesh_from_arrays_takes_vertex_colours():
+    # One triangle filling the view, degree 0: every pixel is its hit's interpolated colour.
+    v = np.array([[-9, -9, 0], [9, -9, 0], [0, 9, 0]], np.float32)
+    t = np.array([[0, 1, 2]], np.uint32)
+    head = "image width=16 height=12 spp=1 degree=0\ncamera eye=0,0,3 look=0,0,0"
+    scene = streamrt.Scene()
+    scene.add(head)
+    scene.mesh(v, t, colors=np.full((3, 3), [0.25, 0.5, 0.125], np.float32), vertex_colors=True)
+    image = streamrt.render(scene).image
+    np.testing.assert_allclose(image.reshape(-1, 3), np.tile([0.25, 0.5, 0.125], (16 * 12, 1)), rtol=1e-5)
+    rgb = streamrt.Scene()
+    rgb.add(head)
+    rgb.mesh(v, t, colors=np.eye(3, dtype=np.float32), vertex_colors=True)
+    both = streamrt.compare(rgb)
+    np.testing.assert_allclose(both["stream"].image.sum(axis=2), 1.0, rtol=1e-5)  # barycentric weights
+    np.testing.assert_allclose(both["stream"].image, both["recursive"].image, rtol=1e-5, atol=1e-6)
+    with pytest.raises(ValueError, match="colors: expected an array of shape"):
+        streamrt.Scene().mesh(v, t, colors=np.zeros((2, 3), np.float32))
+    with pytest.raises(ValueError, match="must be finite and >= 0"):
+        streamrt.Scene().mesh(v, t, colors=np.full((3, 3), -1, np.float32))
+    bare = streamrt.Scene()
+    bare.add(head)
+    bare.mesh(v, t, vertex_colors=True)
+    with pytest.raises(streamrt.SceneError, match="in-memory mesh 'memory:0' was made without them"):
+        streamrt.render(bare)
