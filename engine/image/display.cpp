@@ -1,7 +1,6 @@
 #include "image/display.h"
 
 #include <algorithm>
-#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -16,16 +15,6 @@ using image_detail::for_each;
 
 double srgb_oetf(double c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055; }
 
-double srgb_eotf(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
-
-float srgb_to_linear(std::uint8_t code) {
-    static const std::array<float, 256> table = [] {
-        std::array<float, 256> t{};
-        for (int i = 0; i < 256; ++i) t[std::size_t(i)] = float(srgb_eotf(i / 255.0));
-        return t;
-    }();
-    return table[code];
-}
 
 Framebuffer calibrate(const Framebuffer& fb, Calibration how) {
     Framebuffer out = fb;

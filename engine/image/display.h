@@ -2,8 +2,6 @@
 // The display colour chain of the 8-bit formats (docs/scene-format.md, "Output and display
 // colour"): how the linear framebuffer becomes the bytes of a PNG or PPM, one row at a time,
 // with no converted copy of the image.
-#include <cstdint>
-
 #include "image/framebuffer.h"
 #include "image/display_settings.h"
 
@@ -13,15 +11,7 @@ class Parallelism;
 
 /// The sRGB OETF of IEC 61966-2-1 for c in [0, 1] (in double): 12.92 c up to 0.0031308,
 /// 1.055 c^(1/2.4) - 0.055 above.
-double srgb_oetf(double c);
-
-/// Its inverse, the sRGB EOTF, for c in [0, 1] (in double): c / 12.92 up to 0.04045,
-/// ((c + 0.055) / 1.055)^2.4 above.
-double srgb_eotf(double c);
-
-/// The linear value of an 8-bit sRGB code (srgb_eotf(code / 255), from a table). Texels and a
-/// PLY file's 8-bit vertex colours are colour data stored in sRGB; shading works in linear light.
-float srgb_to_linear(std::uint8_t code);
+double srgb_oetf(double c);  // its inverse, srgb_eotf, is in core/srgb.h
 
 /// Brings values into [0, 1]: clamp, or divide by the image's maximum (the handout's
 /// calibration). NaN becomes 0.

@@ -13,8 +13,8 @@
 #include <stdexcept>
 
 #include "core/mapped_file.h"
+#include "core/srgb.h"
 #include "core/vec3.h"
-#include "image/display.h"
 #include "mesh/obj_reader.h"
 #include "parallel/parallelism.h"
 

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "image/display.h"
+#include "core/srgb.h"
 #include "mesh/mesh.h"
 
 namespace streamrt {

@@ -16,7 +16,7 @@
 #include <stb_image.h>
 #pragma GCC diagnostic pop
 
-#include "image/display.h"
+#include "core/srgb.h"
 
 namespace streamrt {
 

@@ -1,7 +1,7 @@
 // libFuzzer target for the OBJ reader alone: parse_obj() on arbitrary bytes must either return
 // data whose triangles address its vertices and texture coordinates, with finite positions, or
 // throw std::runtime_error with one printable line `f.obj:LINE:COL: message`; and read in
-// 7-byte chunks (every chunk seam crossed) exactly as in one. Built and run by
+// 7-byte chunks (every chunk seam crossed) exactly as in one, vertex colours included. Built and run by
 // scripts/fuzz.sh obj.
 #include <cmath>
 #include <cstdint>
@@ -19,7 +19,7 @@ using streamrt::ObjData;
 /// The data, or the error's text.
 std::string read(std::string_view text, std::size_t chunk, ObjData& out) {
     try {
-        out = streamrt::parse_obj(text, "f.obj", {.keep_uv = true, .chunk_bytes = chunk});
+        out = streamrt::parse_obj(text, "f.obj", {.keep_uv = true, .keep_colors = true, .chunk_bytes = chunk});
     } catch (const std::runtime_error& e) {
         const std::string what = e.what();
         for (unsigned char c : what)
@@ -48,6 +48,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (v >= vertices) std::abort();
     for (std::uint32_t t : a.triangle_uv)
         if (t != ObjData::kNoUv && t >= texcoords) std::abort();
+    // Colours: one per vertex, the first vertex without one the same at every chunk size.
+    if (a.colors.size() != a.positions.size() || a.colors != b.colors || a.colorless_offset != b.colorless_offset ||
+        (a.colorless_offset != std::size_t(-1) && a.colorless_offset >= text.size()))
+        std::abort();
     if (a.positions != b.positions || a.texcoords != b.texcoords || a.triangles != b.triangles ||
         a.triangle_uv != b.triangle_uv || a.mtllib != b.mtllib || a.material_uses.size() != b.material_uses.size() ||
         a.uv_gaps.size() != b.uv_gaps.size())

@@ -2,6 +2,7 @@
 // return data whose triangles address its vertices or throw std::runtime_error with one
 // line; never crash, read out of bounds or allocate beyond the input's size (ASan's
 // -rss_limit_mb and -malloc_limit_mb catch that). Built and run by scripts/fuzz.sh ply.
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +20,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             std::abort();
         for (std::uint32_t v : d.triangles)
             if (v >= vertices) std::abort();
+        // Texture coordinates and colours: per vertex or per corner, finite, colours >= 0.
+        if ((!d.uvs.empty() && d.uvs.size() != 2 * vertices) || (!d.colors.empty() && d.colors.size() != 3 * vertices) ||
+            (!d.corner_uv.empty() && d.corner_uv.size() != 2 * d.triangles.size()))
+            std::abort();
+        for (float c : d.colors)
+            if (!(c >= 0.f) || !std::isfinite(c)) std::abort();
     } catch (const std::runtime_error& e) {
         if (std::string_view(e.what()).find('\n') != std::string_view::npos) std::abort();
     }

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <string>
 
+#include "core/srgb.h"
 #include "mesh/mesh.h"
-#include "image/display.h"
 #include "render/texture.h"
 #include "scene/parser.h"
 #include "scene/expect_error.h"
