@@ -183,15 +183,14 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
     const MaterialT<double>& material = materials_[object.material];
     // The texture, or a mesh's vertex colours, replace the object's colour (render/texture.h).
-    const PreparedObject& hit_object = objects_[std::size_t(hit.object)];
+    const PreparedObject& ob = objects_[std::size_t(hit.object)];
     const ColorT<double> object_color =
         material.texture ? texture_color_at(material, ray, hit)
-        : material.vertex_colors && hit_object.mesh && hit_object.mesh->view().vertex_colors
-            ? mesh_vertex_color(hit_object.mesh->view(), hit.tri, hit.bu, hit.bv)
+        : material.vertex_colors && ob.mesh && ob.mesh->view().vertex_colors
+            ? mesh_vertex_color(ob.mesh->view(), hit.tri, hit.bu, hit.bv)
             : ColorT<double>{object.color.x, object.color.y, object.color.z};
     RecursiveSink sink{*this, depth, counts, key};
     // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
-    const PreparedObject& ob = objects_[std::size_t(hit.object)];
     const bool smooth = ob.kind == ShapeKind::Mesh && ob.param != 0.0;
     const auto shadow_point = [&](const Vec3d& p) { return smooth ? p + terminator_shift_at(ray, hit) : p; };
     const auto shade = [&]<bool kLit, bool kShadows>() {

@@ -27,8 +27,9 @@ struct Texture {
     static constexpr auto field = &Texture::texture;
 };
 
-/// vertex_colors=true: a mesh's colours at its vertices (a PLY file's red green blue),
-/// interpolated across each triangle, replace the object's colour (render/texture.h).
+/// vertex_colors=true: a mesh's colours at its vertices (a PLY file's red green blue, an OBJ
+/// file's v x y z r g b), interpolated across each triangle, replace the object's colour
+/// (render/texture.h).
 struct VertexColors {
     static constexpr PropertyInfo info{"vertex_colors", ValueKind::Flag, Bound::Any, true};
     bool vertex_colors = false;

@@ -373,7 +373,7 @@ float linear_color(Body& body, double value, const PlyType& t) {
 
 /// Reads the body's elements in header order into `out`.
 template <class Body>
-void read_body(Body& body, const PlyHeader& h, PlyData& out) {
+void read_body(Body& body, const PlyHeader& h, const PlyReadOptions& options, PlyData& out) {
     std::uint64_t vertex_count = 0;
     for (const PlyElement& e : h.elements)
         if (e.name == "vertex") vertex_count = e.count;
@@ -401,6 +401,8 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
             for (int s = 3; s < 6; ++s) normals = normals && std::count(slot.begin(), slot.end(), s) == 1;
             for (int s = 6; s < 8; ++s) uvs = uvs && std::count(slot.begin(), slot.end(), s) == 1;
             for (int s = 8; s < 11; ++s) colors = colors && std::count(slot.begin(), slot.end(), s) == 1;
+            uvs = uvs && options.keep_uv;
+            colors = colors && options.keep_colors;
             out.positions.reserve(3 * std::size_t(e.count));  // bounded by the file's length (parse_header)
             if (normals) out.normals.reserve(3 * std::size_t(e.count));
             if (uvs) out.uvs.reserve(2 * std::size_t(e.count));
@@ -410,12 +412,12 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
         const PlyProperty* texcoords = nullptr;  // and its first texture coordinate list
         for (const PlyProperty& p : e.props) {
             if (!indices && is_index_list(e, p)) indices = &p;
-            if (!texcoords && is_texcoord_list(e, p)) texcoords = &p;
+            if (!texcoords && options.keep_uv && is_texcoord_list(e, p)) texcoords = &p;
         }
         if (face) out.triangles.reserve(3 * std::size_t(e.count));
         if (texcoords) out.corner_uv.reserve(6 * std::size_t(e.count));
-        std::vector<std::uint32_t> corners;  // one face's vertex numbers, then its texture coordinates
-        std::vector<float> corner_uv;
+        std::vector<std::uint32_t> corners;  // one face's vertex numbers
+        std::vector<float> corner_uv;        // and its texcoord list
         for (std::uint64_t k = 0; k < e.count; ++k) {
             body.begin_item(e.name, k);
             double v[11] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
@@ -486,15 +488,15 @@ void read_body(Body& body, const PlyHeader& h, PlyData& out) {
 
 }  // namespace
 
-PlyData parse_ply(std::string_view bytes, const std::string& name) {
+PlyData parse_ply(std::string_view bytes, const std::string& name, const PlyReadOptions& options) {
     const PlyHeader h = parse_header(bytes, name);
     PlyData out;
     if (h.format == PlyFormat::Ascii) {
         AsciiBody body(bytes, h, name);
-        read_body(body, h, out);
+        read_body(body, h, options, out);
     } else {
         BinaryBody body(bytes, h, name);
-        read_body(body, h, out);
+        read_body(body, h, options, out);
     }
     return out;
 }
@@ -504,7 +506,7 @@ std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv,
     if (!in) throw std::runtime_error("cannot open mesh file");
     const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     if (in.bad()) throw std::runtime_error("cannot read mesh file");
-    const PlyData data = parse_ply(bytes, path);
+    const PlyData data = parse_ply(bytes, path, {.keep_uv = with_uv, .keep_colors = with_colors});
     const std::size_t faces = data.triangles.size() / 3;
     std::vector<float> corner_uv;
     if (with_uv) {
@@ -524,8 +526,7 @@ std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv,
         throw std::runtime_error(
             "vertex_colors=true needs colours at the vertices, and this PLY file has none (vertex properties red "
             "green blue)");
-    auto mesh = Mesh::build(path, data.positions, data.triangles, {}, corner_uv, data.normals,
-                            with_colors ? data.colors : std::vector<float>{});
+    auto mesh = Mesh::build(path, data.positions, data.triangles, {}, corner_uv, data.normals, data.colors);
     if (mesh->triangle_count() == 0)
         throw std::runtime_error(faces == 0 ? "PLY file has no faces"
                                             : "PLY file has no triangles of non-zero area (" + std::to_string(faces) +

@@ -22,16 +22,23 @@ struct PlyData {
     std::vector<float> positions;          ///< 3 per vertex
     std::vector<float> normals;            ///< 3 per vertex, or empty (no nx ny nz)
     std::vector<std::uint32_t> triangles;  ///< 3 vertex numbers per triangle
-    std::vector<float> uvs;                ///< 2 per vertex (u, v), or empty
-    std::vector<float> corner_uv;          ///< 6 per triangle (its corners' u, v) from face texcoord lists, or empty
-    std::vector<float> colors;             ///< 3 per vertex (red green blue as linear light), or empty
+    std::vector<float> uvs;                ///< keep_uv: 2 per vertex (u, v), or empty
+    std::vector<float> corner_uv;          ///< keep_uv: 6 per triangle (its corners' u, v) from face texcoord lists, or empty
+    std::vector<float> colors;             ///< keep_colors: 3 per vertex (red green blue as linear light), or empty
+};
+
+/// What parse_ply keeps beside positions, normals and triangles (a large scan's colours are
+/// not held for a render that does not show them; their values are then not checked either).
+struct PlyReadOptions {
+    bool keep_uv = false;      ///< PlyData::uvs and corner_uv
+    bool keep_colors = false;  ///< PlyData::colors
 };
 
 /// Parses the bytes of a PLY file named `name` (for messages). Throws std::runtime_error
 /// with one line: `name:line:col: message` for the header and an ASCII body,
 /// `name: element E K (byte offset B): message` for a binary body (element E's K-th item,
 /// counted from 0).
-PlyData parse_ply(std::string_view bytes, const std::string& name);
+PlyData parse_ply(std::string_view bytes, const std::string& name, const PlyReadOptions& options = {});
 
 /// Reads a PLY file into a mesh (its normals, when present, are the mesh's vertex normals).
 /// With `with_uv` (a textured object) the mesh keeps texture coordinates: the faces'

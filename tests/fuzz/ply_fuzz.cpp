@@ -14,7 +14,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     try {
-        const streamrt::PlyData d = streamrt::parse_ply(std::string_view(reinterpret_cast<const char*>(data), size), "f.ply");
+        const streamrt::PlyData d = streamrt::parse_ply(std::string_view(reinterpret_cast<const char*>(data), size), "f.ply",
+                                                        {.keep_uv = true, .keep_colors = true});
         const std::size_t vertices = d.positions.size() / 3;
         if (d.positions.size() % 3 || d.triangles.size() % 3 || (!d.normals.empty() && d.normals.size() != d.positions.size()))
             std::abort();

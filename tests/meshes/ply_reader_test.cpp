@@ -108,9 +108,12 @@ void check_data(const PlyData& d, bool normals) {
     CHECK(d.normals[0] == 0.f);
 }
 
+/// Everything a PLY file may hold, kept (the readers' strictest reading).
+constexpr PlyReadOptions kKeepAll{.keep_uv = true, .keep_colors = true};
+
 std::string error_of(const std::string& bytes) {
     try {
-        parse_ply(bytes, "t.ply");
+        parse_ply(bytes, "t.ply", kKeepAll);
     } catch (const std::runtime_error& e) {
         return e.what();
     }
@@ -288,13 +291,18 @@ TEST_CASE("ply: texture coordinates, per vertex under each usual name and per fa
         CAPTURE(u);
         const PlyData d = parse_ply(kHeadAscii + "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                                                  "property float " + u + "\nproperty float " + v + "\n" + vertex_uv_tail,
-                                    "uv.ply");
+                                    "uv.ply", kKeepAll);
         CHECK(d.uvs == std::vector<float>{0.25f, 0.5f, 0.75f, 0.5f, 0.25f, 1.f});
         CHECK(d.corner_uv.empty());
     }
+    // Not asked for: not kept.
+    CHECK(parse_ply(kHeadAscii + "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                 "property float u\nproperty float v\n" + vertex_uv_tail,
+                    "uv.ply")
+              .uvs.empty());
     // Only one of the pair: no texture coordinates, and the lone value is skipped.
     const PlyData lone = parse_ply(kHeadAscii + "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                                                "property float u\nproperty float w\n" + vertex_uv_tail, "uv.ply");
+                                                "property float u\nproperty float w\n" + vertex_uv_tail, "uv.ply", kKeepAll);
     CHECK(lone.uvs.empty());
     CHECK(lone.positions == std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0});
 
@@ -309,7 +317,7 @@ TEST_CASE("ply: texture coordinates, per vertex under each usual name and per fa
                                         " 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
                                         "property float s\nproperty double t\nproperty uchar red\nelement face 1\n"
                                         "property list uchar int vertex_indices\nend_header\n" + b.bytes,
-                                    "b.ply");
+                                    "b.ply", kKeepAll);
         CHECK(d.uvs == std::vector<float>{0, 0, 1, 0, 1, 0.5f, 0, 0.5f});
         CHECK(d.triangles == std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3});
     }
@@ -322,18 +330,18 @@ TEST_CASE("ply: texture coordinates, per vertex under each usual name and per fa
     const std::vector<float> fan_uv = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.1f, 0.2f, 0.5f, 0.6f, 0.7f, 0.8f};
     const PlyData after = parse_ply(faces_head + "property list uchar int vertex_indices\nproperty list uchar float texcoord\n"
                                                  "end_header\n" + verts + "4 0 1 2 3 8 0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8\n",
-                                    "f.ply");
+                                    "f.ply", kKeepAll);
     CHECK(after.corner_uv == fan_uv);
     CHECK(after.uvs.empty());
     const PlyData before = parse_ply(faces_head + "property list uchar float texcoord\nproperty list uchar int vertex_indices\n"
                                                   "end_header\n" + verts + "8 0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8 4 0 1 2 3\n",
-                                     "f.ply");
+                                     "f.ply", kKeepAll);
     CHECK(before.corner_uv == fan_uv);
     CHECK(before.triangles == std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3});
     // An empty list on a face is allowed by the header's size check (only the index list has a minimum).
     CHECK(parse_ply(faces_head + "property list uchar int vertex_indices\nproperty list uchar int flags\nend_header\n" +
                         verts + "3 0 1 2 0\n",
-                    "f.ply").triangles.size() == 3);
+                    "f.ply", kKeepAll).triangles.size() == 3);
 
     // Errors: a texcoord list of the wrong length, a non-finite coordinate.
     CHECK(error_of(faces_head + "property list uchar int vertex_indices\nproperty list uchar float texcoord\nend_header\n" +
@@ -404,7 +412,7 @@ TEST_CASE("ply: vertex colours, 8-bit and 16-bit sRGB codes or linear floats, re
     // uchar: the sRGB codes decoded (IEC 61966-2-1: 128 -> 0.2158605, 10 -> 10 / 255 / 12.92).
     const PlyData u8 = parse_ply(head + "property uchar red\nproperty uchar green\nproperty uchar blue\n" + faces +
                                      "0 0 0 255 128 0\n1 0 0 10 0 0\n0 1 0 0 0 255\n3 0 1 2\n",
-                                 "c.ply");
+                                 "c.ply", kKeepAll);
     REQUIRE(u8.colors.size() == 9);
     CHECK(u8.colors[0] == 1.f);
     CHECK(u8.colors[1] == doctest::Approx(0.2158605).epsilon(1e-6));
@@ -415,18 +423,24 @@ TEST_CASE("ply: vertex colours, 8-bit and 16-bit sRGB codes or linear floats, re
     const PlyData u16 = parse_ply(head + "property ushort diffuse_red\nproperty ushort diffuse_green\n"
                                          "property ushort diffuse_blue\n" + faces +
                                       "0 0 0 65535 32768 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n",
-                                  "c.ply");
+                                  "c.ply", kKeepAll);
     REQUIRE(u16.colors.size() == 9);
     CHECK(u16.colors[0] == 1.f);
     CHECK(u16.colors[1] == doctest::Approx(std::pow((32768.0 / 65535.0 + 0.055) / 1.055, 2.4)).epsilon(1e-6));
     // float: linear values as written.
     const PlyData f32 = parse_ply(head + "property float red\nproperty float green\nproperty float blue\n" + faces +
                                       "0 0 0 0.25 0.5 2\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n",
-                                  "c.ply");
+                                  "c.ply", kKeepAll);
     CHECK(std::vector<float>(f32.colors.begin(), f32.colors.begin() + 3) == std::vector<float>{0.25f, 0.5f, 2.f});
     // Two of the three: no colours.
     CHECK(parse_ply(head + "property uchar red\nproperty uchar green\n" + faces + "0 0 0 1 2\n1 0 0 1 2\n0 1 0 1 2\n3 0 1 2\n",
-                    "c.ply").colors.empty());
+                    "c.ply", kKeepAll).colors.empty());
+    // Not asked for: neither kept nor checked (a render that does not show them reads on).
+    const PlyData bare = parse_ply(head + "property float red\nproperty float green\nproperty float blue\n" + faces +
+                                       "0 0 0 0 -0.5 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n",
+                                   "c.ply");
+    CHECK(bare.colors.empty());
+    CHECK(bare.positions.size() == 9);
     CHECK(error_of(head + "property float red\nproperty float green\nproperty float blue\n" + faces +
                    "0 0 0 0 -0.5 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n") ==
           "t.ply:13:14: vertex colour -0.500000 is not a finite value >= 0");
