@@ -37,6 +37,16 @@ struct Stream {
         count = n;
     }
     RayView view(float* t) const { return {count, ox.data(), oy.data(), oz.data(), dx.data(), dy.data(), dz.data(), t}; }
+    /// The live rays in a random order (a fixed seed: the same order every run). Screen order
+    /// lets each walk find its nodes in cache from the walk before; a renderer's deep rays
+    /// (inside glass, after several bounces) come in no such order.
+    void shuffle(std::uint32_t seed = 7) {
+        std::mt19937 rng(seed);
+        for (std::size_t i = count; i > 1; --i) {
+            const std::size_t j = std::uniform_int_distribution<std::size_t>(0, i - 1)(rng);
+            for (auto* a : {&ox, &oy, &oz, &dx, &dy, &dz, &t_max}) std::swap((*a)[i - 1], (*a)[j]);
+        }
+    }
 };
 
 struct Streams {

@@ -3,7 +3,7 @@
 (docs/performance.md, "Ray traversal, Embree against streamrt").
 
 usage: scripts/ab_rays.py OLD_EMBREE_RAYS NEW_EMBREE_RAYS [--rounds N] [--reps R]
-                          [--rays primary,shadow,...] MESH...
+                          [--rays primary,shadow,...] [--shuffle] MESH...
 
 Runs the two harness binaries alternately (old then new, then new then old, ...), --rounds
 times each, every mesh, and prints per mesh and ray set the median Mrays/s of streamrt's packet
@@ -29,13 +29,14 @@ def main():
     ap.add_argument("--rounds", type=int, default=6)
     ap.add_argument("--reps", type=int, default=3, help="the harness's own --reps (median of R)")
     ap.add_argument("--rays", default=",".join(KINDS))
+    ap.add_argument("--shuffle", action="store_true", help="the harness's --shuffle: rays in a random order")
     args = ap.parse_args()
     runs = collections.defaultdict(list)  # (mesh, kind, build, column) -> Mrays/s
     for r in range(args.rounds):
         order = (("old", args.old), ("new", args.new))
         for build, binary in order if r % 2 == 0 else order[::-1]:
             for mesh in args.meshes:
-                out = subprocess.run([binary, "--reps", str(args.reps), "--rays", args.rays, mesh],
+                out = subprocess.run([binary, "--reps", str(args.reps), "--rays", args.rays, mesh] + (["--shuffle"] if args.shuffle else []),
                                      capture_output=True, text=True, check=True).stdout
                 for line in out.splitlines():
                     f = line.split()

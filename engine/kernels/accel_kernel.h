@@ -59,7 +59,7 @@ inline auto slab_test(const B& lox, const B& loy, const B& loz, const B& hix, co
 }
 
 /// Starts loading the object records of a leaf that a walk has just met: with many objects
-/// the records (72 bytes each) miss the caches, and the walk would wait on them when it pops
+/// the records (64 bytes each) miss the caches, and the walk would wait on them when it pops
 /// the leaf; the leaves nearer than it are tested meanwhile.
 inline void prefetch_leaf(const AccelView& bvh, std::int32_t first, std::uint32_t count) {
     simd::prefetch_lines(bvh.prims + first, sizeof(KernelObject) * count);

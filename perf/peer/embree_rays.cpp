@@ -11,7 +11,9 @@
 // (AccelKernelTable: packet and single-ray walks; the plane is outside both).
 //
 // --rays keeps only the listed ray sets (primary, shadow, mirror, glass, diffuse), e.g. to
-// profile one of them with perf.
+// profile one of them with perf. --shuffle traces every mesh ray set in a random order (fixed
+// seed) instead of screen order: each walk then finds less of its path in cache from the walk
+// before, as a renderer's deep rays do.
 //
 // Each mesh is read by streamrt's own reader (load_mesh_file) and built twice: streamrt's mesh
 // (its 8-wide hierarchy, as a scene uses it) and an Embree scene of the same triangles, in the
@@ -240,6 +242,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> files;
     std::string only;  // --rays: comma-separated kinds, empty = all
     std::size_t spheres = 0;  // --spheres N: the sphere field instead of meshes
+    bool shuffle = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--reps" && i + 1 < argc) {
@@ -252,11 +255,13 @@ int main(int argc, char** argv) {
             quality = q == "high" ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
         } else if (a == "--rays" && i + 1 < argc) {
             only = "," + std::string(argv[++i]) + ",";
+        } else if (a == "--shuffle") {
+            shuffle = true;
         } else if (a == "--spheres" && i + 1 < argc) {
             spheres = std::size_t(std::max(1.0, std::atof(argv[++i])));
         } else if (a == "-h" || a == "--help" || a.rfind("--", 0) == 0) {
             std::fprintf(stderr, "usage: embree_rays [--reps N] [--isa sse2|sse4.2|avx2|avx512] [--quality medium|high] "
-                                 "[--rays primary,shadow,mirror,glass,diffuse] MESH.{obj,ply} ... | --spheres N\n");
+                                 "[--rays primary,shadow,mirror,glass,diffuse] [--shuffle] MESH.{obj,ply} ... | --spheres N\n");
             return a == "-h" || a == "--help" ? 0 : 2;
         } else {
             files.push_back(a);
@@ -295,11 +300,14 @@ int main(int argc, char** argv) {
         xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
         xf.mesh = &mesh->view();
         const View view = view_of_bounds(mesh->lo, mesh->hi);
-        const Streams s = make_streams(*mesh, kt, xf, view);
+        Streams s = make_streams(*mesh, kt, xf, view);
+        if (shuffle)
+            for (Stream* st : {&s.primary, &s.shadow, &s.mirror, &s.glass, &s.diffuse}) st->shuffle();
         std::printf("\n%s: %zu triangles; streamrt read + build %.2f s, Embree build (%s quality, 1 thread) "
-                    "%.2f s; %dx%d view\n",
+                    "%.2f s; %dx%d view%s\n",
                     file.c_str(), mesh->triangle_count(), t_built - t_read,
-                    quality == RTC_BUILD_QUALITY_HIGH ? "high" : "medium", t_embree, view.width, view.height);
+                    quality == RTC_BUILD_QUALITY_HIGH ? "high" : "medium", t_embree, view.width, view.height,
+                    shuffle ? ", rays in a random order" : "");
         std::printf("%-8s %9s %10s %10s %10s %7s %10s   %s\n", "rays", "count", "Embree16", "Embree1", "streamrt", "ratio",
                     "single", "hits: Embree16 / Embree1 / streamrt");
         // The same mesh with every packet handed to the single-ray walk at the root.
