@@ -91,6 +91,7 @@ Job make_job(const Options& opt, std::shared_ptr<const Scene> scene, bool writes
     if (!sample_map.empty() && (job.render_settings.adaptive == 0 || opt.tiled() || opt.compare))
         throw UsageError("--aov samples= needs adaptive sampling (--adaptive, --target-error or image adaptive=) on "
                          "one whole image (not --compare or a tiled render)");
+    job.options.sample_map = !sample_map.empty();
     if (writes) {
         if (!sample_map.empty()) check_writable_path(sample_map, opt.scene_path);
         // A shard part is a tile file (docs/distributed.md), whatever its name.

@@ -315,7 +315,10 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     }
 
     Framebuffer image = Framebuffer::uninitialized(w, h);
-    Framebuffer map = Framebuffer::uninitialized(w, h);
+    // The sample map only when someone reads it: a second image of the picture's size, whose
+    // first touch of every page is paid on the render's clock.
+    const bool keep_map = prepared.keep_sample_map;
+    Framebuffer map = keep_map ? Framebuffer::uninitialized(w, h) : Framebuffer{};
     std::vector<double> tile_samples(tiles.size());  // summed in tile order after: the same for any -j
     par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
         double n = 0, error = 0;
@@ -323,10 +326,12 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
             const ColorT<double> mean = tally.mean();
             float* px = image.pixel(x, y);
             px[0] = float(mean.x), px[1] = float(mean.y), px[2] = float(mean.z);
-            float* m = map.pixel(x, y);
-            m[0] = float(tally.n);
-            m[1] = float(tally.standard_error());
-            m[2] = 0.f;
+            if (keep_map) {
+                float* m = map.pixel(x, y);
+                m[0] = float(tally.n);
+                m[1] = float(tally.standard_error());
+                m[2] = 0.f;
+            }
             n += tally.n;
             error += tally.image_error_squared();
         });

@@ -56,7 +56,7 @@ MemoryEstimate estimate_render_memory(const Scene& scene, const RenderSettings& 
         // Per pixel, at most (a pixel that stops at its corners has no tally): its tally, its
         // place in the tile and in the last round's list (two 32-bit indices), its neighbour
         // flag, its above-T flag (the neighbour rule's image, driver/adaptive_render.cpp) and
-        // its sample-map pixel.
+        // its sample-map pixel (counted whether or not a map is asked for: a bound).
         e.adaptive_bytes =
             pixels * (sizeof(PixelTally) + 2 * sizeof(std::uint32_t) + 2 * sizeof(std::uint8_t) + 3 * sizeof(float));
         // The first round's corners, (width + 1) x (height + 1) colours (render/adaptive.h).

@@ -126,6 +126,7 @@ std::unique_ptr<PreparedRender> prepare_render(std::shared_ptr<const Scene> scen
     p->height = settings.height;
     p->adaptive = AdaptiveRule{settings.adaptive, settings.spp};
     p->stop = options.adaptive_stop;
+    p->keep_sample_map = options.sample_map;
     return p;
 }
 
@@ -197,7 +198,7 @@ RenderResult render_prepared(PreparedRender& prepared, Parallelism& par, RenderP
     r.image = prepared.render(par, &p);
     r.seconds = seconds_since(start);
     r.adaptive = prepared.last_adaptive;
-    if (r.adaptive) r.sample_map = prepared.sample_map;
+    if (r.adaptive) r.sample_map = std::move(prepared.sample_map);  // the result owns it from here
     r.counts = p.counts();
     return r;
 }

@@ -48,6 +48,9 @@ struct EngineOptions {
     std::size_t slice_rays = 0;         ///< stream engine: most rays traced at once (0: default; tests)
     accel::AccelConfig accel;           ///< both engines: whether and how the object hierarchy is used
     AdaptiveStop adaptive_stop;         ///< both engines: adaptive sampling's early stops (whole image)
+    /// Adaptive sampling: fill RenderResult::sample_map. A front end that writes or returns
+    /// no sample map says false, and the render skips a second image of the picture's size.
+    bool sample_map = true;
 };
 
 /// An engine with its set-up done (tables, hierarchy), ready to render. Uniform or adaptive
@@ -88,7 +91,8 @@ class PreparedRender {
     AdaptiveRule adaptive;      ///< from the scene's settings (threshold 0: uniform)
     AdaptiveStop stop;          ///< whole-image adaptive renders only
     std::optional<AdaptiveSummary> last_adaptive;  ///< set by an adaptive render()
-    Framebuffer sample_map;                        ///< set by an adaptive render()
+    bool keep_sample_map = true;                   ///< EngineOptions::sample_map
+    Framebuffer sample_map;                        ///< set by an adaptive render() when keep_sample_map
 
   protected:
     virtual Framebuffer render_uniform(Parallelism& par, RenderProgress* progress) = 0;
