@@ -305,6 +305,22 @@ TEST_CASE("adaptive: the same picture and sample counts for -j1, -j2 and tile by
     }
 }
 
+TEST_CASE("adaptive: without a sample map asked for, the same picture and no map") {
+    const Scene sc = adaptive_scene(0.004);
+    const RenderResult with_map = render(sc, EngineKind::Stream, 2);
+    EngineOptions options;
+    options.sample_map = false;
+    Parallelism par(2);
+    auto prepared = prepare_render(sc, EngineKind::Stream, options);
+    const RenderResult without = render_prepared(*prepared, par);
+    REQUIRE(without.adaptive);
+    CHECK(without.image.rgb == with_map.image.rgb);
+    CHECK(without.adaptive->mean_spp == with_map.adaptive->mean_spp);
+    CHECK(without.sample_map.rgb.empty());
+    REQUIRE(with_map.sample_map.rgb.size() == with_map.image.rgb.size());
+    CHECK(with_map.sample_map.width == sc.settings.width);
+}
+
 TEST_CASE("adaptive: counts stay within [4, cap], flat pixels stop at 4, edges reach the cap") {
     const Scene sc = adaptive_scene(1e-9);  // below any spread: every pixel with one goes on
     const RenderResult r = render(sc, EngineKind::Stream, 2);
