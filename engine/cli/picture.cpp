@@ -127,6 +127,7 @@ int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBu
         if (!write_image(map, r.sample_map, floats, wo)) throw Interrupted{};
     }
     const double write_seconds = since(phase_start);
+    if (job.profile) job.profile->adaptive = r.adaptive;
     report_profile(opt, job.profile.get());
     print_summary(opt, job, par.jobs(), "", r.seconds, r.counts, r.setup_seconds, write_seconds, r.adaptive);
     return 0;

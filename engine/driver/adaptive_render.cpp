@@ -228,6 +228,14 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
         });
         return rmse_of_tiles();
     };
+    // Wall time by phase (AdaptivePhases): each lap adds the time since the last to one phase.
+    auto lap_start = Clock::now();
+    const auto lap = [&lap_start](double& phase) {
+        const auto now = Clock::now();
+        phase += std::chrono::duration<double>(now - lap_start).count();
+        lap_start = now;
+    };
+    AdaptivePhases& phases = summary.seconds;
     for (int r = 0;; ++r) {
         if (r == 0 && corners_first) {
             par.for_each_index(order.size(), 1, [&](std::size_t k) {
@@ -244,6 +252,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                 if (progress) progress->add(counts);
             });
             summary.rounds = 1;
+            lap(phases.corners);
             if (progress && progress->cancelled()) break;
             if (out_of_time()) {
                 summary.time_limited = true;
@@ -281,6 +290,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                             t.spread_near.push_back(1);
                         }
             });
+            lap(phases.neighbour_rule);
         }
         std::atomic<int> refined{0};
         // Without an image target or a clock, nothing after round 1 looks beyond its own
@@ -303,6 +313,8 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
             }
             if (progress) r == 0 ? progress->add(counts) : progress->add_rays(counts);
         });
+        // Round 0 without corners is the first round of samples: counted with the rounds.
+        lap(phases.rounds);
         if (refined == 0) break;
         summary.rounds = last_round + 1;
         if (to_the_end) break;
@@ -338,10 +350,12 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
         tile_samples[i] = n;
         tile_error[i] = error;
     });
+    lap(phases.final_pass);
     double samples = 0;  // camera rays: a corner is traced once for the four pixels it bounds
     if (corners_first) samples = double(w + 1) * double(h + 1) - double(kFirstRoundSamples) * double(w) * double(h);
     for (const double n : tile_samples) samples += n;
     summary.mean_spp = samples / (double(w) * double(h));
+    summary.cap = prepared.adaptive.cap;
     summary.estimated_rmse = rmse_of_tiles();
     prepared.last_adaptive = summary;
     prepared.sample_map = std::move(map);

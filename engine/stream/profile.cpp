@@ -70,6 +70,15 @@ std::string StreamProfile::text() const {
         out += "(the intersect and occlusion rows by ray generation, 0 = camera rays; shadow rays by the "
                "generation that cast them)\n";
     }
+    if (adaptive) {
+        const AdaptivePhases& p = adaptive->seconds;
+        std::snprintf(line, sizeof line,
+                      "adaptive: %.2f samples per pixel (at most %d), %d round(s), estimated error %.3g; wall s: "
+                      "corners %.4f, neighbour rule %.4f, rounds %.4f, final pass %.4f\n",
+                      adaptive->mean_spp, adaptive->cap, adaptive->rounds, adaptive->estimated_rmse, p.corners,
+                      p.neighbour_rule, p.rounds, p.final_pass);
+        out += line;
+    }
     return out;
 }
 
@@ -114,10 +123,21 @@ std::string StreamProfile::json() const {
         first = false;
     }
     std::snprintf(buf, sizeof buf,
-                  "\n  ],\n  \"rays\": {\"primary\": %llu, \"shadow\": %llu, \"reflected\": %llu, \"refracted\": %llu}\n}\n",
+                  "\n  ],\n  \"rays\": {\"primary\": %llu, \"shadow\": %llu, \"reflected\": %llu, \"refracted\": %llu}",
                   (unsigned long long)counts.primary, (unsigned long long)counts.shadow,
                   (unsigned long long)counts.reflected, (unsigned long long)counts.refracted);
     out += buf;
+    if (adaptive) {
+        const AdaptivePhases& p = adaptive->seconds;
+        std::snprintf(buf, sizeof buf,
+                      ",\n  \"adaptive\": {\"mean_spp\": %.6f, \"cap\": %d, \"rounds\": %d, \"estimated_rmse\": %.6g, "
+                      "\"time_limited\": %s, \"wall_seconds\": {\"corners\": %.6f, \"neighbour_rule\": %.6f, "
+                      "\"rounds\": %.6f, \"final_pass\": %.6f}}",
+                      adaptive->mean_spp, adaptive->cap, adaptive->rounds, adaptive->estimated_rmse,
+                      adaptive->time_limited ? "true" : "false", p.corners, p.neighbour_rule, p.rounds, p.final_pass);
+        out += buf;
+    }
+    out += "\n}\n";
     return out;
 }
 

@@ -2,11 +2,13 @@
 // Per-stage throughput figures of the stream engine (streamrt --profile).
 #include <array>
 #include <chrono>
+#include <optional>
 #include <ctime>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "render/adaptive.h"
 #include "render/render_stats.h"
 
 namespace streamrt {
@@ -60,6 +62,8 @@ struct StreamProfile {
     std::string isa;
     int lanes = 0;
     std::vector<std::string> built;  ///< the stages and kernels this scene's pipeline has
+    /// A whole-image adaptive render's outcome and phases (set by the front end after it).
+    std::optional<AdaptiveSummary> adaptive;
     StreamProfile& operator+=(const StreamProfile& o) {
         for (int i = 0; i < kStageCount; ++i) stages[std::size_t(i)] += o.stages[std::size_t(i)];
         if (generations.size() < o.generations.size()) generations.resize(o.generations.size());

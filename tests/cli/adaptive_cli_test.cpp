@@ -2,7 +2,9 @@
 // closing line, the sample map file, the scene key and every refusal as one line.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <set>
 
 #include "cli/cli_support.h"
@@ -42,6 +44,38 @@ TEST_CASE("cli adaptive: --adaptive renders, states its samples and error, write
     for (const float c : counts) CHECK((c == 4.f || c == 8.f || c == 16.f));
     CHECK(counts.count(4.f) == 1);
     CHECK(counts.size() >= 2);
+}
+
+TEST_CASE("cli adaptive: --profile states the samples, rounds and wall time by phase, in text and JSON") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", kScene), json = d.path / "p.json";
+    const Run r = run_streamrt("-j2 " + q(scene) + " -o " + q(d.path / "a.pfm") + " --spp 16 --adaptive 0.01 --profile " +
+                               "--profile-json " + q(json) + " --aov samples=" + q(d.path / "n.pfm"));
+    REQUIRE(r.code == 0);
+    INFO(r.out);
+    // The profile's mean is the closing line's; the rounds are the corners, then 4 and 8 more
+    // samples: 3 when some pixel reaches the cap of 16 (the sample map says whether one did).
+    const std::size_t closing = r.out.find(", spp ");
+    REQUIRE(closing != std::string::npos);
+    const std::string mean = r.out.substr(closing + 6, r.out.find(' ', closing + 6) - closing - 6);
+    const streamrt::Framebuffer map = streamrt::read_image((d.path / "n.pfm").string());
+    float most = 0;
+    for (int y = 0; y < 30; ++y)
+        for (int x = 0; x < 40; ++x) most = std::max(most, map.pixel(x, y)[0]);
+    REQUIRE(most == 16.f);
+    CHECK(r.out.find("adaptive: " + mean + " samples per pixel (at most 16), 3 round(s), estimated error ") !=
+          std::string::npos);
+    CHECK(r.out.find("; wall s: corners ") != std::string::npos);
+    const std::string j = slurp(json);
+    const std::size_t spp_at = j.find("\"adaptive\": {\"mean_spp\": ");
+    REQUIRE(spp_at != std::string::npos);
+    CHECK(std::stod(j.substr(j.find(": ", spp_at + 13) + 2)) == doctest::Approx(std::stod(mean)).epsilon(0.001));
+    CHECK(j.find("\"cap\": 16, \"rounds\": 3,") != std::string::npos);
+    for (const char* phase : {"corners", "neighbour_rule", "rounds", "final_pass"}) {
+        const std::size_t at = j.find("\"" + std::string(phase) + "\": ", j.find("\"wall_seconds\""));
+        REQUIRE(at != std::string::npos);
+        CHECK(std::stod(j.substr(j.find(": ", at) + 2)) >= 0.0);
+    }
 }
 
 TEST_CASE("cli adaptive: the scene's image adaptive= key, and spp 1 takes the default cap 64") {
