@@ -87,6 +87,31 @@ void tally_corners(const float* rgb, const Tile& corners, TileTallies& t) {
                 corner_tally(rgb, row, std::size_t(y - corners.y0) * row + std::size_t(x - corners.x0));
 }
 
+/// The neighbour rule's flags (AdaptiveRule::above) of the pixels of `tile` from their corners
+/// alone, into `above` (the whole image's flags, row by row): the tallies corner_tally would
+/// make, without their colour, and each corner's luminance computed once for the tile instead
+/// of once for each of the four pixels it bounds. `rgb`: the (w + 1) x (h + 1) corner lattice.
+void corner_flags(const AdaptiveRule& rule, const float* rgb, int w, const Tile& tile, std::uint8_t* above) {
+    const std::size_t row = std::size_t(w) + 1, n = std::size_t(tile.width()) + 1;
+    double rows[2][kTileSize + 1];
+    const auto luminances = [&](int y, double* out) {
+        const float* c = rgb + (std::size_t(y) * row + std::size_t(tile.x0)) * 3;
+        for (std::size_t k = 0; k < n; ++k, c += 3) out[k] = luminance(c[0], c[1], c[2]);
+    };
+    double *top = rows[0], *bottom = rows[1];
+    luminances(tile.y0, top);
+    for (int y = tile.y0; y < tile.y1; ++y) {
+        luminances(y + 1, bottom);
+        std::uint8_t* out = above + std::size_t(y) * std::size_t(w) + std::size_t(tile.x0);
+        for (std::size_t x = 0; x + 1 < n; ++x) {
+            PixelTally p;  // corner_tally's order: top left, top right, bottom left, bottom right
+            for (const double v : {top[x], top[x + 1], bottom[x], bottom[x + 1]}) p.add_corner_luminance(v);
+            out[x] = rule.above(p);
+        }
+        std::swap(top, bottom);
+    }
+}
+
 /// Whether each tally's error is above its stopping point (AdaptiveRule::above), in order.
 void mark_above(const AdaptiveRule& rule, const std::vector<PixelTally>& tallies, std::uint8_t* above) {
     for (std::size_t i = 0; i < tallies.size(); ++i) above[i] = rule.above(tallies[i]);
@@ -276,6 +301,10 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
             // image of bytes, then each tile's pixels look at their eight neighbours there.
             std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>> above_image(std::size_t(w) * std::size_t(h));  // every pixel written
             par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
+                if (corners_first) {  // every pixel still stands at its corners
+                    corner_flags(prepared.adaptive, corner_rgb.data(), w, tiles[i].tile, above_image.data());
+                    return;
+                }
                 for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int x, int y, const PixelTally& p) {
                     above_image[std::size_t(y) * std::size_t(w) + std::size_t(x)] = prepared.adaptive.above(p);
                 });
@@ -290,6 +319,8 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                 static thread_local std::vector<std::uint8_t> near;
                 near.resize(std::size_t(t.tile.width()) * std::size_t(t.tile.height()));
                 mark_spread({0, 0, w, h}, above_image.data(), t.tile, near);
+                const std::size_t taking = std::size_t(std::count_if(near.begin(), near.end(), [](std::uint8_t v) { return v != 0; }));
+                t.tallies.reserve(taking), t.pixel.reserve(taking), t.spread_near.reserve(taking);
                 const std::size_t row = std::size_t(w) + 1;
                 std::uint32_t p = 0;
                 for (int y = t.tile.y0; y < t.tile.y1; ++y)

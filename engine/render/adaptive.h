@@ -74,7 +74,13 @@ struct PixelTally {
     /// A sample at one of the pixel's corners (the corner round), weighted kCornerWeight.
     void add_corner(float sr, float sg, float sb) {
         r += kCornerWeight * sr, g += kCornerWeight * sg, b += kCornerWeight * sb;
-        corner_y += add_luminance(luminance(sr, sg, sb));
+        add_corner_luminance(luminance(sr, sg, sb));
+    }
+    /// add_corner's part that the error estimate reads, from the corner's luminance y: a
+    /// tally of corners made this way gives the same above() and standard_error() as one
+    /// made by add_corner, without its colour.
+    void add_corner_luminance(double y) {
+        corner_y += add_luminance(y);
         ++corners;
     }
     /// The weight in the pixel's mean of its first `count` samples (the corners come first).
