@@ -206,6 +206,32 @@ TEST_CASE("adaptive: the image's estimate compares a pixel's last round with the
     CHECK(edge.image_error_squared() == doctest::Approx(edge.standard_error() * edge.standard_error()).epsilon(1e-12));
 }
 
+TEST_CASE("adaptive: a tally of corners from their luminance alone has add_corner's spread, to the bit") {
+    // The neighbour rule's fast pass (driver/adaptive_render.cpp, corner_flags) builds its
+    // tallies this way: above() must not tell them apart.
+    const float c[4][3] = {{0.9f, 0.1f, 0.3f}, {0.25f, 0.5f, 0.125f}, {0.0f, 0.0f, 0.0f}, {1.5f, 0.75f, 0.3f}};
+    PixelTally full, fast;
+    for (const auto& k : c) {
+        full.add_corner(k[0], k[1], k[2]);
+        fast.add_corner_luminance(luminance(k[0], k[1], k[2]));
+    }
+    CHECK(fast.n == 4);
+    CHECK(fast.corners == 4);
+    CHECK(fast.shift == full.shift);
+    CHECK(fast.sum_y == full.sum_y);
+    CHECK(fast.sum_yy == full.sum_yy);
+    CHECK(fast.corner_y == full.corner_y);
+    // Luminances 0.28452, 0.419775, 0, 0.87696: standard error 0.18283 (worked out by hand),
+    // so a pixel of 4 samples stops at T (4 / 16)^(3/4) = 0.35355 T for T >= 0.5171.
+    CHECK(fast.standard_error() == doctest::Approx(0.18283).epsilon(1e-4));
+    CHECK(fast.standard_error() == full.standard_error());
+    CHECK(AdaptiveRule{0.51, 64}.above(fast));
+    CHECK(AdaptiveRule{0.51, 64}.above(full));
+    CHECK_FALSE(AdaptiveRule{0.52, 64}.above(fast));
+    CHECK_FALSE(AdaptiveRule{0.52, 64}.above(full));
+    CHECK(fast.r == 0.0);  // no colour: the rule does not need it
+}
+
 TEST_CASE("adaptive: a pixel's four corners weigh as one of its own samples in its mean and its estimate") {
     REQUIRE(kCornerWeight == 0.25);
     // Corners of grey 0 (an edge along the pixel's border), then four samples of its own of 1.
