@@ -174,14 +174,22 @@ Result make_result(RenderResult&& r, const RenderJob& job, EngineKind engine, do
     out.rays["reflected"] = r.counts.reflected;
     out.rays["refracted"] = r.counts.refracted;
     out.rays["total"] = r.counts.total();
-    if (job.profile && engine == EngineKind::Stream)
+    if (job.profile && engine == EngineKind::Stream) {
+        job.profile->adaptive = r.adaptive;  // as the command line's profile
         out.profile = py::module_::import("json").attr("loads")(job.profile->json());
+    }
     if (r.adaptive) {
         py::dict a;
         a["mean_spp"] = r.adaptive->mean_spp;
         a["estimated_rmse"] = r.adaptive->estimated_rmse;
         a["rounds"] = r.adaptive->rounds;
         a["time_limited"] = r.adaptive->time_limited;
+        py::dict phases;  // wall seconds, as --profile reports them
+        phases["corners"] = r.adaptive->seconds.corners;
+        phases["neighbour_rule"] = r.adaptive->seconds.neighbour_rule;
+        phases["rounds"] = r.adaptive->seconds.rounds;
+        phases["final_pass"] = r.adaptive->seconds.final_pass;
+        a["seconds"] = phases;
         a["sample_map"] = to_array(std::move(r.sample_map));
         out.adaptive = a;
     }

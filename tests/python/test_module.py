@@ -79,6 +79,13 @@ def test_adaptive_result_carries_the_sample_map_of_the_command_line():
     corners, later = 49 * 33, int((counts - 4).sum())
     assert r.rays["primary"] == corners + later
     assert r.adaptive["mean_spp"] == pytest.approx((corners + later) / (48 * 32))
+    # Rounds: the corners, then 4, 8 more samples; 3 since some pixel took 16.
+    assert counts.max() == 16.0 and r.adaptive["rounds"] == 3
+    assert set(r.adaptive["seconds"]) == {"corners", "neighbour_rule", "rounds", "final_pass"}
+    assert all(v >= 0 for v in r.adaptive["seconds"].values())
+    p = streamrt.render(WHITTED, width=48, height=32, spp=16, adaptive=0.01, profile=True).profile
+    assert p["adaptive"]["rounds"] == 3 and p["adaptive"]["cap"] == 16
+    assert p["adaptive"]["mean_spp"] == pytest.approx(r.adaptive["mean_spp"], abs=1e-6)
     assert streamrt.render(WHITTED, width=48, height=32, spp=16).adaptive is None
 
 
