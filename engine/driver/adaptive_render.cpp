@@ -315,7 +315,8 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
         if (r == 1) {
             // The neighbour rule reads round 0 across tiles: each pixel's above-T flag, in an
             // image of bytes, then each tile's pixels look at their eight neighbours there.
-            std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>> above_image(std::size_t(w) * std::size_t(h));  // every pixel written
+            // Not zero-filled: every pixel's flag is written below.
+            std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>> above_image(std::size_t(w) * std::size_t(h));
             par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
                 if (corners_first) {  // every pixel still stands at its corners
                     corner_flags(prepared.adaptive, corner_rgb.data(), w, tiles[i].tile, above_image.data());
