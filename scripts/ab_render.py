@@ -28,8 +28,8 @@ import tempfile
 import time
 
 
-def streamrt(binary, scene, args, out, *extra):
-    """Runs one render with the options asked for; its output (stdout and stderr)."""
+def command(binary, scene, args, out, *extra):
+    """The streamrt command line of one render with the options asked for."""
     cmd = [binary, "-j%d" % args.jobs, *extra, scene, "-o", out]
     if args.adaptive:
         cmd += ["--adaptive", str(args.adaptive)]
@@ -38,7 +38,12 @@ def streamrt(binary, scene, args, out, *extra):
         cmd += ["--width", w, "--height", h]
     if args.spp:
         cmd += ["--spp", str(args.spp)]
-    r = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    return cmd
+
+
+def streamrt(binary, scene, args, out, *extra):
+    """Runs one render with the options asked for; its output (stdout and stderr)."""
+    r = subprocess.run(command(binary, scene, args, out, *extra), capture_output=True, text=True, check=True)
     return r.stdout + r.stderr
 
 
@@ -52,21 +57,15 @@ def render_seconds(binary, scene, args, out):
 
 def whole_process(binary, scene, args, out):
     """Wall seconds and peak RSS (MiB) of one whole streamrt process, as its parent sees them."""
-    cmd = [binary, "-j%d" % args.jobs, "-q", scene, "-o", out]
-    if args.size:
-        w, h = args.size.split("x")
-        cmd += ["--width", w, "--height", h]
-    if args.spp:
-        cmd += ["--spp", str(args.spp)]
-    if args.adaptive:
-        cmd += ["--adaptive", str(args.adaptive)]
-    t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, ru = os.wait4(p.pid, 0)  # this child's own rusage: its peak RSS
-    wall = time.perf_counter() - t0
-    if os.waitstatus_to_exitcode(status) != 0:
-        sys.exit("%s failed: %s" % (" ".join(cmd), p.stderr.read().decode().strip()))
-    p.stderr.close()
+    cmd = command(binary, scene, args, out, "-q")
+    with tempfile.TemporaryFile() as err:
+        t0 = time.perf_counter()
+        p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
+        _, status, ru = os.wait4(p.pid, 0)  # this child's own rusage: its peak RSS
+        wall = time.perf_counter() - t0
+        if os.waitstatus_to_exitcode(status) != 0:
+            err.seek(0)
+            sys.exit("%s failed: %s" % (" ".join(cmd), err.read().decode().strip()))
     return wall, ru.ru_maxrss / 1024.0
 
 

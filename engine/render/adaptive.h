@@ -183,7 +183,6 @@ struct AdaptiveRule {
     }
 };
 
-/// An adaptive render's outcome, for the closing line and the profile.
 /// Where a whole-image adaptive render spent its wall time (driver/adaptive_render.cpp), for
 /// --profile: the corner round, the neighbour rule (each pixel's corners against T, then its
 /// eight neighbours'), the later rounds, and the final pass (means, sample map, error).
@@ -191,6 +190,7 @@ struct AdaptivePhases {
     double corners = 0, neighbour_rule = 0, rounds = 0, final_pass = 0;
 };
 
+/// An adaptive render's outcome, for the closing line and the profile.
 struct AdaptiveSummary {
     double mean_spp = 0;        ///< samples taken per pixel, on average
     double estimated_rmse = 0;  ///< sqrt(mean of the pixels' image_error_squared()), luminance

@@ -2,9 +2,9 @@
 // Per-stage throughput figures of the stream engine (streamrt --profile).
 #include <array>
 #include <chrono>
-#include <optional>
 #include <ctime>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
