@@ -27,7 +27,7 @@ if [[ $target == ply || $target == obj ]]; then
   if ((rebuild)); then
     echo "fuzz.sh: building $bin with $CXX"
     "$CXX" -std=c++20 -O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer,address,undefined \
-      -fno-sanitize-recover=undefined -Iengine "${reader_sources[@]}" -ltinyobjloader -ltbb -o "$bin"
+      -fno-sanitize-recover=undefined -Iengine "${reader_sources[@]}" -ltinyobjloader -ltbb -lz -o "$bin"
   fi
   cp -n tests/fuzz/${target}_corpus/* "$out/${target}_corpus/" 2>/dev/null || true
   exec "$bin" "$out/${target}_corpus" -max_total_time="$seconds" -max_len=4096 -timeout=10 -rss_limit_mb=2048 \

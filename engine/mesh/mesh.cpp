@@ -12,9 +12,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "core/mapped_file.h"
 #include "core/srgb.h"
 #include "core/vec3.h"
+#include "mesh/mesh_bytes.h"
 #include "mesh/obj_reader.h"
 #include "parallel/parallelism.h"
 
@@ -189,8 +189,7 @@ std::shared_ptr<const Mesh> build_checked(const std::string& path, const std::ve
 }  // namespace
 
 std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv, bool with_colors) {
-    MappedFile file;
-    if (!file.open(path)) throw std::runtime_error("cannot open mesh file");
+    const MeshBytes file(path);  // mapped, or inflated from a .gz file
     ObjData d = parse_obj(file.text(), path, {.keep_uv = with_uv, .keep_colors = with_colors});
     std::vector<float> corner_uv;
     if (with_uv) {
@@ -210,8 +209,7 @@ std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv,
 }
 
 ObjModel load_obj_model(const std::string& path, bool with_uv) {
-    MappedFile file;
-    if (!file.open(path)) throw std::runtime_error("cannot open mesh file");
+    const MeshBytes file(path);  // mapped, or inflated from a .gz file
     const ObjData d = parse_obj(file.text(), path, {.keep_uv = true});
     ObjModel model;
     // The library (tinyobjloader reads MTL files): the materials in file order, their numbers by name.

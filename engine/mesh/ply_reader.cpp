@@ -11,8 +11,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/error.h"
 #include "core/srgb.h"
 #include "mesh/mesh.h"
+#include "mesh/mesh_bytes.h"
 
 namespace streamrt {
 
@@ -71,12 +73,6 @@ struct PlyHeader {
     throw std::runtime_error(name + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " + message);
 }
 
-std::string quoted(std::string_view s) {
-    std::string q(1, '\'');
-    q.append(s);
-    q.push_back('\'');
-    return q;
-}
 
 bool is_index_list(const PlyElement& e, const PlyProperty& p) {
     return e.name == "face" && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
@@ -134,7 +130,7 @@ PlyHeader parse_header(std::string_view bytes, const std::string& name) {
         };
         const auto expect_words = [&](std::size_t n, const char* form) {
             if (words.size() < n) fail(words.size(), std::string("expected ") + form);
-            if (words.size() > n) fail(n, "unexpected " + quoted(words[n].text) + " after " + form);
+            if (words.size() > n) fail(n, "unexpected " + quote(words[n].text) + " after " + form);
         };
         if (line == 1) {
             if (words.size() != 1 || words[0].text != "ply") fail(0, "not a PLY file (the first line must be 'ply')");
@@ -149,12 +145,12 @@ PlyHeader parse_header(std::string_view bytes, const std::string& name) {
             if (words[1].text == "ascii") h.format = PlyFormat::Ascii;
             else if (words[1].text == "binary_little_endian") h.format = PlyFormat::BinaryLittle;
             else if (words[1].text == "binary_big_endian") h.format = PlyFormat::BinaryBig;
-            else fail(1, "unknown PLY format " + quoted(words[1].text));
-            if (words[2].text != "1.0") fail(2, "unsupported PLY version " + quoted(words[2].text) + " (1.0 is read)");
+            else fail(1, "unknown PLY format " + quote(words[1].text));
+            if (words[2].text != "1.0") fail(2, "unsupported PLY version " + quote(words[2].text) + " (1.0 is read)");
             have_format = true;
             continue;
         }
-        if (!have_format) fail(0, "expected 'format' before " + quoted(key));
+        if (!have_format) fail(0, "expected 'format' before " + quote(key));
         if (key == "element") {
             expect_words(3, "'element <name> <count>'");
             PlyElement e;
@@ -162,9 +158,9 @@ PlyHeader parse_header(std::string_view bytes, const std::string& name) {
             const std::string_view c = words[2].text;
             const auto [ptr, ec] = std::from_chars(c.data(), c.data() + c.size(), e.count);
             if (ec != std::errc() || ptr != c.data() + c.size())
-                fail(2, "expected a count of items (0 or more), got " + quoted(c));
+                fail(2, "expected a count of items (0 or more), got " + quote(c));
             for (const PlyElement& o : h.elements)
-                if (o.name == e.name) fail(1, "a second element " + quoted(e.name));
+                if (o.name == e.name) fail(1, "a second element " + quote(e.name));
             e.line = line, e.col = words[0].col;
             e.count_line = line, e.count_col = words[2].col;
             h.elements.push_back(std::move(e));
@@ -178,23 +174,23 @@ PlyHeader parse_header(std::string_view bytes, const std::string& name) {
                 expect_words(5, "'property list <count type> <item type> <name>'");
                 p.is_list = true;
                 p.count_type = ply_type(words[2].text);
-                if (p.count_type.size == 0) fail(2, "unknown property type " + quoted(words[2].text));
-                if (p.count_type.is_float) fail(2, "a list's count type must be an integer type, got " + quoted(words[2].text));
+                if (p.count_type.size == 0) fail(2, "unknown property type " + quote(words[2].text));
+                if (p.count_type.is_float) fail(2, "a list's count type must be an integer type, got " + quote(words[2].text));
                 w = 3;
             } else {
                 expect_words(3, "'property <type> <name>'");
             }
             p.type = ply_type(words[w].text);
-            if (p.type.size == 0) fail(w, "unknown property type " + quoted(words[w].text));
+            if (p.type.size == 0) fail(w, "unknown property type " + quote(words[w].text));
             p.name = std::string(words[w + 1].text);
             PlyElement& e = h.elements.back();
             for (const PlyProperty& o : e.props)
-                if (o.name == p.name) fail(w + 1, "a second property " + quoted(p.name) + " in element " + quoted(e.name));
+                if (o.name == p.name) fail(w + 1, "a second property " + quote(p.name) + " in element " + quote(e.name));
             const bool position = e.name == "vertex" && (p.name == "x" || p.name == "y" || p.name == "z");
-            if (position && p.is_list) fail(w + 1, "vertex property " + quoted(p.name) + " must be a number, not a list");
+            if (position && p.is_list) fail(w + 1, "vertex property " + quote(p.name) + " must be a number, not a list");
             const bool indices = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
-            if (indices && !p.is_list) fail(w + 1, quoted(p.name) + " must be a list ('property list uchar int " + p.name + "')");
-            if (indices && p.type.is_float) fail(w, "vertex indices must have an integer type, got " + quoted(words[w].text));
+            if (indices && !p.is_list) fail(w + 1, quote(p.name) + " must be a list ('property list uchar int " + p.name + "')");
+            if (indices && p.type.is_float) fail(w, "vertex indices must have an integer type, got " + quote(words[w].text));
             e.props.push_back(std::move(p));
             continue;
         }
@@ -204,7 +200,7 @@ PlyHeader parse_header(std::string_view bytes, const std::string& name) {
             h.body_line = line + 1;
             break;
         }
-        fail(0, "unexpected " + quoted(key) + " in the PLY header");
+        fail(0, "unexpected " + quote(key) + " in the PLY header");
     }
     const auto has = [](const PlyElement& e, std::initializer_list<const char*> names) {
         for (const PlyProperty& p : e.props)
@@ -234,7 +230,7 @@ PlyHeader parse_header(std::string_view bytes, const std::string& name) {
         const std::uint64_t room = ascii ? body_bytes + 1 : body_bytes;  // the last ASCII value needs no separator
         if (item > 0 && (e.count > (room - std::min(room, needed)) / item))
             fail_at(name, e.count_line, e.count_col,
-                    "element " + quoted(e.name) + " declares " + std::to_string(e.count) + " items, more than the " +
+                    "element " + quote(e.name) + " declares " + std::to_string(e.count) + " items, more than the " +
                         std::to_string(body_bytes) + " bytes after the header can hold");
         needed += e.count * item;
     }
@@ -256,10 +252,10 @@ public:
         std::int64_t v = 0;
         const auto [ptr, ec] = std::from_chars(w.data(), w.data() + w.size(), v);
         if (ec != std::errc() || ptr != w.data() + w.size())
-            fail("expected an integer (" + std::string(t.name) + "), got " + quoted(w));
+            fail("expected an integer (" + std::string(t.name) + "), got " + quote(w));
         const std::int64_t lo = t.is_signed ? -(std::int64_t(1) << (8 * t.size - 1)) : 0;
         const std::int64_t hi = t.is_signed ? (std::int64_t(1) << (8 * t.size - 1)) - 1 : (std::int64_t(1) << (8 * t.size)) - 1;
-        if (v < lo || v > hi) fail(quoted(w) + " is out of range for " + t.name);
+        if (v < lo || v > hi) fail(quote(w) + " is out of range for " + t.name);
         return v;
     }
     double read_number(const PlyType& t) {
@@ -267,7 +263,7 @@ public:
         const std::string_view w = word();
         double v = 0;
         const auto [ptr, ec] = std::from_chars(w.data(), w.data() + w.size(), v);
-        if (ec != std::errc() || ptr != w.data() + w.size()) fail("expected a number (" + std::string(t.name) + "), got " + quoted(w));
+        if (ec != std::errc() || ptr != w.data() + w.size()) fail("expected a number (" + std::string(t.name) + "), got " + quote(w));
         return v;
     }
     void skip(const PlyType& t) { read_number(t); }
@@ -285,7 +281,7 @@ private:
         }
         word_line_ = line_, word_col_ = int(pos_ - line_start_ + 1);
         if (pos_ >= bytes_.size())
-            fail("file ends inside element " + quoted(*element_) + " item " + std::to_string(item_));
+            fail("file ends inside element " + quote(*element_) + " item " + std::to_string(item_));
         const std::size_t start = pos_;
         while (pos_ < bytes_.size() && !is_space(bytes_[pos_])) ++pos_;
         return bytes_.substr(start, pos_ - start);
@@ -502,11 +498,8 @@ PlyData parse_ply(std::string_view bytes, const std::string& name, const PlyRead
 }
 
 std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv, bool with_colors) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error("cannot open mesh file");
-    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    if (in.bad()) throw std::runtime_error("cannot read mesh file");
-    const PlyData data = parse_ply(bytes, path, {.keep_uv = with_uv, .keep_colors = with_colors});
+    const MeshBytes bytes(path);  // mapped, or inflated from a .gz file
+    const PlyData data = parse_ply(bytes.text(), path, {.keep_uv = with_uv, .keep_colors = with_colors});
     const std::size_t faces = data.triangles.size() / 3;
     std::vector<float> corner_uv;
     if (with_uv) {
@@ -534,7 +527,8 @@ std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv,
     return mesh;
 }
 
-bool is_ply_path(const std::string& path) {
+bool is_ply_path(const std::string& gz_path) {
+    const std::string path = without_gzip_suffix(gz_path);
     if (path.size() < 4) return false;
     std::string ext = path.substr(path.size() - 4);
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
