@@ -131,4 +131,12 @@ TEST_CASE("gzip: errors at the inflated text's line and column, and corrupt, tru
     CHECK(error_of([&] { inflate_gzip(good, 20); })
               .rfind("gzip data inflates to more than 20 bytes (half this machine's memory) at byte ", 0) == 0);
     CHECK(inflate_gzip(good, 4096).size() == std::string(kObj).size());
+    // In a scene: one line, the statement's path column first, then the reader's reason.
+    d.write("t.obj.gz", good.substr(0, good.size() - 6));
+    const std::string scene = (d.path / "s.cfg").string();
+    const std::string e = error_of([&] { parse_scene("sphere\nmesh file=t.obj.gz\n", scene); });
+    CHECK(e.rfind(scene + ":2:11: ", 0) == 0);
+    CHECK(e.find("gzip data ends early (a truncated file?) at byte " + std::to_string(good.size() - 6)) !=
+          std::string::npos);
+    CHECK(e.find('\n') == std::string::npos);
 }
