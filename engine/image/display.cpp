@@ -15,7 +15,6 @@ using image_detail::for_each;
 
 double srgb_oetf(double c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055; }
 
-
 Framebuffer calibrate(const Framebuffer& fb, Calibration how) {
     Framebuffer out = fb;
     float scale = 1.f;

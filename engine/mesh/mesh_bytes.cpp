@@ -82,11 +82,11 @@ InflatedBytes inflate_gzip(std::string_view in, std::size_t limit) {
     return out;
 }
 
-MeshBytes::MeshBytes(const std::string& path, std::size_t limit) {
+MeshBytes::MeshBytes(const std::string& path) {
     file_.emplace();
     if (!file_->open(path)) throw std::runtime_error("cannot open mesh file");
     if (is_gzip_path(path)) {
-        inflated_ = inflate_gzip(file_->text(), limit > 0 ? limit : default_limit());
+        inflated_ = inflate_gzip(file_->text(), default_limit());
         file_.reset();  // the compressed bytes are no longer needed
     }
 }

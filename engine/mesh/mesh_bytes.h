@@ -27,9 +27,9 @@ class MeshBytes {
   public:
     /// Opens `path` (throws std::runtime_error "cannot open mesh file" when it cannot), and
     /// inflates it when is_gzip_path(path): std::runtime_error on corrupt or truncated data,
-    /// with the compressed byte where it stopped, or when it would inflate to more than
-    /// `limit` bytes (default: half this machine's memory).
-    explicit MeshBytes(const std::string& path, std::size_t limit = 0);
+    /// with the compressed byte where it stopped, or when it would inflate to more than half
+    /// this machine's memory.
+    explicit MeshBytes(const std::string& path);
     std::string_view text() const {
         return file_ ? file_->text() : std::string_view(inflated_.data(), inflated_.size());
     }

@@ -5,8 +5,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -72,7 +70,6 @@ struct PlyHeader {
 [[noreturn]] void fail_at(const std::string& name, int line, int col, const std::string& message) {
     throw std::runtime_error(name + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " + message);
 }
-
 
 bool is_index_list(const PlyElement& e, const PlyProperty& p) {
     return e.name == "face" && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
@@ -357,7 +354,8 @@ private:
 
 /// A vertex colour component as linear light: an integer type holds an sRGB code (0 - 255 for
 /// uchar, 0 - 65535 for ushort: the full range of its type is white), a float type a linear
-/// value, as written. Negative or non-finite values are errors.
+/// value, as written. Negative or non-finite values are errors (an integer word outside its
+/// type was refused when read).
 template <class Body>
 float linear_color(Body& body, double value, const PlyType& t) {
     if (!std::isfinite(value) || value < 0.0) body.fail("vertex colour " + std::to_string(value) + " is not a finite value >= 0");

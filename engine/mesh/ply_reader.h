@@ -48,11 +48,12 @@ PlyData parse_ply(std::string_view bytes, const std::string& name, const PlyRead
 /// the vertices' red green blue (MeshView::vertex_colors), and refuses a file without them.
 std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv = false, bool with_colors = false);
 
-/// The mesh of a file by its extension: `.ply` (any case) with load_ply_mesh, anything else
-/// as a Wavefront OBJ file (load_obj_mesh); `with_uv` and `with_colors` as for those.
+/// The mesh of a file by its extension: `.ply` or `.ply.gz` (any case) with load_ply_mesh,
+/// anything else as a Wavefront OBJ file (load_obj_mesh; `.gz` files inflated first,
+/// mesh/mesh_bytes.h); `with_uv` and `with_colors` as for those.
 std::shared_ptr<const Mesh> load_mesh_file(const std::string& path, bool with_uv, bool with_colors = false);
 
-/// True when `path` names a PLY file (extension `.ply`, any case).
+/// True when `path` names a PLY file (extension `.ply`, or `.ply.gz` compressed; any case).
 bool is_ply_path(const std::string& path);
 
 }  // namespace streamrt

@@ -8,12 +8,12 @@
 #include <exception>
 #include <filesystem>
 #include <map>
-#include <tuple>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 #include <vector>

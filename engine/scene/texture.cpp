@@ -1,7 +1,6 @@
 #include "scene/texture.h"
 
-#include <array>
-#include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>

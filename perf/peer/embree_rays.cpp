@@ -254,7 +254,10 @@ int main(int argc, char** argv) {
             if (q != "medium" && q != "high") return std::fprintf(stderr, "--quality: medium or high\n"), 2;
             quality = q == "high" ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
         } else if (a == "--rays" && i + 1 < argc) {
-            only = "," + std::string(argv[++i]) + ",";
+            // Appended piece by piece: GCC 12's -Wrestrict misreads "," + std::string(...) + ",".
+            only = ",";
+            only += argv[++i];
+            only += ",";
         } else if (a == "--shuffle") {
             shuffle = true;
         } else if (a == "--spheres" && i + 1 < argc) {

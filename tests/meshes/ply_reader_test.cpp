@@ -444,6 +444,14 @@ TEST_CASE("ply: vertex colours, 8-bit and 16-bit sRGB codes or linear floats, re
     CHECK(error_of(head + "property float red\nproperty float green\nproperty float blue\n" + faces +
                    "0 0 0 0 -0.5 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n") ==
           "t.ply:13:14: vertex colour -0.500000 is not a finite value >= 0");
+    // A colour code past its type, or not whole, is refused where it is written.
+    const std::string uchar_rgb = head + "property uchar red\nproperty uchar green\nproperty uchar blue\n" + faces;
+    CHECK(error_of(uchar_rgb + "0 0 0 0 300 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n") ==
+          "t.ply:13:9: '300' is out of range for uchar");
+    CHECK(error_of(uchar_rgb + "0 0 0 0 0 0\n1 0 0 12.5 0 0\n0 1 0 0 0 0\n3 0 1 2\n") ==
+          "t.ply:14:7: expected an integer (uchar), got '12.5'");
+    CHECK(error_of(uchar_rgb + "0 0 0 1e30 0 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n3 0 1 2\n") ==
+          "t.ply:13:7: expected an integer (uchar), got '1e30'");
 }
 
 TEST_CASE("ply: vertex_colors=true renders a mesh's interpolated vertex colours, in both engines") {
