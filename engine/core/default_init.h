@@ -3,6 +3,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/memory_advice.h"
 #include "simd/lanes.h"
 
 namespace streamrt {
@@ -37,5 +38,10 @@ using FillLaterVec = std::vector<T, DefaultInitAllocator<T>>;
 /// The same, aligned as simd::AlignedVec.
 template <class T>
 using AlignedFillLaterVec = std::vector<T, DefaultInitAllocator<T, xsimd::aligned_allocator<T, simd::kAlign>>>;
+
+/// The same, in huge pages once it reaches 1 MiB (HugePageAllocator): images and other
+/// large buffers filled right after they are made.
+template <class T>
+using LargeFillLaterVec = std::vector<T, DefaultInitAllocator<T, HugePageAllocator<T>>>;
 
 }  // namespace streamrt

@@ -3,7 +3,11 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <limits>
+#include <new>
 
 namespace streamrt {
 
@@ -27,5 +31,42 @@ template <class T>
 inline void want_huge_pages(const T* begin, std::size_t count) {
     advise_inside(begin, begin + count, MADV_HUGEPAGE, std::uintptr_t(2) << 20);
 }
+
+/// An allocator for arrays that may be large and are written soon after they are made (a
+/// framebuffer, an encoder's buffers): from 1 MiB an array gets whole 2 MiB blocks, aligned
+/// to 2 MiB and advised as huge pages; below, 64-byte-aligned memory from operator new. First
+/// writes to fresh memory are what such an array costs on a virtual machine (about 2 - 3 us a
+/// 4 KiB page here, docs/performance.md "Fresh memory"); a huge page is one fault and one
+/// clear. At most one partial block is left unused per array, and its tail is not touched.
+template <class T>
+struct HugePageAllocator {
+    using value_type = T;
+    static constexpr std::size_t kBlock = std::size_t(2) << 20;
+    static constexpr std::size_t kHugeFrom = std::size_t(1) << 20;  ///< bytes from which blocks are used
+    static constexpr std::align_val_t kSmallAlign{64};
+
+    HugePageAllocator() = default;
+    template <class U>
+    HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
+
+    T* allocate(std::size_t n) {
+        if (n > (std::numeric_limits<std::size_t>::max() - kBlock) / sizeof(T)) throw std::bad_alloc();
+        const std::size_t bytes = n * sizeof(T);
+        if (bytes < kHugeFrom) return static_cast<T*>(::operator new(bytes, kSmallAlign));
+        const std::size_t whole = (bytes + kBlock - 1) & ~(kBlock - 1);
+        void* p = std::aligned_alloc(kBlock, whole);
+        if (!p) throw std::bad_alloc();
+        ::madvise(p, whole, MADV_HUGEPAGE);  // a hint: nothing changes where huge pages are off
+        return static_cast<T*>(p);
+    }
+    void deallocate(T* p, std::size_t n) noexcept {
+        if (n * sizeof(T) < kHugeFrom) ::operator delete(p, kSmallAlign);
+        else std::free(p);
+    }
+    template <class U>
+    bool operator==(const HugePageAllocator<U>&) const noexcept {
+        return true;
+    }
+};
 
 }  // namespace streamrt

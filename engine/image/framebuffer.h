@@ -10,7 +10,7 @@ namespace streamrt {
 
 struct Framebuffer {
     int width = 0, height = 0;
-    std::vector<float, DefaultInitAllocator<float>> rgb;  ///< 3 floats per pixel, row-major from the top-left
+    LargeFillLaterVec<float> rgb;  ///< 3 floats per pixel, row-major from the top-left
 
     Framebuffer() = default;
     /// Zero-filled.

@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "core/default_init.h"
 #include "image/format_util.h"
 #include "image/image_format.h"
 #include "image/image_io.h"
@@ -56,7 +57,7 @@ struct ChunkFrame {
 // the last band finishes the stream, the others end on a sync flush (byte-aligned, not
 // final), so the pieces are independent and simply concatenate.
 struct PngBand {
-    std::vector<unsigned char> z;
+    FillLaterVec<unsigned char> z;  // deflate writes what is kept
     uLong adler = 1;
     std::size_t raw_bytes = 0;
 };
@@ -64,7 +65,7 @@ struct PngBand {
 void encode_png_band(const Framebuffer& fb, const EightBitRows& to_bytes, int y0, int y1, const PngOptions& o,
                      PngBand& band) {
     const std::size_t stride = std::size_t(fb.width) * 3;
-    std::vector<unsigned char> rows(2 * stride), filtered(std::size_t(y1 - y0) * (stride + 1));
+    FillLaterVec<unsigned char> rows(2 * stride), filtered(std::size_t(y1 - y0) * (stride + 1));  // written in full
     unsigned char *prev = rows.data(), *cur = rows.data() + stride;
     // Up reads the row above, also across the band's top edge (it is in the framebuffer).
     if (y0 > 0 && o.filter == PngFilter::Up) to_bytes(y0 - 1, prev);

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/default_init.h"
 #include "image/format_util.h"
 #include "image/image_format.h"
 
@@ -21,7 +22,7 @@ bool encode_ppm(const Framebuffer& fb, const Display& display, const ByteSink& s
     const EightBitRows to_bytes(fb, display, o.par);
     const std::string header = netpbm_header("P6", fb, "255");
     const std::size_t stride = std::size_t(fb.width) * 3, chunk = ppm_chunk_rows(fb.width);
-    std::vector<unsigned char> buf(std::min(chunk, std::size_t(fb.height)) * stride);
+    LargeFillLaterVec<unsigned char> buf(std::min(chunk, std::size_t(fb.height)) * stride);  // every byte written
     for (std::size_t y0 = 0; y0 < std::size_t(fb.height); y0 += chunk) {
         if (o.cancel && o.cancel->load()) throw Cancelled{};
         const std::size_t rows = std::min(chunk, std::size_t(fb.height) - y0);
