@@ -56,8 +56,8 @@ int run(int argc, char** argv) {
     app.add_option("--sampler", opt.sampler, "Pixel sampling: stratified, grid or random")
         ->check(CLI::IsMember(names_vector(kSamplePatternNames)));
     app.add_option("--adaptive", opt.adaptive,
-                   "Adaptive sampling: a pixel of n samples stops once the standard error of its mean luminance is "
-                   "at most T (n / 16)^(3/4) (T at 16 samples, e.g. 0.03); --spp is the most it takes (default 64)")
+                   "Adaptive sampling: a pixel of n samples stops once the standard error of its mean (RMS over R, G, "
+                   "B) is at most T (n / 16)^(3/4) (T at 16 samples, e.g. 0.03); --spp is the most it takes (default 64)")
         ->check(CLI::Range(0.0, 1.0));
     app.add_option("--target-error", opt.target_error,
                    "Adaptive sampling until the image's estimated RMSE (luminance) is at most E")

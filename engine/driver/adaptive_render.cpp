@@ -101,26 +101,19 @@ void tally_corners(const float* rgb, const Tile& corners, TileTallies& t) {
 
 /// The neighbour rule's flags (AdaptiveRule::above) of the pixels of `tile` from their corners
 /// alone, into `above` (the whole image's flags, row by row): the tallies corner_tally would
-/// make, without their colour, and each corner's luminance computed once for the tile instead
-/// of once for each of the four pixels it bounds. `rgb`: the (w + 1) x (h + 1) corner lattice.
+/// make, without their colour sums (PixelTally::add_corner_spread). `rgb`: the
+/// (w + 1) x (h + 1) corner lattice.
 void corner_flags(const AdaptiveRule& rule, const float* rgb, int w, const Tile& tile, std::uint8_t* above) {
-    const std::size_t row = std::size_t(w) + 1, n = std::size_t(tile.width()) + 1;
-    double rows[2][kTileSize + 1];
-    const auto luminances = [&](int y, double* out) {
-        const float* c = rgb + (std::size_t(y) * row + std::size_t(tile.x0)) * 3;
-        for (std::size_t k = 0; k < n; ++k, c += 3) out[k] = luminance(c[0], c[1], c[2]);
-    };
-    double *top = rows[0], *bottom = rows[1];
-    luminances(tile.y0, top);
+    const std::size_t row = std::size_t(w) + 1;
     for (int y = tile.y0; y < tile.y1; ++y) {
-        luminances(y + 1, bottom);
+        const float* top = rgb + (std::size_t(y) * row + std::size_t(tile.x0)) * 3;
+        const float* bottom = top + row * 3;
         std::uint8_t* out = above + std::size_t(y) * std::size_t(w) + std::size_t(tile.x0);
-        for (std::size_t x = 0; x + 1 < n; ++x) {
+        for (int x = 0; x < tile.width(); ++x, top += 3, bottom += 3) {
             PixelTally p;  // corner_tally's order: top left, top right, bottom left, bottom right
-            for (const double v : {top[x], top[x + 1], bottom[x], bottom[x + 1]}) p.add_corner_luminance(v);
+            for (const float* c : {top, top + 3, bottom, bottom + 3}) p.add_corner_spread(c[0], c[1], c[2]);
             out[x] = rule.above(p);
         }
-        std::swap(top, bottom);
     }
 }
 

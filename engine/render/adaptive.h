@@ -35,7 +35,7 @@ inline SampleRun adaptive_round(int r, int cap) {
     return {.first = first, .count = std::max(count, 0), .sequence = true};
 }
 
-/// Rec. 709 luminance of linear RGB: what the error estimate measures.
+/// Rec. 709 luminance of linear RGB: what the image's estimate (image_error_squared) compares.
 inline double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
 
 /// What one corner sample weighs in a pixel's mean, against 1 for a sample of the pixel's own
@@ -48,39 +48,45 @@ inline double luminance(double r, double g, double b) { return 0.2126 * r + 0.71
 /// area light's noise, which a corner averages as well as any sample) 0.117, 0.118, 0.125, 0.140.
 inline constexpr double kCornerWeight = 0.25;
 
-/// A pixel's samples so far: their colour sum (each corner weighted kCornerWeight), and the
-/// sums of their luminance and its square taken about the first sample's luminance (the
-/// shifted-data form: in a bright flat pixel the two sums stay small, so the variance is not
-/// lost to cancellation, and no division per sample). The spread and its decisions count every
-/// sample alike, corners included: a corner that disagrees is the first sign of an edge.
+/// A pixel's samples so far: their colour sum (each corner weighted kCornerWeight), and per
+/// channel the sums of the samples and of their squares taken about the first sample (the
+/// shifted-data form: in a bright flat pixel the sums stay small, so the variance is not lost
+/// to cancellation, and no division per sample). The spread is the mean of the three
+/// channels' variances, as the image's RMSE is the mean of its channels' squared errors: a
+/// spread of luminance alone did not see samples of different colour and equal luminance
+/// (the edge of a red and a green square, a coloured highlight), and such pixels stopped at
+/// their corners with an error of 0.1 - 0.2 in one channel (docs/adaptive-sampling.md,
+/// "What T means"). The spread and its decisions count every sample alike, corners included:
+/// a corner that disagrees is the first sign of an edge.
 struct PixelTally {
     double r = 0, g = 0, b = 0;  ///< colour sums, corners weighted
-    double shift = 0, sum_y = 0, sum_yy = 0;  ///< luminance sums of y - shift
-    double sum_y_before = 0;  ///< sum_y before the latest round (begin_round)
-    double corner_y = 0;      ///< the corners' share of sum_y
+    double shift[3] = {0, 0, 0};  ///< the first sample's R, G, B
+    double sum[3] = {0, 0, 0}, sum_sq[3] = {0, 0, 0};  ///< sums of c - shift and of its square, per channel
+    double sum_y_before = 0;  ///< sum_y() before the latest round (begin_round)
+    double corner_y = 0;      ///< the corners' share of sum_y()
     int n = 0;
     std::uint16_t n_before = 0;  ///< n before the latest round (at most half the cap, 32768); 0 while in the first
     std::uint16_t corners = 0;   ///< how many of the n samples are corners (add_corner): 0 or 4
 
     /// Marks the start of a round: its samples are compared with those before it
     /// (image_error_squared).
-    void begin_round() { n_before = std::uint16_t(n), sum_y_before = sum_y; }
+    void begin_round() { n_before = std::uint16_t(n), sum_y_before = sum_y(); }
 
     /// A sample of the pixel's own sequence.
     void add(float sr, float sg, float sb) {
         r += sr, g += sg, b += sb;
-        add_luminance(luminance(sr, sg, sb));
+        add_spread(sr, sg, sb);
     }
     /// A sample at one of the pixel's corners (the corner round), weighted kCornerWeight.
     void add_corner(float sr, float sg, float sb) {
         r += kCornerWeight * sr, g += kCornerWeight * sg, b += kCornerWeight * sb;
-        add_corner_luminance(luminance(sr, sg, sb));
+        add_corner_spread(sr, sg, sb);
     }
-    /// add_corner's part that the error estimate reads, from the corner's luminance y: a
-    /// tally of corners made this way gives the same above() and standard_error() as one
-    /// made by add_corner, without its colour.
-    void add_corner_luminance(double y) {
-        corner_y += add_luminance(y);
+    /// add_corner's part that the error estimate reads: a tally of corners made this way gives
+    /// the same above() and standard_error() as one made by add_corner, without the colour
+    /// sums that only mean() reads (the neighbour rule's pass over every pixel).
+    void add_corner_spread(float sr, float sg, float sb) {
+        corner_y += add_spread(sr, sg, sb);
         ++corners;
     }
     /// The weight in the pixel's mean of its first `count` samples (the corners come first).
@@ -91,11 +97,19 @@ struct PixelTally {
         const double w = weight(n);
         return {r / w, g / w, b / w};
     }
-    /// n (n - 1) s^2 with s^2 the unbiased sample variance of the luminance (n sum_yy - sum_y^2).
-    double scaled_variance() const { return std::max(0.0, n * sum_yy - sum_y * sum_y); }
-    /// The estimated standard error of the mean luminance, sqrt(s^2 / n); infinity below 2
-    /// samples (no spread yet). Stratified samples vary less than independent ones, so this
-    /// errs on the high side.
+    /// The samples' luminance summed about the first sample's (luminance is linear).
+    double sum_y() const { return luminance(sum[0], sum[1], sum[2]); }
+    /// n (n - 1) s^2 with s^2 the mean over R, G and B of the channels' unbiased sample
+    /// variances (n sum_sq - sum^2 per channel).
+    double scaled_variance() const {
+        double v = 0;
+        for (int c = 0; c < 3; ++c) v += std::max(0.0, n * sum_sq[c] - sum[c] * sum[c]);
+        return v / 3;
+    }
+    /// The estimated standard error of the pixel's mean, sqrt(s^2 / n) with s^2 as in
+    /// scaled_variance(): the root mean square over the channels; infinity below 2 samples
+    /// (no spread yet). Stratified samples vary less than independent ones, so this errs on
+    /// the high side.
     double standard_error() const {
         if (n < 2) return std::numeric_limits<double>::infinity();
         return std::sqrt(scaled_variance() / (double(n) * n * (n - 1)));
@@ -105,30 +119,35 @@ struct PixelTally {
     /// (weighted mean A, weight W) and the round's (mean B, m samples) are two estimates of
     /// the pixel, and the pixel's mean is their mean weighted by W and m; for estimates whose
     /// variances go as 1/W and 1/m, (A - B)^2 W m / (W + m)^2 estimates its squared error
-    /// ((A - B)^2 / 4 for equal halves). Unlike standard_error()^2 it sees what stratification
-    /// gains (the sequence's halves fill each other's gaps, so the pixel's mean varies far
-    /// less than s^2 / n on an edge) and what the corners miss. It is one degree of freedom
-    /// per pixel: too noisy to decide a pixel's rounds, sound summed over an image. Otherwise
-    /// (the first round, a round cut at the cap): standard_error()^2, 0 below 2 samples.
+    /// ((A - B)^2 / 4 for equal halves), on the luminance. Unlike standard_error()^2 it sees
+    /// what stratification gains (the sequence's halves fill each other's gaps, so the
+    /// pixel's mean varies far less than s^2 / n on an edge) and what the corners miss. It is
+    /// one degree of freedom per pixel: too noisy to decide a pixel's rounds, sound summed
+    /// over an image. Otherwise (the first round, a round cut at the cap): standard_error()^2,
+    /// 0 below 2 samples.
     double image_error_squared() const {
         if (n_before >= 2 && n == 2 * n_before) {
             const double m = n - n_before;
             // Before the round: its own samples and its corners (all of the round's are its own).
             const double w = weight(n_before);
             const double a = (sum_y_before - corner_y + kCornerWeight * corner_y) / w;
-            const double d = (sum_y - sum_y_before) / m - a;
+            const double d = (sum_y() - sum_y_before) / m - a;
             return d * d * w * m / ((w + m) * (w + m));
         }
         return n < 2 ? 0.0 : scaled_variance() / (double(n) * n * (n - 1));
     }
 
 private:
-    /// Adds a sample's luminance to the spread's sums; returns it shifted (y - shift).
-    double add_luminance(double y) {
-        if (n++ == 0) shift = y;
-        const double d = y - shift;
-        sum_y += d, sum_yy += d * d;
-        return d;
+    /// Adds a sample to the spread's sums; returns its luminance about the first sample's.
+    double add_spread(double sr, double sg, double sb) {
+        const double c[3] = {sr, sg, sb};
+        if (n++ == 0) shift[0] = sr, shift[1] = sg, shift[2] = sb;
+        double d[3];
+        for (int k = 0; k < 3; ++k) {
+            d[k] = c[k] - shift[k];
+            sum[k] += d[k], sum_sq[k] += d[k] * d[k];
+        }
+        return luminance(d[0], d[1], d[2]);
     }
 };
 

@@ -159,24 +159,38 @@ TEST_CASE("adaptive: the first round is the pixels' corners, each traced once") 
     }
 }
 
-TEST_CASE("adaptive: the error estimate is the standard error of the mean luminance") {
+TEST_CASE("adaptive: the error estimate is the standard error of the mean, root mean square over R, G and B") {
     PixelTally t;
     CHECK(std::isinf(t.standard_error()));
-    // Grey samples (luminance = value, the Rec. 709 weights sum to 1) 1, 2, 3, 4: mean 2.5,
-    // s^2 = (2.25 + 0.25 + 0.25 + 2.25) / 3 = 5/3, standard error sqrt(5/3 / 4).
+    // Grey samples 1, 2, 3, 4 (every channel alike): mean 2.5, s^2 = (2.25 + 0.25 + 0.25 +
+    // 2.25) / 3 = 5/3 in each channel, standard error sqrt(5/3 / 4).
     for (float v : {1.f, 2.f, 3.f, 4.f}) t.add(v, v, v);
     CHECK(t.n == 4);
     CHECK(t.mean().x == doctest::Approx(2.5).epsilon(1e-15));
     CHECK(t.standard_error() == doctest::Approx(std::sqrt(5.0 / 12.0)).epsilon(1e-12));
-    // Pure red: luminance 0.2126 per unit. Samples 0 and 1: s^2 = 0.2126^2 / 2, se = 0.2126 / 2.
+    // Pure red samples 0 and 1: s^2 = 1/2 in red, 0 in green and blue, mean 1/6; the standard
+    // error sqrt(1/6 / 2) = sqrt(1/12).
     PixelTally red;
     red.add(0.f, 0.f, 0.f);
     red.add(1.f, 0.f, 0.f);
-    CHECK(red.standard_error() == doctest::Approx(0.2126 / 2).epsilon(1e-12));
+    CHECK(red.standard_error() == doctest::Approx(std::sqrt(1.0 / 12.0)).epsilon(1e-12));
     // A bright flat pixel has no spread: exactly zero, not rounding noise of two large sums.
     PixelTally flat;
     for (int i = 0; i < 64; ++i) flat.add(1000.1f, 1000.1f, 1000.1f);
     CHECK(flat.standard_error() == 0.0);
+}
+
+TEST_CASE("adaptive: corners of different colour and equal luminance are a spread") {
+    // Two red corners (0.7152, 0, 0) and two green ones (0, 0.2126, 0): each of luminance
+    // 0.2126 x 0.7152, so a spread of luminance alone is 0 and the pixel would stop at its
+    // corners. Per channel: red s^2 = 4 x 0.3576^2 / 3 = 0.170507, green 4 x 0.1063^2 / 3 =
+    // 0.015066, blue 0; mean 0.061858, standard error sqrt(0.061858 / 4) = 0.12436.
+    PixelTally t;
+    for (int i = 0; i < 4; ++i) t.add_corner(i < 2 ? 0.7152f : 0.f, i < 2 ? 0.f : 0.2126f, 0.f);
+    CHECK(t.standard_error() == doctest::Approx(0.12436).epsilon(1e-4));
+    CHECK(AdaptiveRule{0.01, 64}.above(t));
+    // The image's estimate after a first round is the same standard error, squared.
+    CHECK(t.image_error_squared() == doctest::Approx(0.12436 * 0.12436).epsilon(1e-3));
 }
 
 TEST_CASE("adaptive: the image's estimate compares a pixel's last round with the samples before it") {
@@ -206,30 +220,33 @@ TEST_CASE("adaptive: the image's estimate compares a pixel's last round with the
     CHECK(edge.image_error_squared() == doctest::Approx(edge.standard_error() * edge.standard_error()).epsilon(1e-12));
 }
 
-TEST_CASE("adaptive: a tally of corners from their luminance alone has add_corner's spread, to the bit") {
-    // The neighbour rule's fast pass (driver/adaptive_render.cpp, corner_flags) builds its
-    // tallies this way: above() must not tell them apart.
+TEST_CASE("adaptive: a tally of corners without their colour sums has add_corner's spread, to the bit") {
+    // The neighbour rule's pass (driver/adaptive_render.cpp, corner_flags) builds its tallies
+    // this way: above() must not tell them apart.
     const float c[4][3] = {{0.9f, 0.1f, 0.3f}, {0.25f, 0.5f, 0.125f}, {0.0f, 0.0f, 0.0f}, {1.5f, 0.75f, 0.3f}};
     PixelTally full, fast;
     for (const auto& k : c) {
         full.add_corner(k[0], k[1], k[2]);
-        fast.add_corner_luminance(luminance(k[0], k[1], k[2]));
+        fast.add_corner_spread(k[0], k[1], k[2]);
     }
     CHECK(fast.n == 4);
     CHECK(fast.corners == 4);
-    CHECK(fast.shift == full.shift);
-    CHECK(fast.sum_y == full.sum_y);
-    CHECK(fast.sum_yy == full.sum_yy);
+    for (int k = 0; k < 3; ++k) {
+        CHECK(fast.shift[k] == full.shift[k]);
+        CHECK(fast.sum[k] == full.sum[k]);
+        CHECK(fast.sum_sq[k] == full.sum_sq[k]);
+    }
     CHECK(fast.corner_y == full.corner_y);
-    // Luminances 0.28452, 0.419775, 0, 0.87696: standard error 0.18283 (worked out by hand),
-    // so a pixel of 4 samples stops at T (4 / 16)^(3/4) = 0.35355 T for T >= 0.5171.
-    CHECK(fast.standard_error() == doctest::Approx(0.18283).epsilon(1e-4));
+    // Channel variances 0.455625, 0.122292, 0.021406 (worked out by hand), mean 0.199774:
+    // standard error sqrt(0.199774 / 4) = 0.22348, so a pixel of 4 samples stops at
+    // T (4 / 16)^(3/4) = 0.35355 T for T >= 0.6321.
+    CHECK(fast.standard_error() == doctest::Approx(0.22348).epsilon(1e-4));
     CHECK(fast.standard_error() == full.standard_error());
-    CHECK(AdaptiveRule{0.51, 64}.above(fast));
-    CHECK(AdaptiveRule{0.51, 64}.above(full));
-    CHECK_FALSE(AdaptiveRule{0.52, 64}.above(fast));
-    CHECK_FALSE(AdaptiveRule{0.52, 64}.above(full));
-    CHECK(fast.r == 0.0);  // no colour: the rule does not need it
+    CHECK(AdaptiveRule{0.63, 64}.above(fast));
+    CHECK(AdaptiveRule{0.63, 64}.above(full));
+    CHECK_FALSE(AdaptiveRule{0.64, 64}.above(fast));
+    CHECK_FALSE(AdaptiveRule{0.64, 64}.above(full));
+    CHECK(fast.r == 0.0);  // no colour sums: the rule does not need them
 }
 
 TEST_CASE("adaptive: a pixel's four corners weigh as one of its own samples in its mean and its estimate") {

@@ -38,17 +38,18 @@ TEST_CASE("limits: adaptive sampling adds its tallies per pixel and a round's co
     CHECK(uniform.adaptive_bytes == 0);
     sc.settings.adaptive = 0.01;
     const MemoryEstimate adaptive = estimate_render_memory(sc, true, 2);
-    // At most (every pixel refined): a tally of 8 doubles, a count and two 16-bit counts (72
-    // bytes), two 32-bit indices (its pixel, the last round's list), a neighbour flag byte, an
-    // above-T flag byte (the neighbour rule's image), a sample-map pixel of 3 floats: 94 bytes
-    // for each of 3840 x 2160 = 8294400 pixels.
-    REQUIRE(sizeof(PixelTally) == 72);
+    // At most (every pixel refined): a tally of 14 doubles (colour sums; per channel the
+    // spread's shift, sum and sum of squares; two luminance sums), a count and two 16-bit
+    // counts (120 bytes), two 32-bit indices (its pixel, the last round's list), a neighbour
+    // flag byte, an above-T flag byte (the neighbour rule's image), a sample-map pixel of 3
+    // floats: 142 bytes for each of 3840 x 2160 = 8294400 pixels.
+    REQUIRE(sizeof(PixelTally) == 120);
     // And the first round's corners, 3841 x 2161 colours of 12 bytes: 99604812 bytes.
-    CHECK(adaptive.adaptive_bytes == 8294400.0 * 94 + 99604812.0);
+    CHECK(adaptive.adaptive_bytes == 8294400.0 * 142 + 99604812.0);
     // The largest round of a cap of 64 is 32 samples (4, 4, 8, 16, 32): a 16 x 16 tile's
     // colours are 256 x 32 x 3 floats = 98304 bytes per thread.
     CHECK(adaptive.per_thread_bytes - uniform.per_thread_bytes == 98304.0);
-    CHECK(adaptive.total_bytes == doctest::Approx(uniform.total_bytes + 8294400.0 * 94 + 99604812.0 + 2 * 98304.0));
+    CHECK(adaptive.total_bytes == doctest::Approx(uniform.total_bytes + 8294400.0 * 142 + 99604812.0 + 2 * 98304.0));
 }
 
 TEST_CASE("limits: the stream engine's memory grows linearly with depth, never as 2^depth") {
