@@ -39,14 +39,16 @@ inline SampleRun adaptive_round(int r, int cap) {
 inline double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
 
 /// What one corner sample weighs in a pixel's mean, against 1 for a sample of the pixel's own
-/// sequence: a corner ray is shared by the four pixels it bounds, so the four corners together
-/// count as one sample. They sit on the pixel's border, a 2 x 2 grid that places an edge far
+/// sequence: a corner ray is shared by the four pixels it bounds, and the four corners together
+/// count as half a sample. They sit on the pixel's border, a 2 x 2 grid that places an edge far
 /// less well than the pixel's own stratified points; at equal weight they were half the error
-/// of the refined pixels on whitted.cfg. Measured at uniform 16 spp's error (rays traced,
-/// docs/adaptive-sampling.md, Figures), weights 1, 0.5, 0.25, 0: whitted 0.55, 0.38, 0.33, 0.32
-/// of uniform 16's rays; textured 0.54, 0.39, 0.33, 0.31; soft shadows (whose error is the
-/// area light's noise, which a corner averages as well as any sample) 0.117, 0.118, 0.125, 0.140.
-inline constexpr double kCornerWeight = 0.25;
+/// of the refined pixels on whitted.cfg. The weight changes no decision (the spread counts
+/// every sample alike), only the pixel's value. Measured at uniform 16 spp's error (rays
+/// traced, docs/adaptive-sampling.md, "How the samples are taken"), with the spread per
+/// channel, weights 1/2, 1/4, 1/8 and 1/16: whitted 0.366, 0.309, 0.299, 0.298 of uniform 16's
+/// rays; textured 0.376, 0.295, 0.275, 0.274; soft shadows (whose error is the area light's
+/// noise, which a corner averages as well as any sample) 0.129 at 1/4, 0.139 at 1/8.
+inline constexpr double kCornerWeight = 0.125;
 
 /// A pixel's samples so far: their colour sum (each corner weighted kCornerWeight), and per
 /// channel the sums of the samples and of their squares taken about the first sample (the

@@ -249,8 +249,8 @@ TEST_CASE("adaptive: a tally of corners without their colour sums has add_corner
     CHECK(fast.r == 0.0);  // no colour sums: the rule does not need them
 }
 
-TEST_CASE("adaptive: a pixel's four corners weigh as one of its own samples in its mean and its estimate") {
-    REQUIRE(kCornerWeight == 0.25);
+TEST_CASE("adaptive: a pixel's four corners weigh as half a sample of its own in its mean and its estimate") {
+    REQUIRE(kCornerWeight == 0.125);
     // Corners of grey 0 (an edge along the pixel's border), then four samples of its own of 1.
     PixelTally t;
     t.begin_round();
@@ -260,21 +260,21 @@ TEST_CASE("adaptive: a pixel's four corners weigh as one of its own samples in i
     for (int i = 0; i < 4; ++i) t.add(1.f, 1.f, 1.f);
     CHECK(t.n == 8);
     CHECK(t.corners == 4);
-    // Mean (4 x 0.25 x 0 + 4 x 1) / (4 x 0.25 + 4) = 0.8, not the 0.5 of equal weights.
-    CHECK(t.mean().x == doctest::Approx(0.8).epsilon(1e-15));
-    CHECK(t.mean().y == doctest::Approx(0.8).epsilon(1e-15));
+    // Mean (4 x 0.125 x 0 + 4 x 1) / (4 x 0.125 + 4) = 4 / 4.5 = 8/9, not the 0.5 of equal weights.
+    CHECK(t.mean().x == doctest::Approx(8.0 / 9.0).epsilon(1e-15));
+    CHECK(t.mean().y == doctest::Approx(8.0 / 9.0).epsilon(1e-15));
     // The spread counts every sample alike: 0, 0, 0, 0, 1, 1, 1, 1: s^2 = 8 x 0.25 / 7,
     // standard error sqrt(2/7 / 8) = sqrt(1/28).
     CHECK(t.standard_error() == doctest::Approx(std::sqrt(1.0 / 28.0)).epsilon(1e-12));
-    // The image's estimate: before the round A = 0 of weight 1, the round B = 1 of 4 samples:
-    // (A - B)^2 x 1 x 4 / (1 + 4)^2 = 0.16.
-    CHECK(t.image_error_squared() == doctest::Approx(0.16).epsilon(1e-12));
-    // Round 2, eight samples of 1: before it A = 4 / 5 = 0.8 of weight 5, so
-    // 0.2^2 x 5 x 8 / 13^2 = 1.6 / 169; the mean (4 + 8) / 13.
+    // The image's estimate: before the round A = 0 of weight 0.5, the round B = 1 of 4 samples:
+    // (A - B)^2 x 0.5 x 4 / (0.5 + 4)^2 = 2 / 20.25.
+    CHECK(t.image_error_squared() == doctest::Approx(2.0 / 20.25).epsilon(1e-12));
+    // Round 2, eight samples of 1: before it A = 4 / 4.5 = 8/9 of weight 4.5, so
+    // (1/9)^2 x 4.5 x 8 / 12.5^2 = (36 / 81) / 156.25; the mean (4 + 8) / 12.5 = 0.96.
     t.begin_round();
     for (int i = 0; i < 8; ++i) t.add(1.f, 1.f, 1.f);
-    CHECK(t.image_error_squared() == doctest::Approx(1.6 / 169.0).epsilon(1e-12));
-    CHECK(t.mean().x == doctest::Approx(12.0 / 13.0).epsilon(1e-15));
+    CHECK(t.image_error_squared() == doctest::Approx(36.0 / 81.0 / 156.25).epsilon(1e-12));
+    CHECK(t.mean().x == doctest::Approx(0.96).epsilon(1e-15));
 }
 
 TEST_CASE("adaptive: round 1 follows the pixel's or a neighbour's spread, later rounds its own") {
