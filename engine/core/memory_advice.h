@@ -35,7 +35,7 @@ inline void want_huge_pages(const T* begin, std::size_t count) {
 /// An allocator for arrays that may be large and are written soon after they are made (a
 /// framebuffer, an encoder's buffers): from 1 MiB an array gets whole 2 MiB blocks, aligned
 /// to 2 MiB and advised as huge pages; below, 64-byte-aligned memory from operator new. First
-/// writes to fresh memory are what such an array costs on a virtual machine (about 2 - 3 us a
+/// writes to fresh memory are what such an array costs on a virtual machine (1 - 2 us a
 /// 4 KiB page here, docs/performance.md "Fresh memory"); a huge page is one fault and one
 /// clear. At most one partial block is left unused per array, and its tail is not touched.
 template <class T>

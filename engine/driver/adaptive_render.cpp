@@ -221,7 +221,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     // first touched by the thread that fills it, not zeroed first by this one (3.7 MB at
     // 640x480; whole process 2 % faster on whitted, docs/adaptive-sampling.md), in huge pages.
     LargeFillLaterVec<float> corner_rgb(corners_first ? std::size_t(w + 1) * std::size_t(h + 1) * 3 : 0);
-    // With a corner round, a pixel gets a tally (72 bytes) only when it takes round 1: most
+    // With a corner round, a pixel gets a tally (120 bytes) only when it takes round 1: most
     // pixels stop at their corners, and their tallies are made from corner_rgb when read
     // (whitted.cfg at 640x480: allocating and zeroing a tally for every pixel was a twelfth
     // of the render at -j2). Without one, every pixel has a tally from round 0, first touched

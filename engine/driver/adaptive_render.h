@@ -11,7 +11,7 @@ namespace streamrt {
 
 /// The tallies of the pixels of a rectangle that take samples after the corner round (every
 /// pixel without one), in row order: most pixels of a picture stop at their corners, and
-/// their values are read from the corners themselves (72 bytes a pixel only where needed).
+/// their values are read from the corners themselves (120 bytes a pixel only where needed).
 struct TileTallies {
     Tile tile{};
     std::vector<PixelTally> tallies;
