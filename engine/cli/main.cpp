@@ -60,7 +60,7 @@ int run(int argc, char** argv) {
                    "B) is at most T (n / 16)^(3/4) (T at 16 samples, e.g. 0.03); --spp is the most it takes (default 64)")
         ->check(CLI::Range(0.0, 1.0));
     app.add_option("--target-error", opt.target_error,
-                   "Adaptive sampling until the image's estimated RMSE (luminance) is at most E")
+                   "Adaptive sampling until the image's estimated RMSE is at most E")
         ->check(CLI::Range(1e-9, 1.0));
     app.add_option("--time-limit", opt.time_limit,
                    "Adaptive sampling: stop refining after S seconds of rendering and write the picture so far")

@@ -126,7 +126,8 @@ struct PixelTally {
     /// pixel's mean varies far less than s^2 / n on an edge) and what the corners miss. It is
     /// one degree of freedom per pixel: too noisy to decide a pixel's rounds, sound summed
     /// over an image. Otherwise (the first round, a round cut at the cap): standard_error()^2,
-    /// 0 below 2 samples.
+    /// the channels' mean (so a pixel that stopped at its corners counts its colour spread as
+    /// its decision did), 0 below 2 samples.
     double image_error_squared() const {
         if (n_before >= 2 && n == 2 * n_before) {
             const double m = n - n_before;
@@ -214,7 +215,7 @@ struct AdaptivePhases {
 /// An adaptive render's outcome, for the closing line and the profile.
 struct AdaptiveSummary {
     double mean_spp = 0;        ///< samples taken per pixel, on average
-    double estimated_rmse = 0;  ///< sqrt(mean of the pixels' image_error_squared()), luminance
+    double estimated_rmse = 0;  ///< sqrt(mean of the pixels' image_error_squared())
     int rounds = 0;             ///< rounds run
     bool time_limited = false;  ///< --time-limit stopped the refinement
     int cap = 0;                ///< the most samples a pixel may take (--spp)
