@@ -100,9 +100,9 @@ void tally_corners(const float* rgb, const Tile& corners, TileTallies& t) {
 }
 
 /// The neighbour rule's flags (AdaptiveRule::above) of the pixels of `tile` from their corners
-/// alone, into `above` (the whole image's flags, row by row): the tallies corner_tally would
-/// make, without their colour sums (PixelTally::add_corner_spread). `rgb`: the
-/// (w + 1) x (h + 1) corner lattice.
+/// alone, into `above` (the whole image's flags, row by row): the spread corner_tally's
+/// tallies would have (CornerQuad, without colour sums). `rgb`: the (w + 1) x (h + 1)
+/// corner lattice.
 void corner_flags(const AdaptiveRule& rule, const float* rgb, int w, const Tile& tile, std::uint8_t* above) {
     const std::size_t row = std::size_t(w) + 1;
     for (int y = tile.y0; y < tile.y1; ++y) {
@@ -110,9 +110,8 @@ void corner_flags(const AdaptiveRule& rule, const float* rgb, int w, const Tile&
         const float* bottom = top + row * 3;
         std::uint8_t* out = above + std::size_t(y) * std::size_t(w) + std::size_t(tile.x0);
         for (int x = 0; x < tile.width(); ++x, top += 3, bottom += 3) {
-            PixelTally p;  // corner_tally's order: top left, top right, bottom left, bottom right
-            for (const float* c : {top, top + 3, bottom, bottom + 3}) p.add_corner_spread(c[0], c[1], c[2]);
-            out[x] = rule.above(p);
+            const CornerQuad q = CornerQuad::of<false>(top, top + 3, bottom, bottom + 3);
+            out[x] = rule.above(q.scaled_variance(), q.n);
         }
     }
 }
@@ -156,9 +155,10 @@ void write_means(const TileTallies& t, float* rgb) {
     }
 }
 
-/// Calls f(x, y, tally) for every pixel of t.tile in row order: its own tally when it has
-/// one, otherwise (a pixel that stopped at its corners) the tally of its corners from the
-/// whole image's corner lattice `corner_rgb` ((w + 1) x (h + 1) colours).
+/// Calls f(x, y, tally) for every pixel of t.tile in row order: its own PixelTally when it
+/// has one, otherwise (a pixel that stopped at its corners) the CornerQuad of its corners
+/// from the whole image's corner lattice `corner_rgb` ((w + 1) x (h + 1) colours): both
+/// give n, mean(), standard_error() and image_error_squared(), to the same bits.
 template <class F>
 void for_each_pixel(const TileTallies& t, const float* corner_rgb, int w, F&& f) {
     const std::size_t row = std::size_t(w) + 1;
@@ -169,7 +169,8 @@ void for_each_pixel(const TileTallies& t, const float* corner_rgb, int w, F&& f)
             if (k < t.pixel.size() && t.pixel[k] == p) {
                 f(x, y, t.tallies[k++]);
             } else {
-                f(x, y, corner_tally(corner_rgb, row, std::size_t(y) * row + std::size_t(x)));
+                const float* top = corner_rgb + (std::size_t(y) * row + std::size_t(x)) * 3;
+                f(x, y, CornerQuad::of(top, top + 3, top + row * 3, top + row * 3 + 3));
             }
         }
 }
@@ -254,7 +255,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     const auto estimated_rmse = [&] {
         par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
             double sum = 0;
-            for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int, int, const PixelTally& p) { sum += p.image_error_squared(); });
+            for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int, int, const auto& p) { sum += p.image_error_squared(); });
             tile_error[i] = sum;
         });
         return rmse_of_tiles();
@@ -314,8 +315,8 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                     corner_flags(prepared.adaptive, corner_rgb.data(), w, tiles[i].tile, above_image.data());
                     return;
                 }
-                for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int x, int y, const PixelTally& p) {
-                    above_image[std::size_t(y) * std::size_t(w) + std::size_t(x)] = prepared.adaptive.above(p);
+                for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int x, int y, const auto& p) {
+                    above_image[std::size_t(y) * std::size_t(w) + std::size_t(x)] = prepared.adaptive.above(p.scaled_variance(), p.n);
                 });
             });
             par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
@@ -384,7 +385,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     std::vector<double> tile_samples(tiles.size());  // summed in tile order after: the same for any -j
     par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
         double n = 0, error = 0;
-        for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int x, int y, const PixelTally& tally) {
+        for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int x, int y, const auto& tally) {
             const ColorT<double> mean = tally.mean();
             float* px = image.pixel(x, y);
             px[0] = float(mean.x), px[1] = float(mean.y), px[2] = float(mean.z);

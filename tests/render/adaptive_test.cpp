@@ -220,33 +220,38 @@ TEST_CASE("adaptive: the image's estimate compares a pixel's last round with the
     CHECK(edge.image_error_squared() == doctest::Approx(edge.standard_error() * edge.standard_error()).epsilon(1e-12));
 }
 
-TEST_CASE("adaptive: a tally of corners without their colour sums has add_corner's spread, to the bit") {
-    // The neighbour rule's pass (driver/adaptive_render.cpp, corner_flags) builds its tallies
-    // this way: above() must not tell them apart.
+TEST_CASE("adaptive: a pixel's corners read without a tally give add_corner's values, to the bit") {
+    // The neighbour rule and the final pass (driver/adaptive_render.cpp) read a pixel that
+    // stopped at its corners as a CornerQuad: nothing may tell it from the tally.
     const float c[4][3] = {{0.9f, 0.1f, 0.3f}, {0.25f, 0.5f, 0.125f}, {0.0f, 0.0f, 0.0f}, {1.5f, 0.75f, 0.3f}};
-    PixelTally full, fast;
-    for (const auto& k : c) {
-        full.add_corner(k[0], k[1], k[2]);
-        fast.add_corner_spread(k[0], k[1], k[2]);
-    }
-    CHECK(fast.n == 4);
-    CHECK(fast.corners == 4);
+    PixelTally full;
+    for (const auto& k : c) full.add_corner(k[0], k[1], k[2]);
+    const CornerQuad quad = CornerQuad::of(c[0], c[1], c[2], c[3]);
+    const CornerQuad spread_only = CornerQuad::of<false>(c[0], c[1], c[2], c[3]);
+    CHECK(quad.n == full.n);
     for (int k = 0; k < 3; ++k) {
-        CHECK(fast.shift[k] == full.shift[k]);
-        CHECK(fast.sum[k] == full.sum[k]);
-        CHECK(fast.sum_sq[k] == full.sum_sq[k]);
+        CHECK(quad.sum[k] == full.sum[k]);
+        CHECK(quad.sum_sq[k] == full.sum_sq[k]);
+        CHECK(spread_only.sum_sq[k] == full.sum_sq[k]);
     }
-    CHECK(fast.corner_y == full.corner_y);
     // Channel variances 0.455625, 0.122292, 0.021406 (worked out by hand), mean 0.199774:
     // standard error sqrt(0.199774 / 4) = 0.22348, so a pixel of 4 samples stops at
     // T (4 / 16)^(3/4) = 0.35355 T for T >= 0.6321.
-    CHECK(fast.standard_error() == doctest::Approx(0.22348).epsilon(1e-4));
-    CHECK(fast.standard_error() == full.standard_error());
-    CHECK(AdaptiveRule{0.63, 64}.above(fast));
-    CHECK(AdaptiveRule{0.63, 64}.above(full));
-    CHECK_FALSE(AdaptiveRule{0.64, 64}.above(fast));
-    CHECK_FALSE(AdaptiveRule{0.64, 64}.above(full));
-    CHECK(fast.r == 0.0);  // no colour sums: the rule does not need them
+    CHECK(quad.standard_error() == doctest::Approx(0.22348).epsilon(1e-4));
+    CHECK(quad.standard_error() == full.standard_error());
+    CHECK(quad.image_error_squared() == full.image_error_squared());
+    CHECK(spread_only.scaled_variance() == full.scaled_variance());
+    for (const double t : {0.63, 0.64}) {
+        const AdaptiveRule rule{t, 64};
+        CHECK(rule.above(quad.scaled_variance(), quad.n) == rule.above(full));
+    }
+    CHECK(AdaptiveRule{0.63, 64}.above(quad.scaled_variance(), quad.n));
+    CHECK_FALSE(AdaptiveRule{0.64, 64}.above(quad.scaled_variance(), quad.n));
+    // The mean: the corners' colours, (0.9 + 0.25 + 0 + 1.5) / 4 = 0.6625 in red.
+    CHECK(quad.mean().x == doctest::Approx(0.6625).epsilon(1e-7));
+    CHECK(quad.mean().x == full.mean().x);
+    CHECK(quad.mean().y == full.mean().y);
+    CHECK(quad.mean().z == full.mean().z);
 }
 
 TEST_CASE("adaptive: a pixel's four corners weigh as half a sample of its own in its mean and its estimate") {
