@@ -45,13 +45,18 @@ inline V pick(const M& is0, const M& is1, const Vec3T<V>& a) {
     return simd::select(is0, a.x, simd::select(is1, a.y, a.z));
 }
 
-/// Recomputes in double the edge functions that came out exactly 0 in float.
+/// Recomputes in double the three edge functions of each lane (ray and triangle) that has
+/// one exactly 0 in float; the other lanes keep theirs. Lane by lane, so a lane's answer does
+/// not depend on the others: recomputing every lane once any had a zero made a ray's hit
+/// depend on the packet it was traced in (a corner of adaptive sampling, traced in two
+/// different packets by a whole image and by a tile rendered alone, came out an ulp apart).
 template <class V>
 inline void edge_fallback(V& U, V& Vv, V& W, const V& ax, const V& ay, const V& bx, const V& by, const V& cx,
                           const V& cy) {
     if constexpr (std::is_same_v<simd::scalar_t<V>, float>) {
         using simd::any;
-        if (!any((U == V(0.f)) || (Vv == V(0.f)) || (W == V(0.f)))) return;
+        const auto zero = (U == V(0.f)) || (Vv == V(0.f)) || (W == V(0.f));
+        if (!any(zero)) return;
         if constexpr (std::is_same_v<V, float>) {
             U = float(double(cx) * double(by) - double(cy) * double(bx));
             Vv = float(double(ax) * double(cy) - double(ay) * double(cx));
@@ -71,9 +76,9 @@ inline void edge_fallback(V& U, V& Vv, V& W, const V& ax, const V& ay, const V& 
                 out[1][l] = float(Ax * Cy - Ay * Cx);
                 out[2][l] = float(Bx * Ay - By * Ax);
             }
-            U = V::load_aligned(out[0]);
-            Vv = V::load_aligned(out[1]);
-            W = V::load_aligned(out[2]);
+            U = simd::select(zero, V::load_aligned(out[0]), U);
+            Vv = simd::select(zero, V::load_aligned(out[1]), Vv);
+            W = simd::select(zero, V::load_aligned(out[2]), W);
         }
     }
 }
