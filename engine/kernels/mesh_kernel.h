@@ -289,8 +289,14 @@ inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const
             for (std::uint32_t k = std::uint32_t(e.child); k < std::uint32_t(e.child) + e.count; ++k) {
                 const auto sheared = corners.sheared(wr, m, k);
                 if (!xsimd::any(triangle_may_hit(sheared, best))) continue;
-                const TriangleHit<B> h = triangle_hit_sheared(sheared, B(0.f), best);
-                const auto closer = h.t < best;
+                // A tie (two triangles at one t: a ray through their shared edge or vertex)
+                // goes to the lower triangle number, as in the single-ray walk: the answer
+                // must not depend on the order the leaves are met in, which depends on the
+                // packet's other rays (adaptive sampling traces a pixel's corner in different
+                // packets for a whole image and for a tile rendered alone).
+                const TriangleHit<B> h = triangle_hit_sheared<true>(sheared, B(0.f), best);
+                const auto closer =
+                    h.t < best || (h.t == best && xsimd::bool_cast(I(std::int32_t(k)) < bprim));
                 if (!xsimd::any(closer)) continue;
                 best = xsimd::select(closer, h.t, best);
                 bu = xsimd::select(closer, h.u, bu);

@@ -205,18 +205,22 @@ inline bool single_leaf_closest(const MeshView& m, const SingleRay<NodeArch, Lea
         const auto sheared =
             tri_detail::shear(r.wr, block_corner(*b, 0, r), block_corner(*b, 1, r), block_corner(*b, 2, r));
         if (!xsimd::any(triangle_may_hit(sheared, LB(best)))) continue;
-        const TriangleHit<LB> h = triangle_hit_sheared(sheared, LB(0.f), LB(best));
-        if (!xsimd::any(h.t < LB(best))) continue;
+        const TriangleHit<LB> h = triangle_hit_sheared<true>(sheared, LB(0.f), LB(best));
+        if (!xsimd::any(h.t <= LB(best))) continue;
         alignas(16) float t[kBlockTriangles], u[kBlockTriangles], v[kBlockTriangles];
         h.t.store_aligned(t);
         h.u.store_aligned(u);
         h.v.store_aligned(v);
-        for (int l = 0; l < kBlockTriangles; ++l)
-            if (t[l] < best) {
+        for (int l = 0; l < kBlockTriangles; ++l) {
+            // A tie goes to the lower triangle number (mesh_kernel.h's packet walk): the hit
+            // does not depend on the order of the walk.
+            const std::int32_t prim = std::int32_t(first + k + std::uint32_t(l));
+            if (t[l] < best || (t[l] == best && prim < hit.prim)) {
                 best = t[l];
-                hit = {std::int32_t(first + k + std::uint32_t(l)), u[l], v[l]};
+                hit = {prim, u[l], v[l]};
                 found = true;
             }
+        }
     }
     return found;
 }

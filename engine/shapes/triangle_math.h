@@ -151,14 +151,16 @@ inline auto ahead(const Sheared<V>& s) {
 }
 }  // namespace tri_detail
 
-/// The rest of the test on a sheared triangle (tri_detail::shear): the division, t, u, v.
-template <class V>
+/// The rest of the test on a sheared triangle (tri_detail::shear): the division, t, u, v,
+/// for t in (t_min, t_max), or (t_min, t_max] when `with_tie` (the mesh walks' closest hit,
+/// which settles a tie between two triangles by their numbers: mesh_kernel.h).
+template <bool with_tie = false, class V>
 inline TriangleHit<V> triangle_hit_sheared(const tri_detail::Sheared<V>& s, V t_min, V t_max) {
     using namespace simd;
     const auto ok = s.inside && (s.det != V(0));
     const V inv_det = V(1) / select(ok, s.det, V(1));
     const V t = s.T * inv_det;
-    const auto hit = ok && (t > t_min) && (t < t_max);
+    const auto hit = ok && (t > t_min) && (with_tie ? t <= t_max : t < t_max);
     return {select(hit, t, infinity_v<V>()), s.Vv * inv_det, s.W * inv_det};
 }
 

@@ -118,6 +118,21 @@ void for_each_isa(F&& f) {
     }
 }
 
+/// A flat n x n grid in z = 0 with corners at the integers (0 .. n), two triangles a cell
+/// (split along the diagonal from (i, j) to (i + 1, j + 1)).
+std::shared_ptr<const Mesh> flat_grid(int n) {
+    MeshData grid;
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i)
+            for (const float c : {float(i), float(j), 0.f}) grid.positions.push_back(c);
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const std::uint32_t a = std::uint32_t(j * (n + 1) + i), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
+            for (const std::uint32_t v : {a, b, d, a, d, c}) grid.triangles.push_back(v);
+        }
+    return Mesh::build("grid", grid.positions, grid.triangles);
+}
+
 /// The mesh as an object in its own space (the identity transform).
 ObjectXf object_of(const Mesh& mesh) {
     ObjectXf xf{};
@@ -455,17 +470,8 @@ TEST_CASE("mesh walks: a ray's hit does not depend on the other rays of its pack
     // with the last lane of every packet replaced by a ray along +z exactly through the vertex
     // (integer coordinates: its edge functions there are exactly 0); the other lanes' t,
     // triangle and barycentrics must match to the bit.
-    MeshData grid;
     const int n = 8;
-    for (int j = 0; j <= n; ++j)
-        for (int i = 0; i <= n; ++i)
-            for (const float c : {float(i), float(j), 0.f}) grid.positions.push_back(c);
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            const std::uint32_t a = std::uint32_t(j * (n + 1) + i), b = a + 1, c = a + std::uint32_t(n + 1), d = c + 1;
-            for (const std::uint32_t v : {a, b, d, a, d, c}) grid.triangles.push_back(v);
-        }
-    const auto mesh = Mesh::build("grid", grid.positions, grid.triangles);
+    const auto mesh = flat_grid(n);
     std::mt19937 rng(29);
     std::uniform_real_distribution<float> near(-0.9f, 0.9f), from(-3.f, 3.f);
     std::uniform_int_distribution<int> vertex(1, n - 1);
@@ -500,4 +506,72 @@ TEST_CASE("mesh walks: a ray's hit does not depend on the other rays of its pack
         CHECK(hits == alone.o.size() - alone.o.size() / lanes);  // every aimed ray reaches the grid
         CHECK(vertex_hits == alone.o.size() / lanes);
     });
+}
+
+TEST_CASE("mesh walks: a ray through a shared edge takes the lower-numbered triangle, whatever its packet") {
+    // Two triangles of a flat grid that share an edge give a ray along +z through the edge's
+    // midpoint the same t (1, exactly). The walks visit leaves in an order that depends on the
+    // packet's other rays (the entry distance of a child is the smallest over its lanes), so
+    // the tie is settled by the triangle numbers: the lower wins. Each edge ray is traced with
+    // a companion lane entering one cell's box first (from nearer), every cell in turn.
+    const int n = 6;
+    const auto mesh = flat_grid(n);
+    // The triangles (in the mesh's own numbering) with corners p and q, from their coordinates.
+    const auto sharing = [&](float px, float py, float qx, float qy) {
+        std::vector<int> found;
+        for (std::size_t k = 0; k < mesh->triangle_count(); ++k) {
+            const float* t = &mesh->tri[9 * k];
+            int corners = 0;
+            for (int c = 0; c < 3; ++c)
+                corners += (t[3 * c] == px && t[3 * c + 1] == py) || (t[3 * c] == qx && t[3 * c + 1] == qy);
+            if (corners == 2) found.push_back(int(k));
+        }
+        return found;
+    };
+    struct Edge {
+        float px, py, qx, qy;
+    };
+    std::vector<Edge> edges;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            edges.push_back({float(i), float(j), float(i + 1), float(j + 1)});  // a cell's diagonal
+            if (j > 0) edges.push_back({float(i), float(j), float(i + 1), float(j)});  // between two rows
+            if (i > 0) edges.push_back({float(i), float(j), float(i), float(j + 1)});  // between two columns
+        }
+    for (std::uint32_t single : {0u, 64u}) {  // the packet walk, and the single-ray walk from the root
+        CAPTURE(single);
+        const auto walk = mesh->with_single_ray_lanes(single);
+        for_each_isa([&](const KernelTable& kt) {
+            const std::size_t lanes = std::size_t(kt.float_lanes);
+            Case c;
+            std::vector<int> want;
+            for (const Edge& e : edges) {
+                const std::vector<int> two = sharing(e.px, e.py, e.qx, e.qy);
+                REQUIRE(two.size() == 2);
+                for (int cell = 0; cell < n * n; ++cell) {
+                    for (std::size_t l = 0; l < lanes; ++l) {
+                        if (l == 1) {  // the companion, entering the cell's box at t = 0.5
+                            c.o.push_back({float(cell % n) + 0.25f, float(cell / n) + 0.6f, -0.5f});
+                        } else {
+                            c.o.push_back({0.5f * (e.px + e.qx), 0.5f * (e.py + e.qy), -1.f});
+                        }
+                        c.d.push_back({0.f, 0.f, 1.f});
+                        c.t_max.push_back(1e30f);
+                        want.push_back(l == 1 ? -2 : std::min(two[0], two[1]));
+                    }
+                }
+            }
+            const ObjectXf xf = object_of(*walk);
+            Traced tr(c);
+            kt.closest[int(ShapeKind::Mesh)](tr.view, tr.id.data(), &xf, 1);
+            std::size_t wrong = 0, edge_rays = 0;
+            for (std::size_t i = 0; i < want.size(); ++i) {
+                if (want[i] == -2) continue;
+                ++edge_rays;
+                wrong += tr.id[i] != 0 || tr.rs.t_max[i] != 1.f || tr.prim[i] != want[i];
+            }
+            CHECK(edge_rays == want.size() - want.size() / lanes);
+            CHECK(wrong == 0);
+        });
+    }
 }
