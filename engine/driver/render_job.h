@@ -69,8 +69,10 @@ static_assert(sizeof(PixelSettings) == 88, "PixelSettings changed: list every fi
 /// T sqrt(n / 16) (2026-11-27). 3: an adaptive pixel's corners weigh a quarter of its own
 /// samples in its mean (kCornerWeight); 4: its stopping point became T (n / 16)^(3/4) (both 2026-11-27).
 /// 5: its spread became the mean of the channels' variances, and its corners weigh an eighth
-/// (2026-11-28).
-inline constexpr int kPixelsRevision = 5;
+/// (2026-11-28). 6: mesh hits lane by lane (the watertight test's double fallback, ties to the
+/// lower triangle) and a uniform tile's pixels in Z order in scenes with a hierarchy: pixels
+/// of mesh and object-tree scenes move by an ulp (2026-11-28).
+inline constexpr int kPixelsRevision = 6;
 
 /// "pixels=4,width=640,height=480,spp=4,...": kPixelsRevision, then every field of
 /// PixelSettings, enums by their names, numbers exactly (%.17g), the stream kernels' level as

@@ -68,7 +68,7 @@ TEST_CASE("settings record: every field is in the token, and changing any one ch
     CHECK(settings_token(rec) == settings_token(rec_other));
     CHECK(token.find("isa=sse2") != std::string::npos);
     // A build that computes pixels differently for the same settings writes another token.
-    CHECK(token.rfind("pixels=5,width=64,", 0) == 0);
+    CHECK(token.rfind("pixels=6,width=64,", 0) == 0);
 }
 
 TEST_CASE("settings record: a job carries the overrides and the scene's own values") {
@@ -89,7 +89,7 @@ TEST_CASE("settings record: a job carries the overrides and the scene's own valu
     CHECK(job.settings.sampler == SamplePattern::Grid);
     CHECK(job.settings.tonemap == Tonemap::Reinhard);
     const std::string token = settings_token(job.settings);
-    CHECK(token.rfind("pixels=5,width=40,height=30,spp=5,", 0) == 0);
+    CHECK(token.rfind("pixels=6,width=40,height=30,spp=5,", 0) == 0);
     CHECK(token.find(",light_samples=7,") != std::string::npos);
     CHECK(token.find(",cutoff=0.25,") != std::string::npos);
     CHECK(token.find(",sampler=grid,") != std::string::npos);
