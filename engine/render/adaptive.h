@@ -166,10 +166,11 @@ struct CornerQuad {
     static constexpr int n = 4;
 
     /// The corners c[0 .. 4), 3 floats each; `colour` summed only when `with_colour` (without
-    /// it, mean() is not to be read: the neighbour rule needs the spread alone).
+    /// it, 0: the neighbour rule needs the spread alone).
     template <bool with_colour = true>
     static CornerQuad of(const float* c0, const float* c1, const float* c2, const float* c3) {
         CornerQuad q;
+        if constexpr (!with_colour) q.colour[0] = q.colour[1] = q.colour[2] = 0;
         for (int k = 0; k < 3; ++k) {
             const double shift = c0[k];
             double s = 0, s2 = 0;
@@ -190,7 +191,7 @@ struct CornerQuad {
     double image_error_squared() const { return PixelTally::spread_error_squared(scaled_variance(), n); }
     double standard_error() const { return std::sqrt(image_error_squared()); }
     ColorT<double> mean() const {
-        const double w = (n - n) + kCornerWeight * n;  // PixelTally::weight(4) with 4 corners
+        const double w = kCornerWeight * n;  // PixelTally::weight(4) of 4 corners, exactly
         return {colour[0] / w, colour[1] / w, colour[2] / w};
     }
 };
