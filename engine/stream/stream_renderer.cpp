@@ -4,9 +4,9 @@
 #include <chrono>
 #include <mutex>
 
+#include "parallel/pixel_order.h"
 #include "render/sampling.h"
 #include "shapes/shapes.h"
-#include "parallel/pixel_order.h"
 #include "stream/stages.h"
 
 namespace streamrt {
@@ -17,7 +17,8 @@ StreamRenderer::StreamRenderer(const Scene& scene, const RenderSettings& setting
       kernels_(kernel_table(isa)),
       tile_fn_(nullptr),
       shade_mode_(resolve_shade_mode(scene_, shade)),
-      slice_rays_(slice_rays > 0 ? slice_rays : default_slice_rays(scene_.settings.spp)) {
+      slice_rays_(slice_rays > 0 ? slice_rays : default_slice_rays(scene_.settings.spp)),
+      z_order_(scene_.accel ? !scene_.has_meshes : scene_.has_meshes) {
     tile_fn_ = select_tile_fn();
 }
 
@@ -93,15 +94,19 @@ void StreamRenderer::render_one_tile(const Tile& tile, float* rgb, RayCounts& co
     // Tile-local accumulation in a fixed order: the result cannot depend on scheduling.
     float accum[kTileSize * kTileSize * 3] = {};
     const int pixels = tile.width() * tile.height();
-    // Pixels in Z order where rays walk one hierarchy, whose nodes a compact packet shares: a
-    // mesh's tree (meshes without the object tree) or the object tree of shapes. The rest keep
-    // the rows (docs/performance.md, "Pixels in Z order"): a scene of a few shapes, tested ray
-    // by ray against each, gained nothing (its shade stage lost 2 - 4 %), and in the object
-    // tree over instanced meshes compact packets reach small instances with more lanes, past
-    // the single-ray hand-over's threshold (the 10,000-instance field's intersect 1.15x).
+    // Pixels in Z order where rays walk one hierarchy (z_order_), whose nodes a compact packet
+    // shares. The rest keep the rows (docs/performance.md, "Pixels in Z order"): a scene of a
+    // few shapes, tested ray by ray against each, gained nothing (its shade stage lost 2 - 4 %),
+    // and in the object tree over instanced meshes compact packets reach small instances with
+    // more lanes, past the single-ray hand-over's threshold (the 10,000-instance field's
+    // intersect 1.15x). A whole tile reads the table itself; a partial one filters it.
     std::uint32_t order[kTileSize * kTileSize];
     SampleRequest all{.run = {0, scene_.settings.spp}, .n_pixels = pixels};
-    if (scene_.accel ? !scene_.has_meshes : scene_.has_meshes) all.pixels = order, all.n_pixels = z_order_pixels(tile, order);
+    if (z_order_) {
+        const bool whole = tile.width() == kTileSize && tile.height() == kTileSize;
+        all.pixels = whole ? kZOrder.pixel : order;
+        if (!whole) all.n_pixels = z_order_pixels(tile, order);
+    }
     tile_fn_(*this, tile, all, accum, counts, profile, cancel);
     StageTimer timer(profile ? &profile->stages[int(Stage::Accumulate)] : nullptr);
     std::copy_n(accum, pixels * 3, rgb);

@@ -82,6 +82,9 @@ class StreamRenderer {
     TileFn tile_fn_;
     ShadeMode shade_mode_;  ///< resolved for this scene
     std::size_t slice_rays_;
+    /// Whether a uniform tile hands its pixels over in Z order (render_one_tile): where rays
+    /// walk one hierarchy, a mesh's tree without the object tree or the object tree of shapes.
+    bool z_order_;
 };
 
 }  // namespace streamrt
