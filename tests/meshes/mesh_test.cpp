@@ -4,12 +4,15 @@
 // the analytic sphere; OBJ files through the parser; both engines on a mesh scene.
 #include <doctest/doctest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scene/scene_bvh.h"
@@ -22,6 +25,7 @@
 #include "driver/render.h"
 #include "scene/parser.h"
 #include "stream/stream_accel.h"
+#include "stream/stream_scene.h"
 
 using namespace streamrt;
 namespace fs = std::filesystem;
@@ -79,6 +83,16 @@ void check_all_hit(const std::shared_ptr<const Mesh>& mesh, const Rays& r, float
 
     Scene s;
     add_mesh_object(s, mesh);
+    // The stream engine's flat scene, for its per-object culling boxes: the eye at the origin,
+    // so that its frame (relative to the eye) is the mesh's.
+    s.camera.look_at = true;
+    s.camera.eye = {0.0, 0.0, 0.0};
+    s.camera.look = {0.0, 0.0, -1.0};
+    accel::AccelConfig flat;
+    flat.mode = accel::AccelMode::Flat;
+    const StreamScene flat_scene(s, flat);
+    REQUIRE(flat_scene.groups[int(ShapeKind::Mesh)].size() == 1);
+    REQUIRE(flat_scene.group_bounded[int(ShapeKind::Mesh)]);
     ObjectXf xf{};
     xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
     xf.id = 0;
@@ -110,6 +124,25 @@ void check_all_hit(const std::shared_ptr<const Mesh>& mesh, const Rays& r, float
             RayStream sh;
             fill(sh, r, t_limit == kInfF ? 1e30f : t_limit);
             kt.any[int(ShapeKind::Mesh)](view_of(sh), &xf, 1);
+            std::size_t open = 0;
+            for (std::size_t i = 0; i < sh.count; ++i) open += sh.t_max[i] != 0.f;
+            CHECK(open == 0);
+        }
+        // The flat kernels that first test each mesh's world box (padded: a ray that meets the
+        // mesh always meets its box, at the box's corners and edges included).
+        {
+            const ObjectXf* group = flat_scene.groups[int(ShapeKind::Mesh)].data();
+            const ObjectBounds* box = flat_scene.group_bounds[int(ShapeKind::Mesh)].data();
+            RayStream rs;
+            fill(rs, r, t_limit);
+            AlignedVec<std::int32_t> id(rs.capacity(), -1);
+            kt.closest_culled[int(ShapeKind::Mesh)](view_of(rs), id.data(), group, box, 1);
+            std::size_t misses = 0;
+            for (std::size_t i = 0; i < rs.count; ++i) misses += id[i] != 0;
+            CHECK(misses == 0);
+            RayStream sh;
+            fill(sh, r, t_limit == kInfF ? 1e30f : t_limit);
+            kt.any_culled[int(ShapeKind::Mesh)](view_of(sh), group, box, 1);
             std::size_t open = 0;
             for (std::size_t i = 0; i < sh.count; ++i) open += sh.t_max[i] != 0.f;
             CHECK(open == 0);
@@ -256,6 +289,110 @@ TEST_CASE("meshes: a closed cube mesh: 1e5 random rays from inside all hit (doub
             r.add({u(rng) * 0.5f, u(rng) * 0.5f, u(rng) * 0.5f}, t - r.o.back());
         }
         check_all_hit(cube, r);
+        // From outside, entering the cube (its own bounding box) at t = 1 exactly at its
+        // corners and on its edges, from every side and down to grazing angles: the hits that
+        // a box test without padding loses to rounding. Each ray comes from the side of every
+        // face it reaches, so it crosses into the cube there.
+        Rays out;
+        for (int i = 0; i < 20000; ++i) {
+            Vec3f t{float(int(rng() % 2) * 2 - 1), float(int(rng() % 2) * 2 - 1), float(int(rng() % 2) * 2 - 1)};
+            const int free_axis = i % 2 ? int(rng() % 3) : -1;  // an edge point: one coordinate free
+            Vec3f away{};  // outward at t: along each face's normal there, a little or a lot
+            for (int a = 0; a < 3; ++a) {
+                float& c = a == 0 ? t.x : a == 1 ? t.y : t.z;
+                float& w = a == 0 ? away.x : a == 1 ? away.y : away.z;
+                if (a == free_axis) {
+                    c = u(rng);
+                    w = u(rng);
+                } else {
+                    w = c * (i % 7 == 0 ? 1e-3f : 0.05f + std::fabs(u(rng)));
+                }
+            }
+            const Vec3f o = t + away * (2.f + 2.f * u(rng));
+            out.add(o, t - o);
+        }
+        check_all_hit(cube, out, 1.0001f);
+    }
+}
+
+TEST_CASE("meshes: the per-object box of the flat kernels never changes a hit, at a flat mesh's border included") {
+    // A flat square (axis-aligned, its box has no thickness) and a cube, placed by a scale and
+    // a move, with and without a rotation: rays from both sides aimed exactly at border points (corners, edge points) and at
+    // random points, many at grazing angles. The box test before each mesh's walk must give
+    // the same hits, distances and triangles as the walk alone, on every level.
+    const MeshData square{{-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, {0, 1, 2, 0, 2, 3}};
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const glm::dmat4 moved = glm::translate(glm::dmat4(1.0), glm::dvec3(0.3, -1.7, 2.1)) *
+                             glm::scale(glm::dmat4(1.0), glm::dvec3(1.5, 0.7, 2.0));
+    const glm::dmat4 turned = moved * glm::rotate(glm::dmat4(1.0), 0.7, glm::normalize(glm::dvec3(1, 2, 3)));
+    for (const auto& [d, md] : {std::pair{square, moved}, std::pair{square, turned}, std::pair{cube_mesh(1), moved},
+                                std::pair{cube_mesh(1), turned}}) {
+        const auto mesh = build(d);
+        Scene s;
+        add_mesh_object(s, mesh, md);
+        s.camera.look_at = true;  // the engine's origin (the eye) at the world's
+        s.camera.eye = {0.0, 0.0, 0.0};
+        s.camera.look = {0.0, 0.0, -1.0};
+        accel::AccelConfig flat;
+        flat.mode = accel::AccelMode::Flat;
+        const StreamScene sc(s, flat);
+        const ObjectXf* group = sc.groups[int(ShapeKind::Mesh)].data();
+        const ObjectBounds* box = sc.group_bounds[int(ShapeKind::Mesh)].data();
+        REQUIRE(sc.group_bounded[int(ShapeKind::Mesh)]);
+        // In packets of 16 rays that share which of their target's coordinates sit on the
+        // border, and on which side (the box is tested per packet: a packet is left out only
+        // when all its rays miss the box).
+        const bool flat_mesh = d.positions.size() == 12;
+        Rays r;
+        for (int packet = 0; packet < 2000; ++packet) {
+            const int on_border = packet % (flat_mesh ? 3 : 4);  // 0 - 2 coordinates (3 on the cube)
+            const glm::dvec3 side(rng() % 2 ? 1.0 : -1.0, rng() % 2 ? 1.0 : -1.0, rng() % 2 ? 1.0 : -1.0);
+            const bool grazing = packet % 5 == 0;  // nearly along the square's plane
+            for (int k = 0; k < 16; ++k) {
+                glm::dvec3 p(u(rng), u(rng), flat_mesh ? 0.0 : u(rng));
+                for (int a = 0; a < on_border; ++a) p[a] = side[a];
+                const glm::dvec3 target = glm::dvec3(md * glm::dvec4(p, 1.0));
+                glm::dvec3 from(u(rng), u(rng), u(rng));
+                if (grazing) from.z *= 1e-3;
+                const glm::dvec3 o =
+                    glm::dvec3(md * glm::dvec4(p + glm::normalize(from) * (0.5 + 2.0 * std::fabs(u(rng))), 1.0));
+                r.add(Vec3f{float(o.x), float(o.y), float(o.z)},
+                      Vec3f{float(target.x - o.x), float(target.y - o.y), float(target.z - o.z)});
+            }
+        }
+        for (Isa isa : {Isa::Sse2, Isa::Sse42, Isa::Avx2, Isa::Avx512}) {
+            if (!isa_supported(isa)) continue;
+            const std::string isa_str = isa_name(isa);
+            CAPTURE(isa_str);
+            const KernelTable& kt = kernel_table(isa);
+            RayStream walk, culled;
+            fill(walk, r, 1.01f);
+            fill(culled, r, 1.01f);
+            AlignedVec<std::int32_t> id_w(walk.capacity(), -1), id_c(walk.capacity(), -1);
+            AlignedVec<std::int32_t> prim_w(walk.capacity(), -1), prim_c(walk.capacity(), -1);
+            AlignedVec<float> bu(walk.capacity()), bv(walk.capacity());
+            RayView vw = view_of(walk), vc = view_of(culled);
+            vw.prim = prim_w.data(), vc.prim = prim_c.data();
+            vw.bu = vc.bu = bu.data(), vw.bv = vc.bv = bv.data();
+            kt.closest[int(ShapeKind::Mesh)](vw, id_w.data(), group, 1);
+            kt.closest_culled[int(ShapeKind::Mesh)](vc, id_c.data(), group, box, 1);
+            std::size_t hits = 0, differ = 0;
+            for (std::size_t i = 0; i < walk.count; ++i) {
+                hits += id_w[i] == 0;
+                differ += id_w[i] != id_c[i] || walk.t_max[i] != culled.t_max[i] || prim_w[i] != prim_c[i];
+            }
+            CHECK(hits > walk.count / 2);
+            CHECK(differ == 0);
+            RayStream sw, sc2;
+            fill(sw, r, 1.01f);
+            fill(sc2, r, 1.01f);
+            kt.any[int(ShapeKind::Mesh)](view_of(sw), group, 1);
+            kt.any_culled[int(ShapeKind::Mesh)](view_of(sc2), group, box, 1);
+            std::size_t blocked_differ = 0;
+            for (std::size_t i = 0; i < sw.count; ++i) blocked_differ += (sw.t_max[i] == 0.f) != (sc2.t_max[i] == 0.f);
+            CHECK(blocked_differ == 0);
+        }
     }
 }
 
