@@ -317,9 +317,10 @@ TEST_CASE("meshes: a closed cube mesh: 1e5 random rays from inside all hit (doub
 
 TEST_CASE("meshes: the per-object box of the flat kernels never changes a hit, at a flat mesh's border included") {
     // A flat square (axis-aligned, its box has no thickness) and a cube, placed by a scale and
-    // a move, with and without a rotation: rays from both sides aimed exactly at border points (corners, edge points) and at
-    // random points, many at grazing angles. The box test before each mesh's walk must give
-    // the same hits, distances and triangles as the walk alone, on every level.
+    // a move, with and without a rotation: rays from both sides aimed exactly at border points
+    // (corners, edge points) and at random points, many at grazing angles. The box test before
+    // each mesh's walk must give the same hits, distances and triangles as the walk alone, on
+    // every level.
     const MeshData square{{-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, {0, 1, 2, 0, 2, 3}};
     std::mt19937 rng(23);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
