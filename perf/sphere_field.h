@@ -12,6 +12,7 @@
 #include "kernels/accel_kernel_table.h"
 #include "kernels/kernel_table.h"
 #include "kernels/ray_stream.h"
+#include "parallel/pixel_order.h"
 #include "render/camera_rays.h"
 #include "scene/scene.h"
 #include "scene/scene_bvh.h"
@@ -69,8 +70,9 @@ inline Scene random_spheres(std::size_t n, std::vector<SphereRec>* out = nullptr
     return s;
 }
 
-/// The field's rays in the stream engine's order, chunks of 4096 (16 tiles of 16x16 pixels):
-/// camera rays through the pixel centres; at each camera ray's hit (the plane or a sphere, found
+/// The field's rays in the stream engine's order, chunks of 4096 (16 tiles of 16x16 pixels,
+/// each tile's pixels in Z order, as the engine hands them where rays walk the object tree:
+/// parallel/pixel_order.h): camera rays through the pixel centres; at each camera ray's hit (the plane or a sphere, found
 /// by the stream's hierarchy `sa`), in the same order, a mirror-reflected ray and a shadow ray
 /// to the first light.
 struct SphereRays {
@@ -85,10 +87,15 @@ inline SphereRays sphere_rays(const Scene& s, const std::vector<SphereRec>& sph,
     constexpr std::size_t kChunk = 4096;
     SphereRays out;
     std::vector<std::pair<int, int>> order;
-    for (int ty = 0; ty < H; ty += 16)
-        for (int tx = 0; tx < W; tx += 16)
-            for (int y = ty; y < std::min(H, ty + 16); ++y)
-                for (int x = tx; x < std::min(W, tx + 16); ++x) order.push_back({x, y});
+    for (int ty = 0; ty < H; ty += kTileSize)
+        for (int tx = 0; tx < W; tx += kTileSize) {
+            const Tile tile{tx, ty, std::min(W, tx + kTileSize), std::min(H, ty + kTileSize)};
+            std::uint32_t local[kTileSize * kTileSize];
+            const int n = z_order_pixels(tile, local);
+            for (int k = 0; k < n; ++k)
+                order.push_back({tx + int(local[k] % std::uint32_t(tile.width())),
+                                 ty + int(local[k] / std::uint32_t(tile.width()))});
+        }
     for (std::size_t c = 0; c < order.size(); c += kChunk) {
         RayStream r;
         const std::size_t m = std::min(kChunk, order.size() - c);
