@@ -175,6 +175,51 @@ void for_each_pixel(const TileTallies& t, const float* corner_rgb, int w, F&& f)
         }
 }
 
+/// Round 1's tallies of a tile whose pixels all stand at their corners (a corner round 0): the
+/// pixels the neighbour rule sends on (their own flag in `above_image`, the whole image's, or
+/// one of their eight neighbours') get a tally from their corners, in pixel order; `t` keeps
+/// its vectors' memory from tile to tile.
+void start_round_one(TileTallies& t, const std::uint8_t* above_image, const float* corner_rgb, int w, int h) {
+    static thread_local std::vector<std::uint8_t> near;
+    near.resize(std::size_t(t.tile.width()) * std::size_t(t.tile.height()));
+    mark_spread({0, 0, w, h}, above_image, t.tile, near);
+    const std::size_t taking = std::size_t(std::count_if(near.begin(), near.end(), [](std::uint8_t v) { return v != 0; }));
+    t.tallies.clear(), t.pixel.clear(), t.spread_near.clear(), t.took_last.clear();
+    t.tallies.reserve(taking), t.pixel.reserve(taking), t.spread_near.reserve(taking);
+    const std::size_t row = std::size_t(w) + 1;
+    std::uint32_t p = 0;
+    for (int y = t.tile.y0; y < t.tile.y1; ++y)
+        for (int x = t.tile.x0; x < t.tile.x1; ++x, ++p)
+            if (near[p]) {
+                t.tallies.push_back(corner_tally(corner_rgb, row, std::size_t(y) * row + std::size_t(x)));
+                t.pixel.push_back(p);
+                t.spread_near.push_back(1);
+            }
+}
+
+/// A tile's pixels once its rounds are over: the means into `image`, the sample counts and
+/// standard errors into `map` (when not null); returns the tile's sum of samples and adds its
+/// pixels' shares of the image's squared error to `error`.
+double finish_tile(const TileTallies& t, const float* corner_rgb, int w, Framebuffer& image, Framebuffer* map,
+                   double& error) {
+    double n = 0;
+    error = 0;
+    for_each_pixel(t, corner_rgb, w, [&](int x, int y, const auto& tally) {
+        const ColorT<double> mean = tally.mean();
+        float* px = image.pixel(x, y);
+        px[0] = float(mean.x), px[1] = float(mean.y), px[2] = float(mean.z);
+        if (map) {
+            float* m = map->pixel(x, y);
+            m[0] = float(tally.n);
+            m[1] = float(tally.standard_error());
+            m[2] = 0.f;
+        }
+        n += tally.n;
+        error += tally.image_error_squared();
+    });
+    return n;
+}
+
 }  // namespace
 
 void render_adaptive_tile(PreparedRender& prepared, const Tile& tile, float* rgb, RayCounts& counts,
@@ -242,6 +287,17 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     std::vector<int> order(tiles.size());
     for (std::size_t k = 0, stride = interleave_stride(order.size()); k < order.size(); ++k)
         order[k] = int((k * stride) % order.size());
+
+    Framebuffer image = Framebuffer::uninitialized(w, h);
+    // The sample map only when someone reads it: a second image of the picture's size, whose
+    // first touch of every page is paid on the render's clock.
+    const bool keep_map = prepared.keep_sample_map;
+    Framebuffer map = keep_map ? Framebuffer::uninitialized(w, h) : Framebuffer{};
+    std::vector<double> tile_samples(tiles.size());  // summed in tile order after: the same for any -j
+    // Nothing to stop at between rounds (no image target, no clock) after a corner round: each
+    // tile runs its rounds and is finished in one go (the r == 1 step below).
+    const bool fused = corners_first && stop.target_error <= 0 && stop.time_limit <= 0;
+    bool fused_done = false;
 
     AdaptiveSummary summary;
     // The image's estimated RMSE from each tile's sum of its pixels' shares: the tiles' sums
@@ -319,6 +375,34 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                     above_image[std::size_t(y) * std::size_t(w) + std::size_t(x)] = prepared.adaptive.above(p.scaled_variance(), p.n);
                 });
             });
+            if (fused) {
+                // Each tile from its round 1 to its end, then its pixels, in one go on one thread:
+                // its tallies live in that thread's scratch (reused from tile to tile: no fresh
+                // pages for them, no second pass over the image), and the results are the same
+                // as the rounds' loop below and the final pass give.
+                lap(phases.neighbour_rule);
+                std::atomic<int> last_round{0};
+                par.for_each_index(order.size(), 1, [&](std::size_t k) {
+                    const std::size_t i = std::size_t(order[k]);
+                    static thread_local TileTallies t;
+                    t.tile = tiles[i].tile;
+                    t.tallies.clear(), t.pixel.clear(), t.spread_near.clear(), t.took_last.clear();
+                    RayCounts counts;
+                    if (!(progress && progress->cancelled())) {
+                        start_round_one(t, above_image.data(), corner_rgb.data(), w, h);
+                        for (int q = 1; refine(prepared, q, t, counts, progress) > 0; ++q)
+                            for (int seen = last_round.load(); seen < q && !last_round.compare_exchange_weak(seen, q);) {
+                            }
+                    }
+                    // A tile the cancel skipped has no tallies: its pixels keep their corners' means.
+                    tile_samples[i] = finish_tile(t, corner_rgb.data(), w, image, keep_map ? &map : nullptr, tile_error[i]);
+                    if (progress) progress->add_rays(counts);
+                });
+                if (last_round > 0) summary.rounds = last_round + 1;
+                lap(phases.rounds);
+                fused_done = true;
+                break;
+            }
             par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
                 TileTallies& t = tiles[i];
                 if (!corners_first) {
@@ -326,20 +410,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                     return;
                 }
                 // The pixels that take round 1 get their tallies, from their corners.
-                static thread_local std::vector<std::uint8_t> near;
-                near.resize(std::size_t(t.tile.width()) * std::size_t(t.tile.height()));
-                mark_spread({0, 0, w, h}, above_image.data(), t.tile, near);
-                const std::size_t taking = std::size_t(std::count_if(near.begin(), near.end(), [](std::uint8_t v) { return v != 0; }));
-                t.tallies.reserve(taking), t.pixel.reserve(taking), t.spread_near.reserve(taking);
-                const std::size_t row = std::size_t(w) + 1;
-                std::uint32_t p = 0;
-                for (int y = t.tile.y0; y < t.tile.y1; ++y)
-                    for (int x = t.tile.x0; x < t.tile.x1; ++x, ++p)
-                        if (near[p]) {
-                            t.tallies.push_back(corner_tally(corner_rgb.data(), row, std::size_t(y) * row + std::size_t(x)));
-                            t.pixel.push_back(p);
-                            t.spread_near.push_back(1);
-                        }
+                start_round_one(t, above_image.data(), corner_rgb.data(), w, h);
             });
             lap(phases.neighbour_rule);
         }
@@ -377,31 +448,12 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
         if (stop.target_error > 0 && estimated_rmse() <= stop.target_error) break;
     }
 
-    Framebuffer image = Framebuffer::uninitialized(w, h);
-    // The sample map only when someone reads it: a second image of the picture's size, whose
-    // first touch of every page is paid on the render's clock.
-    const bool keep_map = prepared.keep_sample_map;
-    Framebuffer map = keep_map ? Framebuffer::uninitialized(w, h) : Framebuffer{};
-    std::vector<double> tile_samples(tiles.size());  // summed in tile order after: the same for any -j
-    par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
-        double n = 0, error = 0;
-        for_each_pixel(tiles[i], corner_rgb.data(), w, [&](int x, int y, const auto& tally) {
-            const ColorT<double> mean = tally.mean();
-            float* px = image.pixel(x, y);
-            px[0] = float(mean.x), px[1] = float(mean.y), px[2] = float(mean.z);
-            if (keep_map) {
-                float* m = map.pixel(x, y);
-                m[0] = float(tally.n);
-                m[1] = float(tally.standard_error());
-                m[2] = 0.f;
-            }
-            n += tally.n;
-            error += tally.image_error_squared();
+    if (!fused_done) {
+        par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
+            tile_samples[i] = finish_tile(tiles[i], corner_rgb.data(), w, image, keep_map ? &map : nullptr, tile_error[i]);
         });
-        tile_samples[i] = n;
-        tile_error[i] = error;
-    });
-    lap(phases.final_pass);
+        lap(phases.final_pass);
+    }
     double samples = 0;  // camera rays: a corner is traced once for the four pixels it bounds
     if (corners_first) samples = double(w + 1) * double(h + 1) - double(kFirstRoundSamples) * double(w) * double(h);
     for (const double n : tile_samples) samples += n;

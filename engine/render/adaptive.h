@@ -251,7 +251,10 @@ struct AdaptiveRule {
 
 /// Where a whole-image adaptive render spent its wall time (driver/adaptive_render.cpp), for
 /// --profile: the corner round, the neighbour rule (each pixel's corners against T, then its
-/// eight neighbours'), the later rounds, and the final pass (means, sample map, error).
+/// eight neighbours'), the later rounds, and the final pass (means, sample map, error). When
+/// nothing stops the render between rounds (no image target, no clock), each tile looks at its
+/// neighbours, runs its rounds and writes its pixels in one go: that is all `rounds`, the
+/// neighbour rule is the flags alone and the final pass 0.
 struct AdaptivePhases {
     double corners = 0, neighbour_rule = 0, rounds = 0, final_pass = 0;
 };

@@ -358,6 +358,28 @@ TEST_CASE("adaptive: the same picture and sample counts for -j1, -j2 and tile by
     }
 }
 
+TEST_CASE("adaptive: each tile's rounds run to its end in one go give the round-by-round loop's picture, map and estimate") {
+    // With nothing to stop at between rounds, each tile runs its rounds and is finished at once
+    // (render_adaptive_image's fused step); a time limit or an image target that is never
+    // reached keeps the loop that waits for every tile at the end of each round.
+    const Scene sc = adaptive_scene(0.004);
+    for (EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
+        CAPTURE(engine_name(engine));
+        const RenderResult fused = render(sc, engine, 2);
+        for (const AdaptiveStop& stop : {AdaptiveStop{.time_limit = 1e6}, AdaptiveStop{.target_error = 1e-12}}) {
+            const RenderResult looped = render(sc, engine, 2, stop);
+            REQUIRE(looped.adaptive);
+            CHECK(!looped.adaptive->time_limited);
+            CHECK(fused.image.rgb == looped.image.rgb);
+            CHECK(fused.sample_map.rgb == looped.sample_map.rgb);
+            CHECK(fused.adaptive->rounds == looped.adaptive->rounds);
+            CHECK(fused.adaptive->mean_spp == looped.adaptive->mean_spp);
+            CHECK(fused.adaptive->estimated_rmse == looped.adaptive->estimated_rmse);
+            CHECK(fused.counts.total() == looped.counts.total());
+        }
+    }
+}
+
 TEST_CASE("adaptive: tile by tile on a scene with a mesh, the whole image's picture bit for bit") {
     // A corner is traced in one packet by the whole image and in another by a tile alone; a
     // mesh hit that depended on the packet's other rays (the watertight test's double
