@@ -54,6 +54,12 @@ bool write_atomically(const std::string& path, const std::atomic<bool>* cancel, 
     return true;
 }
 
+void allocate_ahead(int fd, std::uint64_t offset, std::uint64_t bytes) {
+    if (bytes == 0) return;
+    // An error (EOPNOTSUPP on file systems without it, ENOSPC) is left to the write that follows.
+    (void)::fallocate(fd, FALLOC_FL_KEEP_SIZE, off_t(offset), off_t(bytes));
+}
+
 void write_all(int fd, std::span<const iovec> pieces) {
     std::vector<iovec> rest(pieces.begin(), pieces.end());
     std::size_t i = 0;

@@ -1,6 +1,7 @@
 #include "image/image_io.h"
 
 #include <algorithm>
+#include <cstdint>
 
 #include "core/error.h"
 #include "image/format_util.h"
@@ -31,7 +32,17 @@ bool write_image(const std::string& path, const Framebuffer& fb, const Display& 
     if (fb.width <= 0 || fb.height <= 0) throw RenderError("cannot encode an empty image");
     return write_atomically(path, options.cancel, [&](int fd) {
         if (format->write_file) return format->write_file(fd, path, fb, display, options);
-        return encode_image(fb, *format, display, [fd](std::span<const iovec> p) { write_all(fd, p); }, options);
+        std::uint64_t at = 0;  // bytes written so far
+        return encode_image(
+            fb, *format, display,
+            [fd, &at](std::span<const iovec> pieces) {
+                std::uint64_t n = 0;
+                for (const iovec& v : pieces) n += v.iov_len;
+                allocate_ahead(fd, at, n);
+                write_all(fd, pieces);
+                at += n;
+            },
+            options);
     });
 }
 

@@ -2,13 +2,20 @@
 // replacement. The display colour chain and EXR: display_test.cpp.
 #include <doctest/doctest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <cstdint>
 #include <limits>
+#include <string>
 
 #include "core/error.h"
+#include "image/atomic_file.h"
 #include "image/image_compare.h"
 #include "image/image_io.h"
 #include "parallel/parallelism.h"
@@ -191,6 +198,35 @@ TEST_CASE("PPM and PFM larger than one write chunk keep every row in place") {
         else CHECK(as_bytes(back) == expected_bytes(fb, Calibration::Clamp));
         fs::remove(p);
     }
+}
+
+TEST_CASE("blocks allocated ahead of the writes: the file's size stays its bytes, nothing beyond its end") {
+    const fs::path p = temp_file("ahead.bin");
+    {
+        const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        REQUIRE(fd >= 0);
+        allocate_ahead(fd, 0, 1 << 20);
+        struct stat st {};
+        REQUIRE(::fstat(fd, &st) == 0);
+        CHECK(st.st_size == 0);  // the size is the bytes written, none yet
+        if (st.st_blocks == 0) MESSAGE("this file system does not allocate ahead (fallocate)");
+        else CHECK(std::uint64_t(st.st_blocks) * 512 >= (1u << 20));
+        ::close(fd);
+    }
+    // A PPM of two write chunks over a larger file: its own size, its own bytes, and no
+    // blocks left allocated past its end.
+    const Framebuffer big = gradient(1200, 1400), fb = gradient(1000, 1400);
+    const fs::path ppm = temp_file("ahead.ppm");
+    write_image(ppm, big, Display::raw(Calibration::Clamp));
+    write_image(ppm, fb, Display::raw(Calibration::Clamp));
+    const std::uint64_t size = std::string("P6\n1000 1400\n255\n").size() + 1000ull * 1400 * 3;
+    CHECK(fs::file_size(ppm) == size);
+    CHECK(as_bytes(read_image(ppm)) == expected_bytes(fb, Calibration::Clamp));
+    struct stat st {};
+    REQUIRE(::stat(ppm.c_str(), &st) == 0);
+    CHECK(std::uint64_t(st.st_blocks) * 512 <= (size + 4095) / 4096 * 4096 + 4096);
+    fs::remove(p);
+    fs::remove(ppm);
 }
 
 TEST_CASE("the file's bytes are the same at -j1 and -j2") {
