@@ -72,9 +72,9 @@ inline Scene random_spheres(std::size_t n, std::vector<SphereRec>* out = nullptr
 
 /// The field's rays in the stream engine's order, chunks of 4096 (16 tiles of 16x16 pixels,
 /// each tile's pixels in Z order, as the engine hands them where rays walk the object tree:
-/// parallel/pixel_order.h): camera rays through the pixel centres; at each camera ray's hit (the plane or a sphere, found
-/// by the stream's hierarchy `sa`), in the same order, a mirror-reflected ray and a shadow ray
-/// to the first light.
+/// parallel/pixel_order.h): camera rays through the pixel centres; at each camera ray's hit
+/// (the plane or a sphere, found by the stream's hierarchy `sa`), in the same order, a
+/// mirror-reflected ray and a shadow ray to the first light.
 struct SphereRays {
     std::vector<RayStream> primary, reflected;
     std::vector<ShadowStream> shadow;

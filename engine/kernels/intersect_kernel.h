@@ -195,7 +195,8 @@ void mesh_any_impl(RayView rays, const ObjectXf* objs, const ObjectBounds* bound
         if (bounds) inv = {B(1.f) / r.d.x, B(1.f) / r.d.y, B(1.f) / r.d.z};
         for (std::size_t k = 0; k < n_objs && xsimd::any(open); ++k) {
             if (!objs[k].mesh) continue;
-            if (bounds && !packet_meets_box<B, float>(r, inv, bounds[k], xsimd::select(open, t_max, B(0.f)))) continue;
+            // Closed lanes already hold t_max <= 0 (set below, or inert from the start).
+            if (bounds && !packet_meets_box<B, float>(r, inv, bounds[k], t_max)) continue;
             const RayPacket<B> c = to_canonical<B, float>(r, objs[k]);
             open = open && !mesh_any_packet(*objs[k].mesh, c.o, c.d, t_max, open, objs[k].mesh->single_ray_lanes);
             t_max = xsimd::select(open, t_max, B(0.f));
