@@ -11,7 +11,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "kernels/kernel_table.h"
@@ -125,6 +127,35 @@ inline Streams make_streams(const Mesh& mesh, const KernelTable& kt, const Objec
     s.glass.pad();
     s.diffuse.pad();
     return s;
+}
+
+/// The same mesh with every packet handed to the single-ray walk at the root, and the
+/// transform `xf` pointed at it.
+struct SingleRayMesh {
+    std::shared_ptr<const Mesh> mesh;
+    ObjectXf xf;
+    SingleRayMesh(const Mesh& m, const ObjectXf& object) : mesh(m.with_single_ray_lanes(16)), xf(object) {
+        xf.mesh = &mesh->view();
+    }
+};
+
+/// One of the five ray sets, with its name and whether it is an any-hit (shadow) set.
+struct RaySet {
+    const char* name;
+    const Stream* st;
+    bool any;
+};
+
+/// The ray sets in table order; `only` ("primary,shadow" ...; empty: all) keeps those it names.
+inline std::vector<RaySet> ray_sets(const Streams& s, const std::string& only) {
+    std::vector<RaySet> kinds;
+    for (const RaySet& k : {RaySet{"primary", &s.primary, false}, RaySet{"shadow", &s.shadow, true},
+                             RaySet{"mirror", &s.mirror, false}, RaySet{"glass", &s.glass, false},
+                             RaySet{"diffuse", &s.diffuse, false}})
+        if (only.empty() || std::string(",").append(only).append(",").find(std::string(",").append(k.name).append(",")) !=
+                                std::string::npos)
+            kinds.push_back(k);
+    return kinds;
 }
 
 /// Median seconds of `reps` runs of fn().

@@ -254,10 +254,7 @@ int main(int argc, char** argv) {
             if (q != "medium" && q != "high") return std::fprintf(stderr, "--quality: medium or high\n"), 2;
             quality = q == "high" ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
         } else if (a == "--rays" && i + 1 < argc) {
-            // Appended piece by piece: GCC 12's -Wrestrict misreads "," + std::string(...) + ",".
-            only = ",";
-            only += argv[++i];
-            only += ",";
+            only = argv[++i];
         } else if (a == "--shuffle") {
             shuffle = true;
         } else if (a == "--spheres" && i + 1 < argc) {
@@ -313,24 +310,13 @@ int main(int argc, char** argv) {
                     shuffle ? ", rays in a random order" : "");
         std::printf("%-8s %9s %10s %10s %10s %7s %10s   %s\n", "rays", "count", "Embree16", "Embree1", "streamrt", "ratio",
                     "single", "hits: Embree16 / Embree1 / streamrt");
-        // The same mesh with every packet handed to the single-ray walk at the root.
-        const std::shared_ptr<const Mesh> single = mesh->with_single_ray_lanes(16);
-        ObjectXf xf_single = xf;
-        xf_single.mesh = &single->view();
-        struct Kind {
-            const char* name;
-            const Stream* st;
-            bool any;
-        };
-        for (const Kind& k : {Kind{"primary", &s.primary, false}, Kind{"shadow", &s.shadow, true},
-                              Kind{"mirror", &s.mirror, false}, Kind{"glass", &s.glass, false},
-                              Kind{"diffuse", &s.diffuse, false}}) {
-            if (!only.empty() && only.find("," + std::string(k.name) + ",") == std::string::npos) continue;
+        const SingleRayMesh single(*mesh, xf);
+        for (const RaySet& k : ray_sets(s, only)) {
             const Result e16 = embree16(scene, *k.st, k.any, reps);
             const Result e1 = embree1(scene, *k.st, k.any, reps);
             std::size_t hits = 0;
             const double ours = mrays(*k.st, k.any, kt, xf, reps, &hits);
-            const double ours_single = mrays(*k.st, k.any, kt, xf_single, reps);
+            const double ours_single = mrays(*k.st, k.any, kt, single.xf, reps);
             std::printf("%-8s %9zu %10.2f %10.2f %10.2f %6.2fx %10.2f   %zu / %zu / %zu\n", k.name, k.st->count,
                         e16.mrays, e1.mrays, ours, ours / e16.mrays, ours_single, e16.hits, e1.hits, hits);
             std::fflush(stdout);
