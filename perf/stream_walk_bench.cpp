@@ -5,7 +5,10 @@
 //   stream_walk_bench [--reps N] [--rays primary,shadow,mirror,glass,diffuse] [--shuffle] [--chunk N] MESH.{obj,ply} ...
 //
 // --chunk N walks each stream as consecutive pieces of N rays, one walk each (a renderer's
-// streams are a tile's rays of one generation, not the whole picture's).
+// streams are a tile's rays of one generation, not the whole picture's). --inside K adds K
+// generations of rays reflected inside the mesh, from the glass rays on (what a glass mesh's
+// deep rays do between its faces; "inside 1" are the glass rays' reflections at the faces they
+// reach).
 // For each mesh and ray kind: Mrays/s of the engine's kernel (AVX-512) as the packet walk and
 // as the single-ray walk from the root, and of the stream walk (medians of N runs), the stream
 // walk over the faster of the two, its rays per node visit (how many rays share the node's
@@ -82,12 +85,34 @@ WalkResult time_stream_walk(const Mesh& mesh, const Stream& st, bool any, const 
     return out;
 }
 
+/// The rays of `in` that hit the mesh, reflected at their hits back into it (the face's normal
+/// turned to meet the ray, the origin 1e-4 off the face on the ray's side), in the same order.
+Stream reflect_inside(const Mesh& mesh, const Stream& in, const KernelTable& kt, const ObjectXf& xf) {
+    simd::AlignedVec<float> t(in.t_max), bu(t.size()), bv(t.size());
+    simd::AlignedVec<std::int32_t> id(t.size(), -1), prim(t.size(), -1);
+    RayView v = in.view(t.data());
+    v.prim = prim.data(), v.bu = bu.data(), v.bv = bv.data();
+    kt.closest[int(ShapeKind::Mesh)](v, id.data(), &xf, 1);
+    Stream out;
+    for (std::size_t i = 0; i < in.count; ++i) {
+        if (id[i] != 0) continue;
+        const Vec3f o{in.ox[i], in.oy[i], in.oz[i]}, d{in.dx[i], in.dy[i], in.dz[i]};
+        const float* q = &mesh.tri[9 * std::size_t(prim[i])];
+        Vec3f n = normalize(cross(Vec3f{q[3] - q[0], q[4] - q[1], q[5] - q[2]}, Vec3f{q[6] - q[0], q[7] - q[1], q[8] - q[2]}));
+        if (dot(n, d) > 0) n = -n;
+        out.add(o + t[i] * d + 1e-4f * n, d - 2.f * dot(d, n) * n, 1e30f);
+    }
+    out.pad();
+    return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     int reps = 5;
     bool shuffle = false;
     std::size_t chunk = 0;
+    int inside = 0;
     std::string only;
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
@@ -95,10 +120,11 @@ int main(int argc, char** argv) {
         if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
         else if (a == "--rays" && i + 1 < argc) only = argv[++i];
         else if (a == "--shuffle") shuffle = true;
+        else if (a == "--inside" && i + 1 < argc) inside = std::max(0, std::atoi(argv[++i]));
         else if (a == "--chunk" && i + 1 < argc) chunk = std::size_t(std::max(16, std::atoi(argv[++i])));
         else if (!a.empty() && a[0] == '-') {
             std::fprintf(stderr, "usage: stream_walk_bench [--reps N] [--rays primary,shadow,mirror,glass,diffuse] "
-                                 "[--shuffle] [--chunk N] MESH.{obj,ply} ...\n");
+                                 "[--shuffle] [--chunk N] [--inside K] MESH.{obj,ply} ...\n");
             return 2;
         } else files.push_back(a);
     }
@@ -122,15 +148,23 @@ int main(int argc, char** argv) {
         xf.m[0] = xf.m[5] = xf.m[10] = 1.f;
         xf.mesh = &mesh->view();
         Streams s = make_streams(*mesh, kt, xf, view_of_bounds(mesh->lo, mesh->hi));
-        if (shuffle)
+        std::vector<Stream> deep;  // reflected inside from the glass rays, generation by generation
+        for (int g = 0; g < inside; ++g) deep.push_back(reflect_inside(*mesh, g == 0 ? s.glass : deep.back(), kt, xf));
+        if (shuffle) {
             for (Stream* st : {&s.primary, &s.shadow, &s.mirror, &s.glass, &s.diffuse}) st->shuffle();
+            for (Stream& st : deep) st.shuffle();
+        }
+        std::vector<RaySet> sets = ray_sets(s, only);
+        std::vector<std::string> deep_names;
+        for (int g = 0; g < inside; ++g) deep_names.push_back("inside " + std::to_string(g + 1));
+        for (int g = 0; g < inside; ++g) sets.push_back({deep_names[std::size_t(g)].c_str(), &deep[std::size_t(g)], false});
         std::printf("\n%s: %zu triangles%s", file.c_str(), mesh->triangle_count(), shuffle ? ", rays in a random order" : "");
         if (chunk) std::printf(", walked %zu rays at a time", chunk);
         std::printf("\n");
         std::printf("%-8s %9s %10s %10s %10s %7s %12s %14s\n", "rays", "count", "packet", "single", "stream", "ratio",
                     "rays/node", "hits (differ)");
         const SingleRayMesh single(*mesh, xf);
-        for (const RaySet& k : ray_sets(s, only)) {
+        for (const RaySet& k : sets) {
             const double engine = mrays(*k.st, k.any, kt, xf, reps);
             const double engine_single = mrays(*k.st, k.any, kt, single.xf, reps);
             const WalkResult w = time_stream_walk(*mesh, *k.st, k.any, kt, xf, reps, chunk ? chunk : k.st->count);
