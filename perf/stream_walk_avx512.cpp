@@ -1,9 +1,8 @@
-// Whole-stream traversal (perf/stream_walk.h, perf/mesh_stream_walk.h), built with the AVX-512
-// flags of the kernels (engine/kernels/isa_flags.cmake), under a namespace of its own
-// (simd/isa_namespace.h).
+// Whole-stream traversal (perf/stream_walk.h) through the engine's own walk
+// (kernels/mesh_stream_kernel.h), built with the AVX-512 flags of the kernels
+// (engine/kernels/isa_flags.cmake), under a namespace of its own (simd/isa_namespace.h).
 #define STREAMRT_ISA_NAMESPACE perf_avx512
 #include "kernels/mesh_kernel.h"
-#include "mesh_stream_walk.h"
 
 #include "stream_walk.h"
 

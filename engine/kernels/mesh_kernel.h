@@ -452,3 +452,5 @@ inline M mesh_any_packet(const MeshView& m, const Vec3T<B>& o, const Vec3T<B>& d
 }
 
 }  // namespace streamrt::STREAMRT_ISA_NAMESPACE
+
+#include "kernels/mesh_stream_kernel.h"

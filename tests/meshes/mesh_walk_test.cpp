@@ -575,3 +575,84 @@ TEST_CASE("mesh walks: a ray through a shared edge takes the lower-numbered tria
         });
     }
 }
+
+TEST_CASE("mesh walks: rays of scattered packets walked as a whole stream get the packet walk's hits, bit for bit") {
+    // The AVX-512 closest-hit kernel walks the live rays of a stream's scattered packets whole
+    // (kernels/mesh_stream_kernel.h) once they are at least kStreamWalkRays and the stream asks
+    // for the hybrid (single_ray_lanes > 0). Rays from inside a closed tessellated ball in every
+    // direction (scattered packets), rays along +z through every vertex and edge midpoint of a
+    // flat grid behind it (ties between two or more triangles: the lower number wins), and idle
+    // lanes; two mesh objects, the grid after the ball, so a ray's hit on the first object
+    // stays when the second's is no nearer. The same stream with single_ray_lanes = 0 (packets
+    // only) is the reference: object, triangle, t and barycentrics the same to the bit.
+    if (!isa_supported(Isa::Avx512)) {
+        MESSAGE("no AVX-512 on this CPU: the whole-stream walk is not built for the others");
+        return;
+    }
+    const KernelTable& kt = kernel_table(Isa::Avx512);
+    MeshData ball_data;
+    {
+        // A UV ball of radius 1: 24 x 12 quads, two triangles each.
+        const int nu = 24, nv = 12;
+        for (int j = 0; j <= nv; ++j)
+            for (int i = 0; i <= nu; ++i) {
+                const double th = 3.14159265358979 * j / nv, ph = 2 * 3.14159265358979 * i / nu;
+                for (const double c : {std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)})
+                    ball_data.positions.push_back(float(c));
+            }
+        for (int j = 0; j < nv; ++j)
+            for (int i = 0; i < nu; ++i) {
+                const std::uint32_t a = std::uint32_t(j * (nu + 1) + i), b = a + 1, c = a + std::uint32_t(nu + 1), d = c + 1;
+                for (const std::uint32_t v : {a, c, d, a, d, b}) ball_data.triangles.push_back(v);
+            }
+    }
+    const auto ball = Mesh::build("ball", ball_data.positions, ball_data.triangles);
+    const int n = 8;
+    const auto grid = flat_grid(n);
+    ObjectXf objs[2] = {object_of(*ball), object_of(*grid)};
+    objs[0].id = 0, objs[1].id = 1;
+    // The grid sits at z = 3 in the world: its canonical space is shifted by -3 in z (Mi).
+    objs[1].m[11] = -3.f;
+    Case c;
+    std::mt19937 rng(11);
+    std::normal_distribution<float> g(0.f, 1.f);
+    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+    // Packets of 16: 12 rays from inside the ball in random directions (so every packet has
+    // scattered) and 4 along +z through the grid's vertices and edge midpoints, from behind the
+    // ball (ties).
+    std::vector<Vec3f> grid_points;
+    for (int j = 0; j <= 2 * n; ++j)
+        for (int i = 0; i <= 2 * n; ++i) grid_points.push_back({0.5f * float(i), 0.5f * float(j), 1.5f});
+    std::size_t ball_rays = 0, idle = 0, next_grid = 0;
+    for (int k = 0; next_grid < grid_points.size() || k % 16 != 0; ++k) {
+        if (k % 16 >= 12) {
+            c.o.push_back(grid_points[next_grid % grid_points.size()]);
+            next_grid += 1;
+            c.d.push_back({0.f, 0.f, 1.f});
+            c.t_max.push_back(1e30f);
+            continue;
+        }
+        c.o.push_back({0.3f * u(rng), 0.3f * u(rng), 0.3f * u(rng)});
+        c.d.push_back(normalize(Vec3f{g(rng), g(rng), g(rng)}));
+        const bool is_idle = ball_rays++ % 13 == 0;  // some idle lanes
+        idle += is_idle;
+        c.t_max.push_back(is_idle ? 0.f : 1e30f);
+    }
+    REQUIRE(c.o.size() >= 4 * 256);
+    Traced packets(c), streamed(c);
+    packets.view.single_ray_lanes = 0;
+    streamed.view.single_ray_lanes = kt.float_lanes;
+    kt.closest[int(ShapeKind::Mesh)](packets.view, packets.id.data(), objs, 2);
+    kt.closest[int(ShapeKind::Mesh)](streamed.view, streamed.id.data(), objs, 2);
+    std::size_t ball_hits = 0, grid_hits = 0, differ = 0;
+    for (std::size_t i = 0; i < c.o.size(); ++i) {
+        ball_hits += packets.id[i] == 0;
+        grid_hits += packets.id[i] == 1;
+        differ += packets.id[i] != streamed.id[i] || packets.prim[i] != streamed.prim[i] ||
+                  std::memcmp(&packets.rs.t_max[i], &streamed.rs.t_max[i], 4) != 0 ||
+                  std::memcmp(&packets.bu[i], &streamed.bu[i], 4) != 0 || std::memcmp(&packets.bv[i], &streamed.bv[i], 4) != 0;
+    }
+    CHECK(ball_hits == ball_rays - idle);  // every live ray from inside meets the ball
+    CHECK(grid_hits == next_grid);         // every grid ray, from beyond the ball, meets the grid
+    CHECK(differ == 0);
+}

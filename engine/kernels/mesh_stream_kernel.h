@@ -1,13 +1,14 @@
 #pragma once
-// The whole-stream mesh walk (AVX-512 only), for perf/stream_walk_bench: a list of rays walks a
-// mesh's 8-wide BVH at once. Each node is visited once with the list of the rays that reached
-// it, filtered 16 rays at a time (their data gathered) against the node's child boxes into one
-// list per child (compress-stores); the lists are walked depth first, the child nearest along
-// the list's first ray first; a leaf tests its triangles against its list 16 rays at a time.
-// The box test, the watertight triangle test and the tie rule are the engine's packet walk's
-// (kernels/mesh_kernel.h, included first under a per-level namespace), so every ray gets the
-// packet walk's hit to the bit, whatever the order of the work (docs/performance.md, "Whole
-// streams through the tree"). Raw buffers only, as in the kernel files.
+// The whole-stream mesh walk (AVX-512 only): a list of rays walks a mesh's 8-wide BVH at once.
+// Each node is visited once with the list of the rays that reached it, filtered 16 rays at a
+// time (their data gathered) against the node's child boxes into one list per child
+// (compress-stores); the lists are walked depth first, the child nearest along the list's first
+// ray first; a leaf tests its triangles against its list 16 rays at a time. The box test, the
+// watertight triangle test and the tie rule are the packet walk's (mesh_kernel.h), so every ray
+// gets the packet walk's hit to the bit, whatever the order of the work. It pays where rays have
+// lost their coherence and come by the hundred: the deep rays of a glass mesh
+// (docs/performance.md, "Whole streams through the tree"). Raw buffers only: the per-level
+// files touch no container code (intersect_kernel.h). Included by kernels/mesh_kernel.h.
 #if defined(__AVX512F__) && defined(__AVX512BW__)
 #include <immintrin.h>
 
