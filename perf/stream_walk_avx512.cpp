@@ -8,8 +8,6 @@
 
 namespace streamrt::perf {
 
-bool stream_walk_supported() { return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw"); }
-
 StreamWalkStats stream_walk(const MeshView& m, const StreamRays& r, bool any) {
     using namespace perf_avx512::mesh_detail;
     static thread_local RawBuffer<std::uint32_t> list, pool;

@@ -8,7 +8,7 @@
 // streams are a tile's rays of one generation, not the whole picture's). --inside K adds K
 // generations of rays reflected inside the mesh, from the glass rays on (what a glass mesh's
 // deep rays do between its faces; "inside 1" are the glass rays' reflections at the faces they
-// reach).
+// reach); `--rays none` leaves out the five usual sets.
 // For each mesh and ray kind: Mrays/s of the engine's kernel (AVX-512) as the packet walk and
 // as the single-ray walk from the root, and of the stream walk (medians of N runs), the stream
 // walk over the faster of the two, its rays per node visit (how many rays share the node's
@@ -107,6 +107,12 @@ Stream reflect_inside(const Mesh& mesh, const Stream& in, const KernelTable& kt,
 }
 
 }  // namespace
+
+// Here, in the file built for any x86-64, not in the AVX-512 one: it runs before anything knows
+// the CPU has those instructions.
+bool streamrt::perf::stream_walk_supported() {
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw");
+}
 
 int main(int argc, char** argv) {
     int reps = 5;
