@@ -64,8 +64,14 @@ struct ShadeJob {
     ShadeRules<float> rules;  ///< degree, ambient, whether children spawn, cut-off, cone spread
     // Outputs: the weighted local colour of each ray (indexed as `order`) ...
     float *lr, *lg, *lb;
-    // ... and the rays it spawns.
+    // ... and the rays it spawns: reflected children in `next`, refracted ones in
+    // `next_refracted` (a region of the same arrays that the stage joins after the last run),
+    // and shadow rays, whose `pixel` field holds their hit's run position: the stage adds an
+    // unblocked shadow ray's light to that hit's local colour, and the local colours into the
+    // pixels after the occlusion stage. A pixel's terms then come in an order that depends on
+    // its own rays alone (docs/architecture.md, "Sums in a fixed order").
     RayAppend next;
+    RayAppend next_refracted;
     ShadowAppend shadows;
     // Mesh objects only: the hit triangle and its barycentrics per ray (the slice's order); the
     // mesh and its smooth flag are the run's object's, or (gathered) each ray's object's.

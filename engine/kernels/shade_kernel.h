@@ -211,7 +211,7 @@ inline void append(const ShadeJob& job, std::size_t i, const M& active, const Ve
     using A = typename B::arch_type;
     const unsigned bits = lane_bits(active);
     if (bits == 0) return;
-    const RayAppend& r = job.next;
+    const RayAppend& r = kind == RayKind::Refracted ? job.next_refracted : job.next;
     const std::size_t j = *r.count;
     compress_store(o.x, bits, r.ox + j);
     compress_store(o.y, bits, r.oy + j);
@@ -241,6 +241,7 @@ struct SimdSink {
     using Mask = xsimd::batch_bool<float, typename B::arch_type>;
     const ShadeJob& job;
     std::size_t i;  ///< the packet's first ray in the run
+    xsimd::batch<std::int32_t, typename B::arch_type> positions;  ///< i + lane: the lanes' run positions
 
     void local(const ColorT<B>& c) const {
         c.x.store_unaligned(job.lr + i);
@@ -262,7 +263,8 @@ struct SimdSink {
         compress_store(c.x, bits, sa.cr + j);
         compress_store(c.y, bits, sa.cg + j);
         compress_store(c.z, bits, sa.cb + j);
-        *sa.count = j + compress_store(run_field<typename B::arch_type>(job, i, job.pixel), bits, sa.pixel + j);
+        // Not the pixel: the hit's run position (ShadeJob::shadows).
+        *sa.count = j + compress_store(positions, bits, sa.pixel + j);
     }
     void child(const Mask& send, const Vec3T<B>& from, const Vec3T<B>& dir, const ColorT<B>& weight, const ColorT<B>&,
                const B& cone, RayKind kind) const {
@@ -291,7 +293,9 @@ void shade_run(const ShadeJob& job) {
     const float* surface_floats = reinterpret_cast<const float*>(job.surfaces);
     const MaterialT<float>& m = *job.material;
     alignas(64) float lane_index[W];
-    for (std::size_t l = 0; l < W; ++l) lane_index[l] = float(l);
+    alignas(64) std::int32_t lane_number[W];
+    for (std::size_t l = 0; l < W; ++l) lane_index[l] = float(l), lane_number[l] = std::int32_t(l);
+    const I lane_numbers = I::load_aligned(lane_number);
     // Textures: the object's canonical units per world unit, once per run (gathered: per lane).
     const float run_scale = m.texture && !kGathered ? canonical_per_world<float>(ob.m) : -1.f;
     const B lanes = B::load_aligned(lane_index);
@@ -342,7 +346,7 @@ void shade_run(const ShadeJob& job) {
         } else if (m.vertex_colors && kind == ShapeKind::Mesh) {  // so do a mesh's vertex colours
             color = vertex_colors<B, kGathered>(job, i, color);
         }
-        SimdSink<B> sink{job, i};
+        SimdSink<B> sink{job, i, lane_numbers + I(std::int32_t(i))};
         // A smooth mesh's shadow rays start from its curved patch, not the flat triangle (one
         // branch per run; gathered, the flat lanes keep their point and a packet with no
         // smooth lane skips the shift).

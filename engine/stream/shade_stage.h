@@ -75,24 +75,19 @@ inline void add_runs(float* __restrict accum, const std::int32_t* __restrict pix
         a[0] = sr, a[1] = sg, a[2] = sb;
     }
 }
-/// accum[pixel[i]] += (cr, cg, cb)[i] for each unblocked shadow ray (t_max > 0), in order; a
-/// pixel's sum stays in registers until another pixel's ray comes (add_runs: the same bits).
-inline void add_unblocked(float* __restrict accum, const ShadowStream& s) {
+/// Shadow rays as the shade stage sends them (ShadeJob::shadows, ScalarSink): each unblocked
+/// one's colour (t_max > 0) added to its hit's local colour, `pixel` holding the hit's place
+/// in SortedHits::order; in stream order, where a hit's shadow rays come in light order.
+inline void add_unblocked_to_hits(float* __restrict lr, float* __restrict lg, float* __restrict lb,
+                                  const ShadowStream& s) {
     const float *__restrict t = s.t_max.data(), *__restrict r = s.cr.data(), *__restrict g = s.cg.data(),
                 *__restrict b = s.cb.data();
-    const std::int32_t* __restrict pixel = s.pixel.data();
-    std::int32_t held = -1;
-    ColorT<float> sum{};
+    const std::int32_t* __restrict hit = s.pixel.data();
     for (std::size_t i = 0; i < s.count; ++i) {
         if (!(t[i] > 0.f)) continue;
-        if (pixel[i] != held) {
-            if (held >= 0) store_sum(accum, held, sum);
-            held = pixel[i];
-            sum = load_sum(accum, held);
-        }
-        sum.x += r[i], sum.y += g[i], sum.z += b[i];
+        const std::size_t h = std::size_t(hit[i]);
+        lr[h] += r[i], lg[h] += g[i], lb[h] += b[i];
     }
-    if (held >= 0) store_sum(accum, held, sum);
 }
 inline std::uint64_t lanes_for(std::size_t n, int width) {
     return (std::uint64_t(n) + std::uint64_t(width) - 1) / std::uint64_t(width) * std::uint64_t(width);
@@ -118,8 +113,9 @@ struct ShadeStage {
                 .eye = {0.f, 0.f, 0.f}};  // the engine's origin is the eye (stream_scene.cpp)
     }
 
-    /// Where shade_hit's results go on the scalar path: the local colour into the tile,
-    /// shadow and child rays appended to their streams.
+    /// Where shade_hit's results go on the scalar path: the local colour into the tile (with
+    /// shadow rays, into the hit's place k of `hits`, to wait for its unblocked light as on
+    /// the SIMD path: add_shadowed_locals), shadow and child rays appended to their streams.
     struct ScalarSink {
         static constexpr bool kTestsShadowsNow = false;
         float* accum;
@@ -129,10 +125,15 @@ struct ShadeStage {
         RayCounts& counts;
         const std::uint32_t* keys;  ///< area lights only (else unread): the rays' keys
         std::size_t i;              ///< the ray shaded
+        SortedHits& hits;
+        std::size_t k;              ///< its place among the slice's hits (SortedHits::order)
 
         std::uint32_t light_key() const { return keys[i]; }
 
-        void local(const ColorT<float>& c) { stage_detail::add(accum, px, c); }
+        void local(const ColorT<float>& c) {
+            if constexpr (kShadows) hits.lr[k] = c.x, hits.lg[k] = c.y, hits.lb[k] = c.z;
+            else stage_detail::add(accum, px, c);
+        }
         void shadow(bool send, const Vec3f& from, const Vec3f& to, float t_max, const ColorT<float>& c) {
             if (!send) return;
             const std::size_t j = shadows.count++;
@@ -146,7 +147,7 @@ struct ShadeStage {
             shadows.cr[j] = c.x;
             shadows.cg[j] = c.y;
             shadows.cb[j] = c.z;
-            shadows.pixel[j] = px;
+            shadows.pixel[j] = std::int32_t(k);  // the hit's place, not the pixel
         }
         void child(bool send, const Vec3f& from, const Vec3f& dir, const ColorT<float>& weight, const ColorT<float>&,
                    float cone, RayKind kind) {
@@ -162,10 +163,12 @@ struct ShadeStage {
     /// and refracted rays appended to `next` (only surviving rays move on). Misses bring the
     /// background.
     static void shade(const StreamScene& sc, const RayStream& rays, const AlignedVec<std::int32_t>& object,
-                      const MeshHits& mesh_hits, int depth, RayStream& next, ShadowStream& shadows, float* accum,
-                      RayCounts& counts) {
+                      const MeshHits& mesh_hits, int depth, RayStream& next, ShadowStream& shadows, SortedHits& hits,
+                      float* accum, RayCounts& counts) {
         using namespace stage_detail;
         const ShadeRules<float> rules = shade_rules(sc, depth);
+        if constexpr (kShadows) hits.reserve(rays.count);
+        hits.hits = 0;
         // This path serves scenes with many objects, where each hit's records are likely
         // cache misses: fetch them a few rays ahead (in leaf order, neighbouring rays mostly
         // hit objects close in memory).
@@ -201,7 +204,9 @@ struct ShadeStage {
                                          ob.xf.param != 0.f)
                     : visit_shape(kind, [&](auto shape) { return shape.template normal<float>(pc, ob.xf.param); });
             const ArrivingRay<float> arriving{o, d, t, rays.cone[i], w, w};
-            ScalarSink sink{accum, px, next, shadows, counts, keys, i};
+            const std::size_t k = hits.hits;
+            if constexpr (kShadows) hits.order[k] = std::int32_t(i), ++hits.hits;
+            ScalarSink sink{accum, px, next, shadows, counts, keys, i, hits, k};
             const Vec3f n_out = apply_normal(ob.xf.m, nc);
             ColorT<float> color{sf.color[0], sf.color[1], sf.color[2]};
             if (m.texture) {  // the texture replaces the object's colour (render/texture.h)
@@ -304,9 +309,16 @@ struct ShadeStage {
             // Past the last run, whole packets read a hit (gathered runs read its object's id).
             std::fill_n(order + hits, simd::kMaxLanes, hits > 0 ? order[hits - 1] : 0);
         }
-        const std::size_t next_before = ws.next.count;
+        // The children's regions (ShadeJob::next, next_refracted): at most one ray per hit
+        // each, plus a packet of slack for the compacting stores.
+        const std::size_t region = simd::round_up_lanes(hits) + simd::kMaxLanes;
         RayStream& nx = ws.next;
         ShadowStream& sh = ws.shadows;
+        std::size_t refracted = 0;  // the refracted children's count (the reflected: nx.count)
+        if constexpr (kSecondary) {
+            nx.reserve(2 * region);
+            if (sc.features.area_lights) nx.reserve_keys();
+        }
         ShadeJob job{.ox = rays.ox.data(),
                      .oy = rays.oy.data(),
                      .oz = rays.oz.data(),
@@ -332,11 +344,13 @@ struct ShadeStage {
                      .lg = h.lg.data(),
                      .lb = h.lb.data(),
                      .next = append_view(nx),
+                     .next_refracted = region_view(nx, region, &refracted),
                      .shadows = append_view(sh),
                      .prim = ws.mesh_hits.prim.data(),
                      .bu = ws.mesh_hits.u.data(),
                      .bv = ws.mesh_hits.v.data()};
-        if (sc.features.area_lights) job.key = rays.key.data(), job.next.key = nx.key.data();
+        if (sc.features.area_lights)
+            job.key = rays.key.data(), job.next.key = nx.key.data(), job.next_refracted.key = nx.key.data() + region;
         const int variant = (kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0);
         const ShadeFn fn = gathered ? kt.shade_gathered[variant] : kt.shade[variant];
         if (gathered) {
@@ -359,13 +373,47 @@ struct ShadeStage {
             }
             fn(job);
         }
-        add_runs(accum, rays.pixel.data(), h.order.data(), h.lr.data(), h.lg.data(), h.lb.data(), hits);
+        h.hits = hits;
+        // With shadow rays the local colours wait for their unblocked light (add_shadowed_locals).
+        if constexpr (!kShadows) add_runs(accum, rays.pixel.data(), h.order.data(), h.lr.data(), h.lg.data(), h.lb.data(), hits);
         if constexpr (kSecondary) {
-            for (std::size_t j = next_before; j < nx.count; ++j) {
-                if (nx.kind[j] == std::uint8_t(RayKind::Reflected)) ++counts.reflected;
-                else ++counts.refracted;
-            }
+            counts.reflected += nx.count;
+            counts.refracted += refracted;
+            join_region(nx, region, refracted, sc.features.area_lights);
         }
+    }
+
+    /// The append view of `r`'s arrays from ray `from` on, counting into `count`.
+    static RayAppend region_view(RayStream& r, std::size_t from, std::size_t* count) {
+        RayAppend v = append_view(r);
+        for (float** a : {&v.ox, &v.oy, &v.oz, &v.dx, &v.dy, &v.dz, &v.t_max, &v.wr, &v.wg, &v.wb, &v.cone}) *a += from;
+        v.pixel += from;
+        v.kind += from;
+        v.count = count;
+        return v;
+    }
+    /// Appends rays [from, from + n) of `s` to its first s.count rays (from >= s.count: a
+    /// forward copy, overlap allowed).
+    static void join_region(RayStream& s, std::size_t from, std::size_t n, bool keys) {
+        if (n == 0) return;
+        const auto move = [&](auto& a) {
+            std::copy(a.begin() + std::ptrdiff_t(from), a.begin() + std::ptrdiff_t(from + n), a.begin() + std::ptrdiff_t(s.count));
+        };
+        for (auto* a : {&s.ox, &s.oy, &s.oz, &s.dx, &s.dy, &s.dz, &s.t_max, &s.wr, &s.wg, &s.wb, &s.cone}) move(*a);
+        move(s.pixel);
+        move(s.kind);
+        if (keys) move(s.key);
+        s.count += n;
+    }
+    /// After the occlusion stage: the unblocked shadow rays' light into their hits' local
+    /// colours, then the local colours into the pixels in SortedHits::order (runs on the SIMD
+    /// path, the stream on the scalar one). A pixel's sum thus takes each hit's whole local
+    /// colour (ambient, then its lights in order, as the recursive engine sums a hit) as one
+    /// term, whichever packets its hits shared.
+    static void add_shadowed_locals(Workspace& ws, const RayStream& rays, float* accum) {
+        SortedHits& h = ws.sorted;
+        stage_detail::add_unblocked_to_hits(h.lr.data(), h.lg.data(), h.lb.data(), ws.shadows);
+        stage_detail::add_runs(accum, rays.pixel.data(), h.order.data(), h.lr.data(), h.lg.data(), h.lb.data(), h.hits);
     }
 
     /// Gathered shading emits shadow rays run by run, (material, kind) after (material, kind):
@@ -373,17 +421,19 @@ struct ShadeStage {
     /// hierarchy walk of such packets cost 1.6x that of rays in pixel order (measured,
     /// docs/performance.md). A counting sort over the tile's pixels puts them back in pixel
     /// order (stable: a pixel's rays keep their light order).
-    static void order_shadows_by_pixel(Workspace& ws, std::size_t tile_pixels) {
+    static void order_shadows_by_pixel(Workspace& ws, const RayStream& rays, std::size_t tile_pixels) {
         ShadowStream& in = ws.shadows;
         ShadowStream& out = ws.shadows_in_pixel_order;
         const std::size_t n = in.count;
+        // A shadow ray's `pixel` is its hit's run position (ShadeJob::shadows).
+        const auto pixel_of = [&](std::size_t i) { return std::size_t(rays.pixel[std::size_t(ws.sorted.order[std::size_t(in.pixel[i])])]); };
         std::vector<std::uint32_t>& start = ws.slot;
         start.assign(tile_pixels + 1, 0);
-        for (std::size_t i = 0; i < n; ++i) ++start[std::size_t(in.pixel[i]) + 1];
+        for (std::size_t i = 0; i < n; ++i) ++start[pixel_of(i) + 1];
         for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
         out.reserve(n);
         for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t j = start[std::size_t(in.pixel[i])]++;
+            const std::size_t j = start[pixel_of(i)]++;
             out.ox[j] = in.ox[i], out.oy[j] = in.oy[i], out.oz[j] = in.oz[i];
             out.dx[j] = in.dx[i], out.dy[j] = in.dy[i], out.dz[j] = in.dz[i];
             out.t_max[j] = in.t_max[i];

@@ -148,10 +148,9 @@ struct PipelineStages {
         }
     }
 
-    /// occlusion: any-hit kernels per shape kind (early exit per packet), then the light of
-    /// every unblocked shadow ray goes into its pixel.
-    static void occlusion(const StreamScene& sc, const KernelTable& kt, ShadowStream& shadows, float* accum,
-                          StageFigures* fig) {
+    /// occlusion: any-hit kernels per shape kind (early exit per packet); the caller adds the
+    /// light of the unblocked shadow rays (trace_slice).
+    static void occlusion(const StreamScene& sc, const KernelTable& kt, ShadowStream& shadows, StageFigures* fig) {
         shadows.pad_tail();
         if (sc.accel) {  // the object hierarchy (stream/stream_accel.h)
             sc.accel->any(kt, view_of(shadows));
@@ -169,7 +168,6 @@ struct PipelineStages {
                 fig->lanes_total += stage_detail::lanes_for(shadows.count, shape_computes_in_double(ShapeKind(k)) ? kt.float_lanes / 2 : kt.float_lanes);
             }
         }
-        stage_detail::add_unblocked(accum, shadows);
     }
 
     /// What the stages of one chunk share.
@@ -216,11 +214,12 @@ struct PipelineStages {
             // Area lights send `samples` shadow rays each (StreamScene::shadow_rays_per_hit).
             if constexpr (kShadows) ws.shadows.reserve(rays.count * sc.shadow_rays_per_hit);
             if (c.shade_mode == ShadeMode::Scalar)
-                Shade::shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, c.accum, c.counts);
+                Shade::shade(sc, rays, ws.object, ws.mesh_hits, depth, ws.next, ws.shadows, ws.sorted, c.accum,
+                             c.counts);
             else
                 Shade::shade_sorted(sc, c.kt, rays, ws.object, depth, ws, c.accum, c.counts, c.shade_mode == ShadeMode::Gathered);
             if (kShadows && c.shade_mode == ShadeMode::Gathered)
-                Shade::order_shadows_by_pixel(ws, c.slots);
+                Shade::order_shadows_by_pixel(ws, rays, c.slots);
             if (c.profile) {
                 c.fig(Stage::Shade)->rays_in += rays.count;
                 c.fig(Stage::Shade)->rays_out += ws.next.count + (kShadows ? ws.shadows.count : 0);
@@ -229,7 +228,8 @@ struct PipelineStages {
         if constexpr (kShadows) {
             StageTimer timer(c.fig(Stage::Occlusion), gen ? &gen->occlusion_ns : nullptr);
             c.counts.shadow += ws.shadows.count;
-            occlusion(sc, c.kt, ws.shadows, c.accum, c.fig(Stage::Occlusion));
+            occlusion(sc, c.kt, ws.shadows, c.fig(Stage::Occlusion));
+            Shade::add_shadowed_locals(ws, rays, c.accum);
             if (c.profile) {
                 c.fig(Stage::Occlusion)->rays_in += ws.shadows.count;
                 gen->shadow_rays += ws.shadows.count;

@@ -17,6 +17,7 @@ struct SortedHits {
     AlignedVec<std::int32_t> order;      ///< run order -> the hit's index in the slice (ShadeJob::order)
     std::vector<std::uint32_t> run_start;  ///< per run key, then one past the end
     std::vector<std::uint32_t> fill;       ///< per run key, the next place while ordering
+    std::size_t hits = 0;                  ///< the hits of the slice shaded last
     void reserve(std::size_t n) {
         // Kernels read a whole packet past the last ray of a run.
         const std::size_t cap = simd::round_up_lanes(n) + simd::kMaxLanes;

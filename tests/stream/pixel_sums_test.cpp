@@ -1,7 +1,8 @@
-// The shade and occlusion stages add each ray's colour into its pixel with the pixel's sum
-// held in registers along a run of its rays (stream/shade_stage.h, add_runs and
-// add_unblocked). The pictures rely on this giving the bits of one float addition per ray, in
-// stream order: the same picture for every -j and every slice size.
+// The occlusion stage adds each unblocked shadow ray's light into its hit's local colour, and
+// the hits' local colours go into their pixels with the pixel's sum held in registers along a
+// run of its rays (stream/shade_stage.h, add_unblocked_to_hits and add_runs). The pictures
+// rely on this giving the bits of one float addition per term, in a fixed order: the same
+// picture for every -j, slice size and instruction set.
 #include <doctest/doctest.h>
 
 #include <cstdint>
@@ -45,26 +46,28 @@ TEST_CASE("pixel sums: runs of a pixel's rays add in stream order, and a pixel m
     CHECK(accum == one_by_one);
 }
 
-TEST_CASE("pixel sums: only unblocked shadow rays (t_max > 0) add their colour, in stream order") {
+TEST_CASE("pixel sums: only unblocked shadow rays (t_max > 0) add their colour to their hit, in stream order") {
     ShadowStream s;
     s.reserve(6);
-    const std::int32_t pixel[] = {1, 1, 0, 1, 0, 1};
+    const std::int32_t hit[] = {1, 1, 0, 1, 0, 1};  // the hit's place (SortedHits::order), not a pixel
     const float t_max[] = {2.f, 0.f, 1.f, 3.f, 0.f, 1.f};  // rays 1 and 4 are blocked
     const float red[] = {1.f, 100.f, 0.25f, kTiny, 100.f, kTiny};
     for (int i = 0; i < 6; ++i) {
-        s.pixel[std::size_t(i)] = pixel[i];
+        s.pixel[std::size_t(i)] = hit[i];
         s.t_max[std::size_t(i)] = t_max[i];
         s.cr[std::size_t(i)] = red[i];
         s.cg[std::size_t(i)] = float(i);
         s.cb[std::size_t(i)] = 1.f;
     }
     s.count = 6;
-    std::vector<float> accum(6, 0.f);
-    stage_detail::add_unblocked(accum.data(), s);
-    CHECK(accum[0] == 0.25f);                  // ray 2 (ray 4 is blocked)
-    CHECK(accum[1] == 2.f);                    // cg of ray 2
-    CHECK(accum[2] == 1.f);
-    CHECK(accum[3] == 1.f);                    // rays 0, 3, 5: (1 + tiny) + tiny rounds to 1
-    CHECK(accum[4] == 0.f + 3.f + 5.f);
-    CHECK(accum[5] == 3.f);
+    // The hits' local colours before their light: hit 1's red starts at 0, so its terms sum
+    // to 1 + tiny + tiny = 1 in stream order.
+    std::vector<float> lr{0.5f, 0.f}, lg{10.f, 20.f}, lb{0.f, 0.f};
+    stage_detail::add_unblocked_to_hits(lr.data(), lg.data(), lb.data(), s);
+    CHECK(lr[0] == 0.75f);             // 0.5 + ray 2 (ray 4 is blocked)
+    CHECK(lg[0] == 10.f + 2.f);        // cg of ray 2
+    CHECK(lb[0] == 1.f);
+    CHECK(lr[1] == 1.f);               // rays 0, 3, 5: (1 + tiny) + tiny rounds to 1
+    CHECK(lg[1] == 20.f + 0.f + 3.f + 5.f);
+    CHECK(lb[1] == 3.f);
 }
