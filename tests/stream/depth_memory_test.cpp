@@ -68,10 +68,10 @@ TEST_CASE("depth: slices of whole pixels give one pixel its additions in the sam
     // At spp 4 and depth 5 a pixel has at most 4 x 2^5 = 128 rays in a generation: with
     // slices of 128 or 200 rays generations are cut, pixels never. Each pixel then sums the
     // same terms in the same order: bit-identical, one ray at a time (scalar shading) and in
-    // the SIMD kernels, whose spawned rays follow their kind or shadow slot, then the run
-    // order, wherever the packets are cut (ShadeJob::next). Whitted's two lights and its
-    // glass sphere give a pixel two shadow rays and two children per hit, and its rays share
-    // runs with other pixels' rays: emitted packet by packet, light by light and kind by
+    // the SIMD kernels, whose children join the next stream by kind and whose shadow rays add
+    // their light into their hit, wherever the packets are cut (ShadeJob::next). Whitted's two
+    // lights and its glass sphere give a hit two shadow rays and two children, and its rays
+    // share runs with other pixels' rays: appended packet by packet, light by light and kind by
     // kind, the cuts moved a pixel's sums by up to an ulp.
     const Scene s = whitted(64, 48, 4, 5);
     for (ShadeMode shade : {ShadeMode::Scalar, ShadeMode::Sorted, ShadeMode::Gathered}) {
