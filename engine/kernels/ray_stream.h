@@ -57,6 +57,16 @@ struct RayStream {
     }
     /// Makes the lanes between count and the next multiple of kMaxLanes inert.
     void pad_tail() { make_tail_inert(*this); }
+    /// Calls f(&RayStream::array) for every per-ray array but `key` (which only scenes with
+    /// area lights fill): the one list of them that copying code walks.
+    template <class F>
+    static void for_each_array(F&& f) {
+        for (auto a : {&RayStream::ox, &RayStream::oy, &RayStream::oz, &RayStream::dx, &RayStream::dy, &RayStream::dz,
+                       &RayStream::t_max, &RayStream::wr, &RayStream::wg, &RayStream::wb, &RayStream::cone})
+            f(a);
+        f(&RayStream::pixel);
+        f(&RayStream::kind);
+    }
 };
 
 /// Shadow rays: a segment towards a light and the colour it brings if nothing blocks it.

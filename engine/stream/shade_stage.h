@@ -399,9 +399,7 @@ struct ShadeStage {
         const auto move = [&](auto& a) {
             std::copy(a.begin() + std::ptrdiff_t(from), a.begin() + std::ptrdiff_t(from + n), a.begin() + std::ptrdiff_t(s.count));
         };
-        for (auto* a : {&s.ox, &s.oy, &s.oz, &s.dx, &s.dy, &s.dz, &s.t_max, &s.wr, &s.wg, &s.wb, &s.cone}) move(*a);
-        move(s.pixel);
-        move(s.kind);
+        RayStream::for_each_array([&](auto a) { move(s.*a); });
         if (keys) move(s.key);
         s.count += n;
     }

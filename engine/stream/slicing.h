@@ -16,11 +16,8 @@ inline void copy_rays(const RayStream& src, std::size_t from, std::size_t n, Ray
         dst.reserve_keys();
         std::copy_n(src.key.begin() + std::ptrdiff_t(from), n, dst.key.begin());
     }
-    for (auto a : {&RayStream::ox, &RayStream::oy, &RayStream::oz, &RayStream::dx, &RayStream::dy, &RayStream::dz,
-                   &RayStream::t_max, &RayStream::wr, &RayStream::wg, &RayStream::wb, &RayStream::cone})
-        std::copy_n((src.*a).begin() + std::ptrdiff_t(from), n, (dst.*a).begin());
-    std::copy_n(src.pixel.begin() + std::ptrdiff_t(from), n, dst.pixel.begin());
-    std::copy_n(src.kind.begin() + std::ptrdiff_t(from), n, dst.kind.begin());
+    RayStream::for_each_array(
+        [&](auto a) { std::copy_n((src.*a).begin() + std::ptrdiff_t(from), n, (dst.*a).begin()); });
     dst.count = n;
 }
 
