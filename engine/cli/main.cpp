@@ -102,8 +102,8 @@ int run(int argc, char** argv) {
     if (launcher && !opt.mpi)
         throw UsageError(std::string("started by an MPI launcher (") + launcher +
                          " is set) without --mpi: every rank would render and write the same image");
-    if (opt.mpi && !mpi_available())
-        throw UsageError("--mpi: this streamrt was built without MPI support (cmake -DSTREAMRT_MPI=ON)");
+    if (std::string why; opt.mpi && !mpi_available(&why))
+        throw UsageError("--mpi: this streamrt has no MPI support (" + why + "; cmake -DSTREAMRT_MPI=ON)");
     if (opt.mpi && !launcher && !std::getenv("OMPI_COMM_WORLD_SIZE") && !std::getenv("PMI_SIZE"))
         throw UsageError("--mpi: not started by an MPI launcher (mpirun -np N streamrt --mpi ...)");
     if (opt.resume && opt.checkpoint.empty()) throw UsageError("--resume needs --checkpoint FILE");

@@ -15,11 +15,9 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/module_loader.h"
+#include "distributed/mpi_transport.h"
 #include "distributed/tile_file.h"
-
-#if STREAMRT_HAVE_MPI
-#include <mpi.h>
-#endif
 
 namespace streamrt {
 
@@ -46,23 +44,21 @@ std::string rank_stats_text(const std::vector<RankStats>& stats) {
     return out;
 }
 
-#if !STREAMRT_HAVE_MPI
+namespace {
 
-bool mpi_available() { return false; }
-MpiSession::MpiSession(int&, char**&) { throw UsageError("--mpi: this streamrt was built without MPI (cmake -DSTREAMRT_MPI=ON)"); }
-MpiSession::~MpiSession() = default;
-int MpiSession::broadcast_status(int status) const { return status; }
-void MpiSession::broadcast_bundle(SceneBundle&) const {}
-int MpiSession::min_over_ranks(int value) const { return value; }
-void MpiSession::abort(int code) const { std::exit(code); }
-std::vector<RankStats> mpi_render_tiles(const MpiSession&, PreparedRender&, Parallelism&, std::span<const int>,
-                                        MpiSchedule, const TileSink&, RenderProgress&, StreamProfile*) {
-    throw UsageError("--mpi: this streamrt was built without MPI");
+/// The MPI module's table, loaded on first use; null with `error` set when it is missing.
+const MpiTransport* load_transport(std::string* error) {
+    // Global: Open MPI loads plugins of its own that look up its library's symbols.
+    static const ModuleTable<MpiTransport> loaded =
+        load_module_table<MpiTransport>(kMpiModuleFile, kMpiTransportSymbol, kMpiTransportVersion, true);
+    if (error) *error = loaded.error;
+    return loaded.table;
 }
 
-#else
+}  // namespace
 
-bool mpi_available() { return true; }
+bool mpi_available(std::string* why) { return load_transport(why) != nullptr; }
+
 
 namespace {
 
@@ -79,35 +75,21 @@ struct FinalMessage {
     RayCounts counts;
 };
 
-/// Waits for a request without spinning a core away from the render threads.
-void wait_quietly(MPI_Request& request, MPI_Status* status = MPI_STATUS_IGNORE) {
-    for (int done = 0;;) {
-        MPI_Test(&request, &done, status);
-        if (done) return;
-        std::this_thread::sleep_for(std::chrono::microseconds(100));
-    }
-}
-
-/// Receives a message of unknown length from `source` with `tag`.
+/// Receives a message of unknown length from `source` with `tag`, waiting for it without
+/// spinning a core away from the render threads.
 template <class T>
-std::vector<T> receive(int source, int tag, MPI_Status* status_out = nullptr) {
-    MPI_Status status;
-    for (int flag = 0; !flag;) {
-        MPI_Iprobe(source, tag, MPI_COMM_WORLD, &flag, &status);
-        if (!flag) std::this_thread::sleep_for(std::chrono::microseconds(100));
-    }
-    int bytes = 0;
-    MPI_Get_count(&status, MPI_BYTE, &bytes);
+std::vector<T> receive(const MpiTransport& mpi, int source, int tag) {
+    int from = 0, bytes = 0;
+    while (!mpi.probe(source, tag, &from, &bytes)) std::this_thread::sleep_for(std::chrono::microseconds(100));
     std::vector<T> data(std::size_t(bytes) / sizeof(T));
-    MPI_Recv(data.data(), bytes, MPI_BYTE, status.MPI_SOURCE, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    if (status_out) *status_out = status;
+    mpi.receive(data.data(), bytes, from, tag);
     return data;
 }
 
-void send_bytes(const void* data, std::size_t bytes, int dest, int tag, std::uint64_t& sent) {
-    MPI_Request request;
-    MPI_Isend(data, int(bytes), MPI_BYTE, dest, tag, MPI_COMM_WORLD, &request);
-    wait_quietly(request);
+/// Sends and waits quietly (as `receive`) until the data may be reused.
+void send_bytes(const MpiTransport& mpi, const void* data, std::size_t bytes, int dest, int tag, std::uint64_t& sent) {
+    void* request = mpi.start_send(data, int(bytes), dest, tag);
+    while (!mpi.test(request)) std::this_thread::sleep_for(std::chrono::microseconds(100));
     sent += bytes;
 }
 
@@ -184,15 +166,12 @@ std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& pr
     // still renders some sends them with one more request, and is done once it has none.
     std::vector<std::uint64_t> out(std::size_t(mpi.size()), 0);
     while (working > 0) {
-        MPI_Status status;
-        int flag = 0;
-        MPI_Iprobe(MPI_ANY_SOURCE, kTagResult, MPI_COMM_WORLD, &flag, &status);
-        if (!flag) {
+        int from = 0, bytes = 0;
+        if (!mpi.transport().probe(kAnySource, kTagResult, &from, &bytes)) {
             std::this_thread::sleep_for(std::chrono::microseconds(200));
             continue;
         }
-        const std::vector<char> msg = receive<char>(status.MPI_SOURCE, kTagResult);
-        const int from = status.MPI_SOURCE;
+        const std::vector<char> msg = receive<char>(mpi.transport(), from, kTagResult);
         std::int32_t jobs = 1;
         std::memcpy(&jobs, msg.data(), sizeof jobs);
         // A rank that was interrupted (its own Ctrl-C or SIGTERM) stops the whole job.
@@ -208,14 +187,14 @@ std::vector<RankStats> render_as_rank0(const MpiSession& mpi, PreparedRender& pr
         // Once interrupted, every rank is told "no more" and the job winds down together.
         const std::vector<std::int32_t> chunk =
             progress.cancelled() ? std::vector<std::int32_t>() : queue.take(from, queue.chunk(jobs));
-        send_bytes(chunk.data(), chunk.size() * sizeof(std::int32_t), from, kTagAssign, mine.bytes_sent);
+        send_bytes(mpi.transport(), chunk.data(), chunk.size() * sizeof(std::int32_t), from, kTagAssign, mine.bytes_sent);
         out[std::size_t(from)] += chunk.size();
         // An interrupted worker renders nothing more: it is done whatever it still had.
         if (chunk.empty() && (out[std::size_t(from)] == 0 || jobs <= 0)) --working;
     }
     local.join();
     for (int r = 1; r < mpi.size(); ++r) {
-        const std::vector<FinalMessage> f = receive<FinalMessage>(r, kTagFinal);
+        const std::vector<FinalMessage> f = receive<FinalMessage>(mpi.transport(), r, kTagFinal);
         const std::uint64_t tiles_seen = stats[std::size_t(r)].tiles;
         stats[std::size_t(r)] = f.at(0).stats;
         stats[std::size_t(r)].tiles = tiles_seen;
@@ -328,8 +307,8 @@ void render_as_worker(const MpiSession& mpi, PreparedRender& prepared, Paralleli
         out -= count;
         const std::int32_t asking = progress.cancelled() ? 0 : jobs;  // 0: interrupted
         msg.insert(0, reinterpret_cast<const char*>(&asking), sizeof asking);
-        send_bytes(msg.data(), msg.size(), 0, kTagResult, final.stats.bytes_sent);
-        const std::vector<std::int32_t> chunk = receive<std::int32_t>(0, kTagAssign);
+        send_bytes(mpi.transport(), msg.data(), msg.size(), 0, kTagResult, final.stats.bytes_sent);
+        const std::vector<std::int32_t> chunk = receive<std::int32_t>(mpi.transport(), 0, kTagAssign);
         if (chunk.empty()) {
             if (out == 0 || asking == 0) break;
             draining = true;
@@ -348,51 +327,48 @@ void render_as_worker(const MpiSession& mpi, PreparedRender& prepared, Paralleli
         final.counts = profile->counts;
     }
     std::uint64_t ignored = 0;
-    send_bytes(&final, sizeof final, 0, kTagFinal, ignored);
+    send_bytes(mpi.transport(), &final, sizeof final, 0, kTagFinal, ignored);
 }
 
 }  // namespace
 
 MpiSession::MpiSession(int& argc, char**& argv) {
-    int provided = 0;
-    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-    MPI_Comm_size(MPI_COMM_WORLD, &size_);
-    if (provided < MPI_THREAD_FUNNELED) {
+    std::string error;
+    mpi_ = load_transport(&error);
+    if (!mpi_) throw UsageError("--mpi: this streamrt has no MPI support (" + error + "; cmake -DSTREAMRT_MPI=ON)");
+    if (!mpi_->init(&argc, &argv, &rank_, &size_)) {
         if (rank_ == 0) std::fprintf(stderr, "streamrt: --mpi: the MPI library does not provide MPI_THREAD_FUNNELED\n");
         abort(2);
     }
 }
 
-MpiSession::~MpiSession() { MPI_Finalize(); }
+MpiSession::~MpiSession() { mpi_->finalize(); }
 
 int MpiSession::broadcast_status(int status) const {
-    MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    mpi_->broadcast(&status, sizeof status, 0);
     return status;
 }
 
 void MpiSession::broadcast_bundle(SceneBundle& bundle) const {
     std::string bytes = rank_ == 0 ? bundle.serialize() : std::string();
     std::uint64_t size = bytes.size();
-    MPI_Bcast(&size, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+    mpi_->broadcast(&size, sizeof size, 0);
     bytes.resize(size);
     // In pieces below 2 GiB (MPI counts are int).
     constexpr std::uint64_t kPiece = 1u << 30;
     for (std::uint64_t off = 0; off < size; off += kPiece)
-        MPI_Bcast(bytes.data() + off, int(std::min(kPiece, size - off)), MPI_BYTE, 0, MPI_COMM_WORLD);
+        mpi_->broadcast(bytes.data() + off, int(std::min(kPiece, size - off)), 0);
     if (rank_ != 0) bundle = SceneBundle::deserialize(bytes);
 }
 
 int MpiSession::min_over_ranks(int value) const {
-    int out = value;
-    MPI_Allreduce(&value, &out, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-    return out;
+    return mpi_->min_over_ranks(value);
 }
 
 void MpiSession::abort(int code) const {
     std::fflush(stdout);
     std::fflush(stderr);
-    MPI_Abort(MPI_COMM_WORLD, code);
+    mpi_->abort(code);
     std::_Exit(code);
 }
 
@@ -403,7 +379,5 @@ std::vector<RankStats> mpi_render_tiles(const MpiSession& mpi, PreparedRender& p
     render_as_worker(mpi, prepared, par, progress, profile);
     return {};
 }
-
-#endif  // STREAMRT_HAVE_MPI
 
 }  // namespace streamrt

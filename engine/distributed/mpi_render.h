@@ -14,8 +14,9 @@
 
 namespace streamrt {
 
-/// True when this build has MPI (CMake option STREAMRT_MPI).
-bool mpi_available();
+/// True when the MPI module loads (built when CMake finds MPI: option STREAMRT_MPI); else
+/// `why` (when given) says where it was looked for.
+bool mpi_available(std::string* why = nullptr);
 
 /// The environment variable showing that an MPI launcher (mpirun, mpiexec, srun --mpi)
 /// started this process as one of several ranks, or nullptr.
@@ -30,8 +31,11 @@ struct RankStats {
     std::uint64_t bytes_sent = 0;
 };
 
-/// MPI_Init_thread (FUNNELED) on construction, MPI_Finalize on destruction; throws
-/// UsageError when MPI is not built in or the thread level is not provided.
+struct MpiTransport;
+
+/// Loads the MPI module (libstreamrt_mpi.so, distributed/mpi_transport.h), MPI_Init_thread
+/// (FUNNELED) on construction, MPI_Finalize on destruction; throws UsageError when the
+/// module is missing (MPI not built in); ends the job when the thread level is not provided.
 class MpiSession {
   public:
     MpiSession(int& argc, char**& argv);
@@ -49,8 +53,10 @@ class MpiSession {
     int min_over_ranks(int value) const;
     /// Ends the whole job now with `code` (a rank failed or was interrupted).
     [[noreturn]] void abort(int code) const;
+    const MpiTransport& transport() const { return *mpi_; }
 
   private:
+    const MpiTransport* mpi_ = nullptr;
     int rank_ = 0, size_ = 1;
 };
 

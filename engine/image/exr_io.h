@@ -1,6 +1,7 @@
 #pragma once
 // OpenEXR files: RGB scanline images, ZIPS-compressed (deflate per scanline), half or float, holding the
-// framebuffer's linear values. Only exr_io.cpp includes OpenEXR's headers.
+// framebuffer's linear values. OpenEXR itself is in a module loaded on first use (exr_codec.h):
+// only engine/modules/exr_codec.cpp includes its headers.
 #include <string>
 
 #include "image/framebuffer.h"

@@ -22,7 +22,7 @@ LAYERS = [
     ["stream", "baseline"],
     ["driver"],
     ["distributed"],
-    ["cli", "python"],
+    ["cli", "python", "modules"],
 ]
 LEVEL = {folder: i for i, peers in enumerate(LAYERS) for folder in peers}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([a-z_0-9]+)/[^"]+"')
