@@ -32,6 +32,22 @@ inline void want_huge_pages(const T* begin, std::size_t count) {
     advise_inside(begin, begin + count, MADV_HUGEPAGE, std::uintptr_t(2) << 20);
 }
 
+/// Arrays from this size (bytes) are given whole huge pages (HugePageAllocator, and the
+/// program's operator new: cli/large_allocations.cpp).
+inline constexpr std::size_t kHugePagesFrom = std::size_t(1) << 20;
+inline constexpr std::size_t kHugePageBlock = std::size_t(2) << 20;
+
+/// `bytes` rounded up to whole 2 MiB blocks, 2 MiB-aligned and advised as huge pages (a
+/// hint: nothing changes where transparent huge pages are off); null when the system has no
+/// memory for it. Freed with std::free.
+inline void* allocate_huge_blocks(std::size_t bytes) noexcept {
+    if (bytes > std::numeric_limits<std::size_t>::max() - kHugePageBlock) return nullptr;
+    const std::size_t whole = (bytes + kHugePageBlock - 1) & ~(kHugePageBlock - 1);
+    void* p = std::aligned_alloc(kHugePageBlock, whole);
+    if (p) ::madvise(p, whole, MADV_HUGEPAGE);
+    return p;
+}
+
 /// An allocator for arrays that may be large and are written soon after they are made (a
 /// framebuffer, an encoder's buffers): from 1 MiB an array gets whole 2 MiB blocks, aligned
 /// to 2 MiB and advised as huge pages; below, 64-byte-aligned memory from operator new. First
@@ -41,8 +57,7 @@ inline void want_huge_pages(const T* begin, std::size_t count) {
 template <class T>
 struct HugePageAllocator {
     using value_type = T;
-    static constexpr std::size_t kBlock = std::size_t(2) << 20;
-    static constexpr std::size_t kHugeFrom = std::size_t(1) << 20;  ///< bytes from which blocks are used
+    static constexpr std::size_t kHugeFrom = kHugePagesFrom;  ///< bytes from which blocks are used
     static constexpr std::align_val_t kSmallAlign{64};
 
     HugePageAllocator() = default;
@@ -50,13 +65,11 @@ struct HugePageAllocator {
     HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
 
     T* allocate(std::size_t n) {
-        if (n > (std::numeric_limits<std::size_t>::max() - kBlock) / sizeof(T)) throw std::bad_alloc();
+        if (n > (std::numeric_limits<std::size_t>::max() - kHugePageBlock) / sizeof(T)) throw std::bad_alloc();
         const std::size_t bytes = n * sizeof(T);
         if (bytes < kHugeFrom) return static_cast<T*>(::operator new(bytes, kSmallAlign));
-        const std::size_t whole = (bytes + kBlock - 1) & ~(kBlock - 1);
-        void* p = std::aligned_alloc(kBlock, whole);
+        void* p = allocate_huge_blocks(bytes);
         if (!p) throw std::bad_alloc();
-        ::madvise(p, whole, MADV_HUGEPAGE);  // a hint: nothing changes where huge pages are off
         return static_cast<T*>(p);
     }
     void deallocate(T* p, std::size_t n) noexcept {

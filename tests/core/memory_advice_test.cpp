@@ -3,47 +3,19 @@
 #include <doctest/doctest.h>
 
 #include <cstdint>
-#include <fstream>
-#include <sstream>
-#include <string>
 
 #include "core/default_init.h"
+#include "core/huge_pages_support.h"
 #include "core/memory_advice.h"
 #include "image/framebuffer.h"
 
 using namespace streamrt;
+using test::address;
+using test::thp_eligible;
 
 namespace {
 
 constexpr std::uintptr_t kTwoMiB = std::uintptr_t(2) << 20;
-
-std::uintptr_t address(const void* p) { return reinterpret_cast<std::uintptr_t>(p); }
-
-std::string read_text(const char* path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-// The kernel's "THPeligible" for the mapping holding p (/proc/self/smaps): 1 when a fault
-// there may take a huge page. -1 when the mapping is not found.
-int thp_eligible(const void* p) {
-    std::ifstream smaps("/proc/self/smaps");
-    std::string line;
-    bool inside = false;
-    while (std::getline(smaps, line)) {
-        std::uintptr_t lo = 0, hi = 0;
-        char dash = 0;
-        std::istringstream head(line);
-        if (head >> std::hex >> lo >> dash >> hi && dash == '-') {
-            inside = address(p) >= lo && address(p) < hi;
-            continue;
-        }
-        if (inside && line.rfind("THPeligible:", 0) == 0) return std::stoi(line.substr(12));
-    }
-    return -1;
-}
 
 }  // namespace
 
@@ -75,10 +47,9 @@ TEST_CASE("LargeFillLaterVec keeps its contents as it grows into huge pages") {
 TEST_CASE("A 1280x720 framebuffer is advised for huge pages") {
     const Framebuffer fb = Framebuffer::uninitialized(1280, 720);  // 11 MB
     CHECK(address(fb.rgb.data()) % kTwoMiB == 0);
-    const std::string mode = read_text("/sys/kernel/mm/transparent_hugepage/enabled");
     // With transparent huge pages on [always] or [madvise], the advice makes the mapping
     // eligible; under [never] (or without the file) nothing is asked of the kernel here.
-    if (mode.find("[madvise]") != std::string::npos || mode.find("[always]") != std::string::npos)
+    if (test::huge_pages_possible())
         CHECK(thp_eligible(fb.rgb.data()) == 1);
     else
         MESSAGE("transparent huge pages off: eligibility not checked");
