@@ -59,7 +59,6 @@ const MpiTransport* load_transport(std::string* error) {
 
 bool mpi_available(std::string* why) { return load_transport(why) != nullptr; }
 
-
 namespace {
 
 constexpr int kTagResult = 1;  // worker -> rank 0: int32 jobs, then finished tile records
