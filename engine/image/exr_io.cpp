@@ -1,5 +1,6 @@
 #include "image/exr_io.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <new>
 #include <system_error>
@@ -13,7 +14,7 @@ namespace streamrt {
 namespace {
 
 constexpr std::size_t kPixelBytes = 3 * sizeof(float);
-constexpr std::size_t kHalfBytes = 2;
+constexpr std::size_t kHalfBytes = 2;  // OpenEXR's half (this side does not include its headers)
 
 /// The OpenEXR module's table, loaded on first use (once per process).
 const ExrCodec& exr_codec(const std::string& path) {
@@ -60,7 +61,7 @@ Framebuffer read_exr(const std::string& path) {
 }
 
 double exr_write_buffer_bytes(int width, int height) {
-    // A band of half rows; OpenEXR's line buffer of kZipLines lines at up to 12 bytes a
+    // A band of half rows; OpenEXR's line buffer of kExrZipLines lines at up to 12 bytes a
     // pixel, about as much again for the compressor's input and output; 8 bytes of offset
     // per block.
     const double band = double(std::min(exr_band_rows(width), height)) * double(width) * 3 * kHalfBytes;
