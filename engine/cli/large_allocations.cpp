@@ -4,9 +4,10 @@
 // page costs 1 - 7 us, so the arrays that reading a large mesh fills once (its triangles in
 // leaf order, their blocks, the hierarchy's references and nodes, the vertex normals: some
 // 14,000 fresh pages for a 235k-triangle mesh) cost more in page faults than in work; in huge
-// pages they are a few dozen faults (docs/performance.md, "Large arrays in huge pages").
-// Linked into the program alone: the Python module leaves the host's allocator alone, and
-// sanitizer builds keep their own operator new, which checks every allocation.
+// pages they are a few dozen faults (docs/performance.md, "Start-up").
+// Linked into the program, the test program and mesh_build_bench (whose first build is what
+// a render's reading sees), not into the engine library: the Python module leaves the host's
+// allocator alone. Sanitizer builds keep their own operator new, which checks every allocation.
 #include <cstddef>
 #include <cstdlib>
 #include <new>

@@ -1,7 +1,7 @@
 #pragma once
 // Optional parts of streamrt that pull in large libraries (OpenEXR for .exr files, MPI for
 // --mpi) live in modules loaded on first use, so every other run starts without loading
-// and relocating those libraries (about 5 ms a process here: docs/performance.md, "Start-up").
+// and relocating those libraries (about 4 ms a process here: docs/performance.md, "Start-up").
 #include <string>
 
 namespace streamrt {
