@@ -101,14 +101,18 @@ struct ShadeStage {
     static constexpr bool kSecondary = kReflect || kRefract;
 
     /// The shading rules for rays of generation `depth`. The stream's weights carry the
-    /// sample's 1/spp, so the cut-off (defined on the refl / trans product alone, as in the
-    /// recursive engine) is scaled by it.
-    static ShadeRules<float> shade_rules(const StreamScene& sc, int depth) {
+    /// sample's weight (SampleRequest::weight: 1/spp when a pixel's samples are summed, 1 for
+    /// adaptive sampling's samples, each in a slot of its own: `per_sample`), so the cut-off
+    /// (defined on the refl / trans product alone, as in the recursive engine) is scaled by
+    /// it. Scaled by 1/spp for both until 2026-11-29: an adaptive render (spp its cap, 64)
+    /// then pruned at a 64th of the cut-off and traced 18 % more rays than the recursive
+    /// engine at its corners (docs/adaptive-sampling.md).
+    static ShadeRules<float> shade_rules(const StreamScene& sc, int depth, bool per_sample) {
         const RenderSettings& s = sc.settings;
         return {.degree = s.degree,
                 .ambient = float(s.ambient),
                 .spawn = kSecondary && depth < s.depth,
-                .cutoff = float(s.cutoff / s.spp),
+                .cutoff = float(per_sample ? s.cutoff : s.cutoff / s.spp),
                 .spread = sc.camera.spread,
                 .eye = {0.f, 0.f, 0.f}};  // the engine's origin is the eye (stream_scene.cpp)
     }
@@ -163,10 +167,10 @@ struct ShadeStage {
     /// and refracted rays appended to `next` (only surviving rays move on). Misses bring the
     /// background.
     static void shade(const StreamScene& sc, const RayStream& rays, const AlignedVec<std::int32_t>& object,
-                      const MeshHits& mesh_hits, int depth, RayStream& next, ShadowStream& shadows, SortedHits& hits,
-                      float* accum, RayCounts& counts) {
+                      const MeshHits& mesh_hits, int depth, bool per_sample, RayStream& next, ShadowStream& shadows,
+                      SortedHits& hits, float* accum, RayCounts& counts) {
         using namespace stage_detail;
-        const ShadeRules<float> rules = shade_rules(sc, depth);
+        const ShadeRules<float> rules = shade_rules(sc, depth, per_sample);
         if constexpr (kShadows) hits.reserve(rays.count);
         hits.hits = 0;
         // This path serves scenes with many objects, where each hit's records are likely
@@ -236,8 +240,8 @@ struct ShadeStage {
     /// local colours then go into the tile in run order (fixed for a given tile, so the
     /// picture does not depend on threads).
     static void shade_sorted(const StreamScene& sc, const KernelTable& kt, const RayStream& rays,
-                             const AlignedVec<std::int32_t>& object, int depth, Workspace& ws, float* accum,
-                             RayCounts& counts, bool gathered) {
+                             const AlignedVec<std::int32_t>& object, int depth, bool per_sample, Workspace& ws,
+                             float* accum, RayCounts& counts, bool gathered) {
         using namespace stage_detail;
         SortedHits& h = ws.sorted;
         // The run key of a hit: its object, or (gathered) its material and shape kind.
@@ -339,7 +343,7 @@ struct ShadeStage {
                      .material = nullptr,
                      .lights = sc.lights.data(),
                      .n_lights = sc.lights.size(),
-                     .rules = shade_rules(sc, depth),
+                     .rules = shade_rules(sc, depth, per_sample),
                      .lr = h.lr.data(),
                      .lg = h.lg.data(),
                      .lb = h.lb.data(),

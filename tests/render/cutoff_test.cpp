@@ -69,6 +69,29 @@ TEST_CASE("cut-off: the stream engine's rule ignores the samples' 1/spp weight")
     CHECK(r.counts.reflected == 256);
 }
 
+TEST_CASE("cut-off: adaptive sampling's samples are cut by refl alone too, in both engines") {
+    // Adaptive samples each weigh 1 in a slot of their own (spp is the cap, 64): the stream
+    // engine once scaled the cut-off by 1/64 for them as for uniform samples, and traced the
+    // 0.5 children a cut-off of 0.6 leaves out. The flat floor stops at its 9 x 9 corners.
+    for (EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
+        const std::string name = engine_name(engine);
+        CAPTURE(name);
+        Parallelism par(2);
+        for (const char* cutoff : {" cutoff=0.6", " cutoff=0.5"}) {
+            CAPTURE(cutoff);
+            Scene s = mirror_floor(cutoff);
+            s.settings.spp = 64;
+            s.settings.adaptive = 0.01;
+            const RenderResult r = render_scene(s, engine, par);
+            REQUIRE(r.adaptive);
+            CHECK(r.counts.primary == 81);
+            const bool cut = std::string(cutoff) == " cutoff=0.6";
+            CHECK(r.counts.reflected == (cut ? 0 : 81));
+            check_every_pixel(r.image, cut ? 0.2f : 0.7f, 0.4f, 0.6f);
+        }
+    }
+}
+
 TEST_CASE("cut-off: out of [0, 1] is a scene error at the value") {
     try {
         (void)parse_scene("image cutoff=1.5\n", "bad.cfg");
