@@ -100,13 +100,11 @@ template <bool kLighting, bool kShadows, bool kReflect, bool kRefract>
 struct ShadeStage {
     static constexpr bool kSecondary = kReflect || kRefract;
 
-    /// The shading rules for rays of generation `depth`. The stream's weights carry the
-    /// sample's weight (SampleRequest::weight: 1/spp when a pixel's samples are summed, 1 for
-    /// adaptive sampling's samples, each in a slot of its own: `per_sample`), so the cut-off
-    /// (defined on the refl / trans product alone, as in the recursive engine) is scaled by
-    /// it. Scaled by 1/spp for both until 2026-11-29: an adaptive render (spp its cap, 64)
-    /// then pruned at a 64th of the cut-off and traced 18 % more rays than the recursive
-    /// engine at its corners (docs/adaptive-sampling.md).
+    /// The shading rules for rays of generation `depth`. The cut-off is defined on the refl /
+    /// trans product alone, as in the recursive engine, and the stream's weights also carry
+    /// the sample's weight (SampleRequest::weight), so it is scaled by that weight: 1/spp
+    /// where a pixel's samples are summed, 1 for adaptive samples (`per_sample`; spp is then
+    /// the cap, and 1/spp cut them at a 64th of the cut-off: docs/adaptive-sampling.md).
     static ShadeRules<float> shade_rules(const StreamScene& sc, int depth, bool per_sample) {
         const RenderSettings& s = sc.settings;
         return {.degree = s.degree,
