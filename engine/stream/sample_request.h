@@ -25,7 +25,10 @@ struct SampleRequest {
     std::int32_t slot_of(int i_in_chunk, int j, int p) const {
         return per_sample ? std::int32_t(i_in_chunk * run.count + j) : std::int32_t(p);
     }
-    float weight() const { return per_sample ? 1.f : 1.f / float(run.count); }
+    /// The samples one slot sums: the run's for uniform sampling, 1 for adaptive sampling's
+    /// own slots. A ray's weight is its reciprocal, and the cut-off is scaled by it.
+    int samples_per_slot() const { return per_sample ? 1 : run.count; }
+    float weight() const { return 1.f / float(samples_per_slot()); }
     /// Slots a chunk of n listed pixels accumulates into.
     std::size_t slots(int n, const Tile& tile) const {
         return per_sample ? std::size_t(n) * std::size_t(run.count) : std::size_t(tile.width() * tile.height());

@@ -102,15 +102,15 @@ struct ShadeStage {
 
     /// The shading rules for rays of generation `depth`. The cut-off is defined on the refl /
     /// trans product alone, as in the recursive engine, and the stream's weights also carry
-    /// the sample's weight (SampleRequest::weight), so it is scaled by that weight: 1/spp
-    /// where a pixel's samples are summed, 1 for adaptive samples (`per_sample`; spp is then
-    /// the cap, and 1/spp cut them at a 64th of the cut-off: docs/adaptive-sampling.md).
-    static ShadeRules<float> shade_rules(const StreamScene& sc, int depth, bool per_sample) {
+    /// the sample's weight, 1 / `samples_per_slot` (SampleRequest), so it is scaled by that.
+    /// (Scaled by the settings' 1/spp, adaptive samples, whose spp is their cap, were cut at a
+    /// 64th of the cut-off: docs/adaptive-sampling.md.)
+    static ShadeRules<float> shade_rules(const StreamScene& sc, int depth, int samples_per_slot) {
         const RenderSettings& s = sc.settings;
         return {.degree = s.degree,
                 .ambient = float(s.ambient),
                 .spawn = kSecondary && depth < s.depth,
-                .cutoff = float(per_sample ? s.cutoff : s.cutoff / s.spp),
+                .cutoff = float(s.cutoff / samples_per_slot),
                 .spread = sc.camera.spread,
                 .eye = {0.f, 0.f, 0.f}};  // the engine's origin is the eye (stream_scene.cpp)
     }
@@ -165,10 +165,10 @@ struct ShadeStage {
     /// and refracted rays appended to `next` (only surviving rays move on). Misses bring the
     /// background.
     static void shade(const StreamScene& sc, const RayStream& rays, const AlignedVec<std::int32_t>& object,
-                      const MeshHits& mesh_hits, int depth, bool per_sample, RayStream& next, ShadowStream& shadows,
-                      SortedHits& hits, float* accum, RayCounts& counts) {
+                      const MeshHits& mesh_hits, int depth, int samples_per_slot, RayStream& next,
+                      ShadowStream& shadows, SortedHits& hits, float* accum, RayCounts& counts) {
         using namespace stage_detail;
-        const ShadeRules<float> rules = shade_rules(sc, depth, per_sample);
+        const ShadeRules<float> rules = shade_rules(sc, depth, samples_per_slot);
         if constexpr (kShadows) hits.reserve(rays.count);
         hits.hits = 0;
         // This path serves scenes with many objects, where each hit's records are likely
@@ -238,7 +238,7 @@ struct ShadeStage {
     /// local colours then go into the tile in run order (fixed for a given tile, so the
     /// picture does not depend on threads).
     static void shade_sorted(const StreamScene& sc, const KernelTable& kt, const RayStream& rays,
-                             const AlignedVec<std::int32_t>& object, int depth, bool per_sample, Workspace& ws,
+                             const AlignedVec<std::int32_t>& object, int depth, int samples_per_slot, Workspace& ws,
                              float* accum, RayCounts& counts, bool gathered) {
         using namespace stage_detail;
         SortedHits& h = ws.sorted;
@@ -341,7 +341,7 @@ struct ShadeStage {
                      .material = nullptr,
                      .lights = sc.lights.data(),
                      .n_lights = sc.lights.size(),
-                     .rules = shade_rules(sc, depth, per_sample),
+                     .rules = shade_rules(sc, depth, samples_per_slot),
                      .lr = h.lr.data(),
                      .lg = h.lg.data(),
                      .lb = h.lb.data(),

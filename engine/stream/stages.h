@@ -182,7 +182,7 @@ struct PipelineStages {
         ShadeMode shade_mode;
         std::size_t slice_rays;  ///< the most rays traced at once
         std::size_t slots;       ///< accumulation slots (accum holds 3 floats each; rays' `pixel`)
-        bool per_sample;         ///< each sample in a slot of its own, weight 1 (SampleRequest)
+        int samples_per_slot;    ///< the samples a slot sums (SampleRequest): rays weigh its reciprocal
         StageFigures* fig(Stage s) const { return profile ? &profile->stages[int(s)] : nullptr; }
     };
 
@@ -215,10 +215,10 @@ struct PipelineStages {
             // Area lights send `samples` shadow rays each (StreamScene::shadow_rays_per_hit).
             if constexpr (kShadows) ws.shadows.reserve(rays.count * sc.shadow_rays_per_hit);
             if (c.shade_mode == ShadeMode::Scalar)
-                Shade::shade(sc, rays, ws.object, ws.mesh_hits, depth, c.per_sample, ws.next, ws.shadows, ws.sorted,
-                             c.accum, c.counts);
+                Shade::shade(sc, rays, ws.object, ws.mesh_hits, depth, c.samples_per_slot, ws.next, ws.shadows,
+                             ws.sorted, c.accum, c.counts);
             else
-                Shade::shade_sorted(sc, c.kt, rays, ws.object, depth, c.per_sample, ws, c.accum, c.counts,
+                Shade::shade_sorted(sc, c.kt, rays, ws.object, depth, c.samples_per_slot, ws, c.accum, c.counts,
                                     c.shade_mode == ShadeMode::Gathered);
             if (kShadows && c.shade_mode == ShadeMode::Gathered)
                 Shade::order_shadows_by_pixel(ws, rays, c.slots);
@@ -290,7 +290,7 @@ struct PipelineStages {
                           int first, int n_pixels, Workspace& ws, float* accum, RayCounts& counts,
                           StreamProfile* profile, ShadeMode shade_mode, std::size_t slice_rays) {
         const Chunk c{sc, kt, tile, ws, accum, counts, profile, shade_mode, std::max<std::size_t>(1, slice_rays),
-                      req.slots(n_pixels, tile), req.per_sample};
+                      req.slots(n_pixels, tile), req.samples_per_slot()};
         {
             StageTimer timer(c.fig(Stage::Generate));
             generate(sc, kt, tile, req, first, n_pixels, ws);
