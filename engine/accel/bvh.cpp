@@ -333,6 +333,7 @@ struct Collapser {
     float child_cost;
     std::unique_ptr<std::array<float, kNodeWidth>[]> exact;
     std::size_t leaves = 0;
+    int depth = 0;  ///< the deepest level emitted (the root's: 1)
 
     static constexpr float kInf = std::numeric_limits<float>::infinity();
 
@@ -392,9 +393,10 @@ struct Collapser {
         cut(n.right, k - j, kids, nk);
     }
 
-    /// Emits the wide node of binary node b, then its inner children's nodes (parents first,
-    /// which refit relies on); returns its index.
-    std::int32_t emit(std::int32_t b) {
+    /// Emits the wide node of binary node b, at `level` (the root's: 1), then its inner
+    /// children's nodes (parents first, which refit relies on); returns its index.
+    std::int32_t emit(std::int32_t b, int level) {
+        depth = std::max(depth, level);
         const std::size_t me = out.size();
         out.emplace_back();
         std::int32_t kids[kNodeWidth];
@@ -429,7 +431,7 @@ struct Collapser {
         out[me] = n;
         for (int j = 0; j < nk; ++j) {
             if (bin[std::size_t(kids[j])].left < 0) continue;
-            const std::int32_t child = emit(kids[j]);
+            const std::int32_t child = emit(kids[j], level + 1);
             out[me].child[j] = child;
             out[me].count[j] = 0;
         }
@@ -490,13 +492,14 @@ Bvh build_over(std::vector<Ref> refs, const BuildOptions& options, std::chrono::
                 std::make_unique_for_overwrite<std::array<float, kNodeWidth>[]>(n_binary)};
     c.solve(0, 0);
     bvh.nodes.reserve(n_binary / 6 + 1);
-    c.emit(0);
+    c.emit(0, 1);
     bvh.prim_index.resize(n);
     parallel_for_index(n, 65536, [&](std::size_t k) { bvh.prim_index[k] = refs[k].id; });
     bvh.bounds = all;
     bvh.stats.binary_nodes = n_binary;
     bvh.stats.wide_nodes = bvh.nodes.size();
     bvh.stats.leaves = c.leaves;
+    bvh.stats.depth = c.depth;
     bvh.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }

@@ -78,6 +78,7 @@ struct BuildOptions {
 struct BuildStats {
     double seconds = 0;
     std::size_t binary_nodes = 0, wide_nodes = 0, leaves = 0;
+    int depth = 0;  ///< levels of wide nodes on the longest path from the root (the root alone: 1; empty: 0)
 };
 
 /// The hierarchy over a set of primitive boxes. Node 0 is the root; an empty hierarchy has no

@@ -8,6 +8,8 @@
 
 #include "core/error.h"
 #include "image/image_io.h"
+#include "kernels/stream_walk_memory.h"
+#include "mesh/mesh.h"
 #include "render/adaptive.h"
 #include "stream/stream_renderer.h"
 
@@ -49,6 +51,12 @@ MemoryEstimate estimate_render_memory(const Scene& scene, const RenderSettings& 
         }
         // The shadow rays of a slice, twice (regrouped by pixel after gathered shading).
         e.per_thread_bytes = streams + 2 * slice * kHitBytes + slice * kSortedBytes + 2 * slice * lights * kShadowBytes;
+        // A closest-hit stream (2 x slice rays at most) over meshes may be walked whole
+        // (kernels/stream_walk_memory.h): its lists grow with the deepest mesh tree.
+        int mesh_depth = 0;
+        for (const auto& m : scene.meshes)
+            if (m) mesh_depth = std::max(mesh_depth, m->bvh.stats.depth);
+        if (mesh_depth > 0) e.per_thread_bytes += mesh_stream_walk_bytes(2 * slice, mesh_depth);
     } else {
         e.per_thread_bytes = (double(s.depth) + 2) * kRecursiveFrameBytes;
     }

@@ -158,7 +158,8 @@ inline constexpr double kStreamWalkRaysPerRoot = 6.0;
 
 /// mesh_closest_impl's rays in packets that have scattered (scattered_packet_lanes, in world
 /// space), walked whole object by object; the other packets go to packet(i). False (nothing
-/// done) when too few rays scattered (kStreamWalkRays).
+/// done) when too few rays scattered (kStreamWalkRays). The memory check counts its buffers
+/// (kernels/stream_walk_memory.h).
 template <class Packet>
 bool mesh_closest_streamed(RayView rays, std::int32_t* object, const ObjectXf* objs, std::size_t n_objs,
                            Packet&& packet) {

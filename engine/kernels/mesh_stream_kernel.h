@@ -155,7 +155,8 @@ class StreamWalker {
         const accel::WideNode& nd = m_.nodes[index];
         int kids = 0;
         while (kids < accel::kNodeWidth && nd.child[kids] >= 0) ++kids;
-        // One list per child from `free` on, each with room for every ray of this one.
+        // One list per child from `free` on, each with room for every ray of this one (the
+        // memory check bounds the lists of a path down the tree: kernels/stream_walk_memory.h).
         pool_.reserve(free + std::size_t(kids) * n);
         std::size_t len[accel::kNodeWidth] = {};
         for (std::size_t k = 0; k < n; k += W) {

@@ -2,10 +2,13 @@
 // every SIMD traversal kernel the CPU runs, on random scenes of 1..1000 objects.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "parallel/parallelism.h"
 #include "scene/scene_bvh.h"
@@ -206,20 +209,61 @@ TEST_CASE("BVH: SIMD packet and single-ray kernels agree with the flat kernels, 
     }
 }
 
+namespace {
+/// The levels of wide nodes on the longest path from the root, walked here (BuildStats::depth
+/// says the same from the build).
+int levels_walked(const accel::Bvh& b) {
+    if (b.nodes.empty()) return 0;
+    std::vector<std::pair<std::int32_t, int>> todo{{0, 1}};
+    int deepest = 0;
+    while (!todo.empty()) {
+        const auto [node, level] = todo.back();
+        todo.pop_back();
+        deepest = std::max(deepest, level);
+        for (int j = 0; j < accel::kNodeWidth; ++j) {
+            const accel::WideNode& n = b.nodes[std::size_t(node)];
+            if (n.child[j] >= 0 && n.count[j] == 0) todo.push_back({n.child[j], level + 1});
+        }
+    }
+    return deepest;
+}
+}  // namespace
+
 TEST_CASE("BVH: build of an empty set, a single box and many equal boxes") {
     CHECK(accel::Bvh::build({}).empty());
+    CHECK(accel::Bvh::build({}).stats.depth == 0);
     accel::Aabb b;
     b.lo[0] = b.lo[1] = b.lo[2] = 0;
     b.hi[0] = b.hi[1] = b.hi[2] = 1;
     const accel::Bvh one = accel::Bvh::build({b});
     REQUIRE(one.nodes.size() == 1);
     CHECK(one.nodes[0].count[0] == 1);
+    CHECK(one.stats.depth == 1);  // the root alone
     const accel::Bvh many = accel::Bvh::build(std::vector<accel::Aabb>(1000, b));
     std::size_t total = 0;
     for (const auto& n : many.nodes)
         for (int j = 0; j < accel::kNodeWidth; ++j) total += n.count[j];
     CHECK(total == 1000);
     CHECK(many.prim_index.size() == 1000);
+    // 1000 boxes in leaves of at most 4 need at least 250 leaves, more than 8 x 8 (64) can hold
+    // under two levels, fewer than 8^3: at least 3 levels (equal boxes split at their median).
+    CHECK(many.stats.depth >= 3);
+    CHECK(many.stats.depth == levels_walked(many));
+}
+
+TEST_CASE("BVH: the tree's depth is the longest path of wide nodes (random boxes)") {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.f, 100.f);
+    for (const int n : {9, 100, 5000}) {
+        CAPTURE(n);
+        auto boxes = std::vector<accel::Aabb>(std::size_t(n));
+        for (auto& b : boxes)
+            for (int a = 0; a < 3; ++a) b.lo[a] = u(rng), b.hi[a] = b.lo[a] + 1.f;
+        const accel::Bvh bvh = accel::Bvh::build(boxes);
+        CHECK(bvh.stats.depth == levels_walked(bvh));
+        // At least n / 4 leaves (at most 4 boxes a leaf), and L levels hold at most 8^L.
+        if (n == 5000) CHECK(bvh.stats.depth >= 4);  // 1250 leaves > 8^3
+    }
 }
 
 TEST_CASE("BVH: the build from a box function leaves empty boxes out and makes the vector form's tree") {
@@ -277,6 +321,7 @@ TEST_CASE("BVH: the collapse into 8-wide nodes takes the least-cost cut (16 boxe
     opt.wide_child_cost = 0.25f;
     const accel::Bvh bvh = accel::Bvh::build(row, opt);
     REQUIRE(bvh.nodes.size() == 5);
+    CHECK(bvh.stats.depth == 2);  // the root and its four quads
     const accel::WideNode& root = bvh.nodes[0];
     for (int j = 0; j < accel::kNodeWidth; ++j) {
         CAPTURE(j);
@@ -301,4 +346,5 @@ TEST_CASE("BVH: the collapse into 8-wide nodes takes the least-cost cut (16 boxe
     }
     CHECK(leaves == 6);
     CHECK(inner == 2);
+    CHECK(flat.stats.depth == 2);
 }

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "driver/limits.h"
+#include "mesh/mesh.h"
 #include "render/adaptive.h"
 #include "scene/parser.h"
 #include "stream/child_peak_rss.h"
@@ -68,6 +69,48 @@ TEST_CASE("limits: the stream engine's memory grows linearly with depth, never a
     CHECK(e256.per_thread_bytes < 512.0 * 1024 * 1024);  // depth 256: about 420 MB a thread
     // The recursive engine's memory is its stack.
     CHECK(estimate_render_memory(glass, false, 1).total_bytes < 1e8);
+}
+
+TEST_CASE("limits: a scene with a mesh adds the whole-stream walk's lists, by its tree's depth") {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("streamrt_limits_mesh_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    // A tetrahedron: 4 triangles, one level of wide nodes whatever the leaves.
+    std::ofstream(dir / "tet.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    // A 64 x 64 grid of squares: 8192 triangles, at least 2048 leaves of 4: more than 8^3 = 512.
+    {
+        std::ofstream grid(dir / "grid.obj");
+        for (int y = 0; y <= 64; ++y)
+            for (int x = 0; x <= 64; ++x) grid << "v " << x << " " << y << " 0\n";
+        for (int y = 0; y < 64; ++y)
+            for (int x = 0; x < 64; ++x) {
+                const int a = y * 65 + x + 1, b = a + 1, c = a + 65, d = c + 1;
+                grid << "f " << a << " " << b << " " << d << "\nf " << a << " " << d << " " << c << "\n";
+            }
+    }
+    const auto scene = [&](const std::string& object) {
+        return parse_scene("image width=64 height=64 depth=5\nlight point pos=0,5,5\n" + object + "\n", "t.cfg");
+    };
+    const MemoryEstimate sphere = estimate_render_memory(scene("sphere"), true, 1);
+    const Scene tet_scene = scene("mesh file=" + (dir / "tet.obj").string());
+    const Scene grid_scene = scene("mesh file=" + (dir / "grid.obj").string());
+    REQUIRE(tet_scene.meshes.size() == 1);
+    REQUIRE(grid_scene.meshes.size() == 1);
+    CHECK(tet_scene.meshes[0]->bvh.stats.depth == 1);
+    const int grid_depth = grid_scene.meshes[0]->bvh.stats.depth;
+    CHECK(grid_depth >= 4);
+    // Per ray of a closest-hit stream (2 x 16384 rays): 4 + 24 + 12 + 12 bytes and a flag per
+    // 16 rays (52.0625), and the lists of a path down to level L, (1 + 8 L) ray numbers of 4
+    // bytes; all grown by half again: 1.5 x 32768 x (52.0625 + 4 x 9) for the tetrahedron.
+    const MemoryEstimate tet = estimate_render_memory(tet_scene, true, 1);
+    CHECK(tet.per_thread_bytes - sphere.per_thread_bytes == doctest::Approx(1.5 * 32768 * 88.0625));
+    // Each further level adds 8 ray numbers of 4 bytes per ray.
+    const MemoryEstimate grid = estimate_render_memory(grid_scene, true, 1);
+    CHECK(grid.per_thread_bytes - tet.per_thread_bytes == doctest::Approx(1.5 * 32768 * 32.0 * (grid_depth - 1)));
+    // The recursive engine walks one ray at a time: no lists.
+    CHECK(estimate_render_memory(tet_scene, false, 1).per_thread_bytes ==
+          estimate_render_memory(scene("sphere"), false, 1).per_thread_bytes);
+    fs::remove_all(dir);
 }
 
 // The estimate against what a render really holds: the peak resident memory of a streamrt
