@@ -12,6 +12,11 @@ included) and their ratio, then the same for the render phase alone (the summary
 "render" figure: the process's start, the scene's reading and the picture's writing, which
 both engines share, left out). SCENE defaults to perf/scenes/peer/bunny_glass.cfg (its mesh comes
 from scripts/fetch_bunny.py). The picture goes to a temporary PPM, removed at the end.
+
+--free-after G adds a third series, the stream engine at --depth G (the same picture's rays
+of generations 0 .. G only), and prints the ratios the stream engine would reach if every ray
+after generation G cost nothing: a bound on what faster deep rays can give, the shared
+reading and writing included.
 """
 import argparse
 import os
@@ -32,6 +37,8 @@ def main():
     ap.add_argument("--runs", type=int, default=9)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--size", default="1280x720", help="WxH (empty: the scene's own)")
+    ap.add_argument("--free-after", type=int, metavar="G",
+                    help="also time the stream engine at --depth G: the ratios if deeper rays were free")
     args = ap.parse_args()
     if args.runs < 1:
         ap.error("--runs must be at least 1")
@@ -41,13 +48,16 @@ def main():
     if args.size:
         w, _, h = args.size.partition("x")
         extra = ["--width", w, "--height", h]
-    seconds = {"recursive": [], "stream": []}
-    render = {"recursive": [], "stream": []}
+    series = {"recursive": ["--engine", "recursive"], "stream": ["--engine", "stream"]}
+    if args.free_after is not None:
+        series["shallow"] = ["--engine", "stream", "--depth", str(args.free_after)]
+    seconds = {name: [] for name in series}
+    render = {name: [] for name in series}
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "engine.ppm")
         for _ in range(args.runs):
             for engine in seconds:
-                cmd = [args.streamrt, "-j%d" % args.jobs, args.scene, "--engine", engine, "-o", out, *extra]
+                cmd = [args.streamrt, "-j%d" % args.jobs, args.scene, *series[engine], "-o", out, *extra]
                 start = time.perf_counter()
                 r = subprocess.run(cmd, capture_output=True, text=True)
                 elapsed = time.perf_counter() - start
@@ -66,6 +76,14 @@ def main():
         rr, rs = statistics.median(render["recursive"]), statistics.median(render["stream"])
         print("render phase alone: recursive %.3f s, stream %.3f s: stream engine %.2fx the recursive baseline"
               % (rr, rs, rr / rs))
+    if args.free_after is not None:
+        sw = statistics.median(seconds["shallow"])
+        line = ("stream engine at --depth %d: %.3f s whole: with every ray after generation %d free, at most %.2fx "
+                "the recursive baseline whole process" % (args.free_after, sw, args.free_after, rec / sw))
+        if render["shallow"] and render["recursive"]:
+            sr = statistics.median(render["shallow"])
+            line += ", %.2fx on the render phase (%.3f s)" % (statistics.median(render["recursive"]) / sr, sr)
+        print(line)
     return 0
 
 
