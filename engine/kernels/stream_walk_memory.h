@@ -2,7 +2,6 @@
 // What one thread's whole-stream walk of a mesh holds (intersect_kernel.h's
 // mesh_closest_streamed and mesh_stream_kernel.h's StreamWalker), for the memory check
 // (driver/limits.cpp). A change to those buffers changes this bound.
-#include <cstddef>
 
 namespace streamrt {
 
