@@ -220,10 +220,9 @@ int levels_walked(const accel::Bvh& b) {
         const auto [node, level] = todo.back();
         todo.pop_back();
         deepest = std::max(deepest, level);
-        for (int j = 0; j < accel::kNodeWidth; ++j) {
-            const accel::WideNode& n = b.nodes[std::size_t(node)];
+        const accel::WideNode& n = b.nodes[std::size_t(node)];
+        for (int j = 0; j < accel::kNodeWidth; ++j)
             if (n.child[j] >= 0 && n.count[j] == 0) todo.push_back({n.child[j], level + 1});
-        }
     }
     return deepest;
 }
@@ -245,8 +244,8 @@ TEST_CASE("BVH: build of an empty set, a single box and many equal boxes") {
         for (int j = 0; j < accel::kNodeWidth; ++j) total += n.count[j];
     CHECK(total == 1000);
     CHECK(many.prim_index.size() == 1000);
-    // 1000 boxes in leaves of at most 4 need at least 250 leaves, more than 8 x 8 (64) can hold
-    // under two levels, fewer than 8^3: at least 3 levels (equal boxes split at their median).
+    // 1000 boxes in leaves of at most 4 need at least 250 leaves, more than the 8 x 8 that two
+    // levels of wide nodes can hold: at least 3 levels (equal boxes split at their median).
     CHECK(many.stats.depth >= 3);
     CHECK(many.stats.depth == levels_walked(many));
 }
