@@ -42,7 +42,7 @@ sys.dont_write_bytecode = True  # no __pycache__ in scripts/
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import perf_common as pc  # noqa: E402
 
-KINDS = ("primary", "shadow", "reflected", "refracted")
+KINDS = ("primary", "shadow", "reflected", "refracted", "diffuse")
 
 
 def case_key(c):

@@ -20,7 +20,8 @@ struct RecursiveSink {
     const RecursiveRenderer& renderer;
     int depth;
     RayCounts& counts;
-    std::uint32_t key;  ///< the camera sample's light-sampling key
+    std::uint32_t key;  ///< the ray's key: its camera sample's light-sampling key, or at degree 6 its own
+    bool rekey;         ///< degree 6: children take keys of their own (child_key)
     ColorT<double> color{0, 0, 0};
 
     std::uint32_t light_key() const { return key; }
@@ -33,8 +34,9 @@ struct RecursiveSink {
     void child(bool send, const Vec3d& from, const Vec3d& dir, const ColorT<double>& weight,
                const ColorT<double>& throughput, double cone, RayKind kind) {
         if (!send) return;
-        ++(kind == RayKind::Reflected ? counts.reflected : counts.refracted);
-        color = color + mul(renderer.trace({from, dir, cone, throughput}, depth + 1, counts, key), weight);
+        ++counts.children(kind);
+        const std::uint32_t k = rekey ? child_key(key, std::uint32_t(kind)) : key;
+        color = color + mul(renderer.trace({from, dir, cone, throughput}, depth + 1, counts, k), weight);
     }
 };
 }  // namespace
@@ -176,9 +178,10 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
         .degree = s.degree,
         .ambient = s.ambient,
         .spawn = depth < s.depth,
-        .cutoff = s.cutoff,
+        .cutoff = s.degree >= 6 ? 0.0 : s.cutoff,  // biased: degree 6 ends paths by roulette instead
         .spread = camera_.spread,
-        .eye = camera_.origin};  // offsets measured from the eye, as the stream engine's
+        .eye = camera_.origin,  // offsets measured from the eye, as the stream engine's
+        .roulette = depth >= kRouletteFromDepth};
     // Weight 1: the caller multiplies what this ray brings back by its weight.
     const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
     const MaterialT<double>& material = materials_[object.material];
@@ -189,17 +192,18 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
         : material.vertex_colors && ob.mesh && ob.mesh->view().vertex_colors
             ? mesh_vertex_color(ob.mesh->view(), hit.tri, hit.bu, hit.bv)
             : ColorT<double>{object.color.x, object.color.y, object.color.z};
-    RecursiveSink sink{*this, depth, counts, key};
+    RecursiveSink sink{*this, depth, counts, key, s.degree >= 6};
     // A smooth mesh's shadow rays start from its curved patch, not the flat triangle.
     const bool smooth = ob.kind == ShapeKind::Mesh && ob.param != 0.0;
     const auto shadow_point = [&](const Vec3d& p) { return smooth ? p + terminator_shift_at(ray, hit) : p; };
-    const auto shade = [&]<bool kLit, bool kShadows>() {
-        shade_hit<kLit, kShadows, true, true>(rules, material, lights_.data(), lights_.size(), arriving, hit.point,
-                                              hit.normal, object_color, true, sink, shadow_point);
+    const auto shade = [&]<bool kLit, bool kShadows, bool kBounce>() {
+        shade_hit<kLit, kShadows, true, true, kBounce>(rules, material, lights_.data(), lights_.size(), arriving,
+                                                       hit.point, hit.normal, object_color, true, sink, shadow_point);
     };
-    if (s.degree == 0) shade.template operator()<false, false>();
-    else if (s.degree < 5) shade.template operator()<true, false>();
-    else shade.template operator()<true, true>();
+    if (s.degree == 0) shade.template operator()<false, false, false>();
+    else if (s.degree < 5) shade.template operator()<true, false, false>();
+    else if (s.degree == 5) shade.template operator()<true, true, false>();
+    else shade.template operator()<true, true, true>();
     return sink.color;
 }
 

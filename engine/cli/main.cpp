@@ -17,7 +17,8 @@ int run(int argc, char** argv) {
     app.add_option("--spp", opt.spp, "Samples per pixel")->check(CLI::Range(1, 65536));
     app.add_option("--width", opt.width, "Image width in pixels")->check(CLI::Range(1, 32768));
     app.add_option("--height", opt.height, "Image height in pixels")->check(CLI::Range(1, 32768));
-    app.add_option("--degree", opt.degree, "Shading degree 0..5 (handout)")->check(CLI::Range(0, 5));
+    app.add_option("--degree", opt.degree, "Shading degree 0..5 (handout), 6: global illumination (path tracing)")
+        ->check(CLI::Range(0, 6));
     app.add_option("--depth", opt.depth, "Maximum bounces")->check(CLI::Range(0, 256));
     app.add_option("--cutoff", opt.cutoff,
                    "Weight cut-off: reflected and refracted rays worth less than this in every channel are not "

@@ -22,10 +22,10 @@ namespace streamrt {
 namespace {
 
 constexpr std::uint32_t kRecordMagic = 0x454c4954u;  // "TILE" little-endian
-constexpr const char* kMagic = "streamrt-tiles 1";
+constexpr const char* kMagic = "streamrt-tiles 2";  // 2: records count diffuse rays
 
 // Fixed part of a record: magic, index, 4 ray counts, seconds; then pixels; then checksum.
-constexpr std::size_t kRecordHead = 4 + 4 + 4 * 8 + 8;
+constexpr std::size_t kRecordHead = 4 + 4 + 5 * 8 + 8;
 
 template <class T>
 void put(std::string& out, const T& v) {
@@ -137,6 +137,7 @@ void append_tile_record(std::string& out, const TileOutput& t) {
     put(out, t.counts.shadow);
     put(out, t.counts.reflected);
     put(out, t.counts.refracted);
+    put(out, t.counts.diffuse);
     put(out, t.seconds);
     out.append(reinterpret_cast<const char*>(t.rgb), std::size_t(t.tile.width() * t.tile.height()) * 3 * sizeof(float));
     put(out, fnv1a(std::string_view(out).substr(begin)));
@@ -154,8 +155,8 @@ std::size_t read_tile_records(std::string_view data, int width, int height, cons
         if (t.index < 0 || t.index >= tiles) break;
         t.tile = tile_rect(width, height, t.index);
         t.counts = RayCounts{get<std::uint64_t>(p + 8), get<std::uint64_t>(p + 16), get<std::uint64_t>(p + 24),
-                             get<std::uint64_t>(p + 32)};
-        t.seconds = get<double>(p + 40);
+                             get<std::uint64_t>(p + 32), get<std::uint64_t>(p + 40)};
+        t.seconds = get<double>(p + 48);
         const std::size_t pixel_bytes = std::size_t(t.tile.width() * t.tile.height()) * 3 * sizeof(float);
         const std::size_t size = kRecordHead + pixel_bytes + 8;
         if (data.size() - pos < size) break;

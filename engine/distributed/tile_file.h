@@ -16,7 +16,7 @@
 namespace streamrt {
 
 /// The first line of a tile file:
-/// "streamrt-tiles 1 scene=HASH settings=S size=WxH tiles=T set=K/N\n" (set=all: every tile).
+/// "streamrt-tiles 2 scene=HASH settings=S size=WxH tiles=T set=K/N\n" (set=all: every tile).
 struct TileFileHeader {
     std::string scene;     ///< content hash of the scene's files (16 hex digits)
     std::string settings;  ///< everything else the pixels depend on: key=value,key=value...

@@ -34,15 +34,21 @@ MemoryEstimate estimate_render_memory(const Scene& scene, const RenderSettings& 
     e.framebuffer_bytes = pixels * 3 * sizeof(float);
     // Writing streams bands into the file: a few bands' buffers, never a copy of the image.
     e.output_bytes = image_write_buffer_bytes(s.width, s.height);
-    bool spawns = false;
-    for (const Material& m : scene.materials) spawns = spawns || (s.degree >= 3 && m.refl > 0) || (s.degree >= 4 && m.trans > 0);
+    bool spawns = false, bounces = false;
+    for (const Material& m : scene.materials) {
+        spawns = spawns || (s.degree >= 3 && m.refl > 0) || (s.degree >= 4 && m.trans > 0);
+        bounces = bounces || (s.degree >= 6 && m.diff > 0);
+    }
+    spawns = spawns || bounces;
+    // Children per ray: reflected and refracted, and at degree 6 a diffuse bounce.
+    const double children = bounces ? 3.0 : 2.0;
     if (stream_engine) {
         const double slice = double(StreamRenderer::default_slice_rays(s.spp));
         e.slice_rays = slice;
         // Levels ws.pending (depth + 2 with spawns), plus the slice traced, its spawns and the
-        // regrouping buffer: each at most 2 x slice rays.
+        // regrouping buffer: each at most `children` x slice rays.
         e.generations = spawns ? s.depth + 2 : 1;
-        const double streams = (double(e.generations) + 3) * 2 * slice * kRayBytes;
+        const double streams = (double(e.generations) + 3) * children * slice * kRayBytes;
         // Shadow rays per hit: one per light, `samples` per area light.
         double lights = 0.0;
         for (const Light& given : scene.lights) {
@@ -56,7 +62,7 @@ MemoryEstimate estimate_render_memory(const Scene& scene, const RenderSettings& 
         int mesh_depth = 0;
         for (const auto& m : scene.meshes)
             if (m) mesh_depth = std::max(mesh_depth, m->bvh.stats.depth);
-        if (mesh_depth > 0) e.per_thread_bytes += mesh_stream_walk_bytes(2 * slice, mesh_depth);
+        if (mesh_depth > 0) e.per_thread_bytes += mesh_stream_walk_bytes(children * slice, mesh_depth);
     } else {
         e.per_thread_bytes = (double(s.depth) + 2) * kRecursiveFrameBytes;
     }

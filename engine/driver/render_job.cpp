@@ -135,7 +135,7 @@ RenderJob build_render_job(std::shared_ptr<const Scene> scene, const RenderOverr
     if (o.height) s.height = in("height", *o.height, 1, 32768);
     if (o.spp) s.spp = in("spp", *o.spp, 1, 65536);
     if (o.depth) s.depth = in("depth", *o.depth, 0, 256);
-    if (o.degree) s.degree = in("degree", *o.degree, 0, 5);
+    if (o.degree) s.degree = in("degree", *o.degree, 0, 6);
     if (o.cutoff) {
         if (!(*o.cutoff >= 0 && *o.cutoff <= 1)) throw UsageError("cutoff must be in [0, 1]");
         s.cutoff = *o.cutoff;

@@ -4,6 +4,9 @@
 // with one level's flags can be picked by the linker for another's callers.
 #include <xsimd/xsimd.hpp>
 
+#include <array>
+#include <utility>
+
 #include <limits>
 
 #include "kernels/generate_kernel.h"
@@ -308,8 +311,17 @@ void mesh_any_hit(RayView rays, const ObjectXf* objs, std::size_t n_objs) {
     mesh_any_impl<Arch>(rays, objs, nullptr, n_objs);
 }
 
-#define SHADE_VARIANT(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8), false>
-#define SHADE_GATHERED(k) &shade_run<Arch, bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8), true>
+/// Shade variant k (ShadeFn's index, kernels/shade_job.h); the bounce variants without
+/// lighting do not exist (degree 6 is lit).
+template <class Arch, int k, bool kGathered>
+constexpr ShadeFn shade_variant() {
+    if constexpr ((k & 16) && !(k & 1)) return nullptr;
+    else return &shade_run<Arch, bool(k & 1), bool(k & 2), bool(k & 4), bool(k & 8), bool(k & 16), kGathered>;
+}
+template <class Arch, bool kGathered, int... k>
+constexpr std::array<ShadeFn, kShadeVariants> shade_variants(std::integer_sequence<int, k...>) {
+    return {shade_variant<Arch, k, kGathered>()...};
+}
 /// The per-kind columns come from the registry (shapes/shapes.h): the canonical shapes in
 /// ShapeKind order, then the mesh kernels (Mesh is the last kind).
 template <class Arch, class... S>
@@ -321,14 +333,8 @@ KernelTable make_table(Isa isa, const char* name, ShapeList<S...>) {
                        {&any_hit<Arch, S>..., &mesh_any_hit<Arch>},
                        {&closest_hit_impl<Arch, S>..., &mesh_closest_impl<Arch>},
                        {&any_hit_impl<Arch, S>..., &mesh_any_impl<Arch>},
-                       {SHADE_VARIANT(0), SHADE_VARIANT(1), SHADE_VARIANT(2), SHADE_VARIANT(3), SHADE_VARIANT(4),
-                        SHADE_VARIANT(5), SHADE_VARIANT(6), SHADE_VARIANT(7), SHADE_VARIANT(8), SHADE_VARIANT(9),
-                        SHADE_VARIANT(10), SHADE_VARIANT(11), SHADE_VARIANT(12), SHADE_VARIANT(13), SHADE_VARIANT(14),
-                        SHADE_VARIANT(15)},
-                       {SHADE_GATHERED(0), SHADE_GATHERED(1), SHADE_GATHERED(2), SHADE_GATHERED(3),
-                        SHADE_GATHERED(4), SHADE_GATHERED(5), SHADE_GATHERED(6), SHADE_GATHERED(7),
-                        SHADE_GATHERED(8), SHADE_GATHERED(9), SHADE_GATHERED(10), SHADE_GATHERED(11),
-                        SHADE_GATHERED(12), SHADE_GATHERED(13), SHADE_GATHERED(14), SHADE_GATHERED(15)},
+                       shade_variants<Arch, false>(std::make_integer_sequence<int, kShadeVariants>{}),
+                       shade_variants<Arch, true>(std::make_integer_sequence<int, kShadeVariants>{}),
                        &generate_rays<Arch>,
                        &generate_lens_rays<Arch>};
 }

@@ -2,6 +2,7 @@
 // The SIMD intersection kernels, one per canonical shape and closest/any-hit, compiled for
 // several x86-64 levels (kernels/isa_*.cpp) and picked once per render from what the CPU
 // has. The pipeline calls them through this table, so only these files carry ISA flags.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 
@@ -44,8 +45,8 @@ struct KernelTable {
     AnyHitFn any[kShapeKindCount];
     ClosestCulledFn closest_culled[kShapeKindCount];
     AnyCulledFn any_culled[kShapeKindCount];
-    ShadeFn shade[kShadeVariants];
-    ShadeFn shade_gathered[kShadeVariants];  ///< runs of one material and kind, objects per lane
+    std::array<ShadeFn, kShadeVariants> shade;
+    std::array<ShadeFn, kShadeVariants> shade_gathered;  ///< runs of one material and kind, objects per lane
     GenerateFn generate;
     GenerateFn generate_lens;  ///< thin-lens cameras (aperture > 0) only
 };

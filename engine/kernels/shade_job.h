@@ -72,6 +72,7 @@ struct ShadeJob {
     // its own rays alone (docs/architecture.md, "Sums in a fixed order").
     RayAppend next;
     RayAppend next_refracted;
+    RayAppend next_diffuse;  ///< degree 6: the diffuse bounces, a third region of the same arrays
     ShadowAppend shadows;
     // Mesh objects only: the hit triangle and its barycentrics per ray (the slice's order); the
     // mesh and its smooth flag are the run's object's, or (gathered) each ray's object's.
@@ -82,7 +83,8 @@ struct ShadeJob {
     const KernelObject* objects = nullptr;     ///< gathered: every object's record, by id
     const SurfaceRecord* surfaces = nullptr;   ///< gathered: every object's colour, by id
     ShapeKind kind = ShapeKind::Sphere;        ///< gathered: the run's shape kind
-    const std::uint32_t* key = nullptr;        ///< area lights: per ray (the slice's order), its light-sampling key
+    const std::uint32_t* key = nullptr;        ///< area lights, degree 6: per ray (the slice's order), its key
+    bool rekey = false;  ///< degree 6: children take keys of their own (render/sampling.h child_key)
 };
 
 /// Camera rays for one chunk. Per ray (arrays padded to whole packets): the pixel's corner
@@ -110,8 +112,9 @@ struct GenerateJob {
 };
 using GenerateFn = void (*)(const GenerateJob& job);
 
-/// Shade variants, indexed by lit | shadows << 1 | reflect << 2 | refract << 3.
-inline constexpr int kShadeVariants = 16;
+/// Shade variants, indexed by lit | shadows << 1 | reflect << 2 | refract << 3 | bounce << 4;
+/// bounce (degree 6) comes with lit only: the unlit bounce variants are not built (nullptr).
+inline constexpr int kShadeVariants = 32;
 using ShadeFn = void (*)(const ShadeJob& job);
 
 }  // namespace streamrt

@@ -211,7 +211,9 @@ inline void append(const ShadeJob& job, std::size_t i, const M& active, const Ve
     using A = typename B::arch_type;
     const unsigned bits = lane_bits(active);
     if (bits == 0) return;
-    const RayAppend& r = kind == RayKind::Refracted ? job.next_refracted : job.next;
+    const RayAppend& r = kind == RayKind::Refracted ? job.next_refracted
+                         : kind == RayKind::Diffuse ? job.next_diffuse
+                                                    : job.next;
     const std::size_t j = *r.count;
     compress_store(o.x, bits, r.ox + j);
     compress_store(o.y, bits, r.oy + j);
@@ -227,9 +229,13 @@ inline void append(const ShadeJob& job, std::size_t i, const M& active, const Ve
     const std::size_t n =
         compress_store(run_field<A>(job, i, job.pixel), bits, r.pixel + j);
     std::memset(r.kind + j, int(kind), n);
-    if (r.key)  // area lights: children inherit the key (uniform per scene)
-        compress_store(run_field<A>(job, i, reinterpret_cast<const std::int32_t*>(job.key)), bits,
+    if (r.key) {  // area lights, degree 6: children inherit the key, or at degree 6 take their own
+        using U = xsimd::batch<std::uint32_t, A>;
+        U key = run_field<A>(job, i, job.key);
+        if (job.rekey) key = child_key(key, std::uint32_t(kind));
+        compress_store(xsimd::bitwise_cast<xsimd::batch<std::int32_t, A>>(key), bits,
                        reinterpret_cast<std::int32_t*>(r.key + j));
+    }
     *r.count = j + n;
 }
 
@@ -279,7 +285,7 @@ struct SimdSink {
 /// kGathered: the run shares a material and a shape kind, not an object; each lane's Mi, shape
 /// parameter and colour are gathered from its object's records (the same values a run of that
 /// object would broadcast, so the same arithmetic per lane).
-template <class Arch, bool kLit, bool kShadows, bool kReflect, bool kRefract, bool kGathered>
+template <class Arch, bool kLit, bool kShadows, bool kReflect, bool kRefract, bool kBounce, bool kGathered>
 void shade_run(const ShadeJob& job) {
     using B = xsimd::batch<float, Arch>;
     using I = xsimd::batch<std::int32_t, Arch>;
@@ -361,8 +367,8 @@ void shade_run(const ShadeJob& job) {
                 return at + terminator_shifts<B, false>(job, i, rows, meets_outside(n_out, d));
             }
         };
-        shade_hit<kLit, kShadows, kReflect, kRefract>(job.rules, m, job.lights, job.n_lights, arriving, p, n_out, color,
-                                                      active, sink, shadow_point);
+        shade_hit<kLit, kShadows, kReflect, kRefract, kBounce>(job.rules, m, job.lights, job.n_lights, arriving, p,
+                                                               n_out, color, active, sink, shadow_point);
     }
 }
 

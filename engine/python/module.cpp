@@ -173,6 +173,7 @@ Result make_result(RenderResult&& r, const RenderJob& job, EngineKind engine, do
     out.rays["shadow"] = r.counts.shadow;
     out.rays["reflected"] = r.counts.reflected;
     out.rays["refracted"] = r.counts.refracted;
+    out.rays["diffuse"] = r.counts.diffuse;
     out.rays["total"] = r.counts.total();
     if (job.profile && engine == EngineKind::Stream) {
         job.profile->adaptive = r.adaptive;  // as the command line's profile
@@ -302,7 +303,7 @@ PYBIND11_MODULE(streamrt, m) {
     py::class_<Result>(m, "Result", "One render: the picture, its times, its rays and (profile=True) the stream profile.")
         .def_readonly("image", &Result::image, "float32 array, height x width x 3, linear, top row first")
         .def_readonly("seconds", &Result::seconds, "{'read', 'setup', 'render'}: seconds")
-        .def_readonly("rays", &Result::rays, "{'primary', 'shadow', 'reflected', 'refracted', 'total'}")
+        .def_readonly("rays", &Result::rays, "{'primary', 'shadow', 'reflected', 'refracted', 'diffuse', 'total'}")
         .def_readonly("profile", &Result::profile, "the content of --profile=json as a dict, or None")
         .def_readonly("engine", &Result::engine, "'stream' or 'recursive'")
         .def_readonly("adaptive", &Result::adaptive,

@@ -293,5 +293,26 @@ inline void light_sample_hashes(const U& key, std::uint32_t light, std::uint32_t
     h2 = hash32(h1 ^ U(0x5bd1e995u));
 }
 
+// ---- Degree 6: the numbers of a path ------------------------------------------------------
+// A path's vertices draw from its ray's key. At degree 6 every child takes a key of its own,
+// made from its parent's and its kind (child_key), so the numbers depend on (pixel, sample,
+// the path's choices so far, dimension) only: both engines and every thread count draw the
+// same ones. Below degree 6 children inherit their parent's key, as before.
+
+/// The key of a ray spawned at degree 6 by a ray of key `key`; `kind` is its RayKind.
+template <class U>
+inline U child_key(const U& key, std::uint32_t kind) {
+    return hash32(key * U(0x9e3779b1u) + U(kind * 0x85ebca77u + 0x27d4eb2fu));
+}
+
+/// The three numbers of a diffuse bounce at a hit of a ray of key `key`: the direction's two
+/// (cosine_direction) and Russian roulette's. Apart from light_sample_hashes' by their seeds.
+template <class U>
+inline void bounce_hashes(const U& key, U& h1, U& h2, U& h3) {
+    h1 = hash32(key ^ U(0x6b43a9b5u));
+    h2 = hash32(h1 ^ U(0x5bd1e995u));
+    h3 = hash32(h2 ^ U(0x2c1b3c6du));
+}
+
 STREAMRT_ISA_END
 }  // namespace streamrt

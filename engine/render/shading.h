@@ -181,11 +181,33 @@ inline DirectLight<V> direct_light(int degree, const MaterialT<T>& m, const Colo
 
 /// The part of the colour that needs no light: degree 0 the flat colour, degree 1
 /// alpha Col, degree >= 2 alpha ambi Col.
+/// Degree 6 computes the light that the ambient term stood for (global-illumination.md), so
+/// it has none.
 template <class V, class T>
 inline ColorT<V> ambient_light(int degree, T alpha, const MaterialT<T>& m, const ColorT<V>& base) {
     if (degree == 0) return base;
     if (degree == 1) return base * V(alpha);
+    if (degree >= 6) return base * V(0);
     return base * V(alpha * m.ambi);
+}
+
+/// A direction about the unit normal n with density cos(theta) / pi (the Lambert BRDF's
+/// importance), from (u1, u2) in [0, 1)^2: the concentric disc lifted onto the hemisphere
+/// (Malley's method), in the frame of Duff et al. (2017), which has no branch and no
+/// singularity but n.z = -1 exactly (sign picks the stable half). The disc's angle comes from
+/// simd/stable_math.h, so every ISA level and the double engine get the same direction bits
+/// for the same numbers, up to their precision.
+template <class V>
+inline Vec3T<V> cosine_direction(const Vec3T<V>& n, const V& u1, const V& u2) {
+    using namespace simd;
+    const PixelSampleT<V> q = concentric_disc(u1, u2);
+    const V z = sqrt(max(V(1) - q.x * q.x - q.y * q.y, V(0)));
+    const V sign = select(n.z >= V(0), V(1), V(-1));
+    const V a = V(-1) / (sign + n.z);
+    const V b = n.x * n.y * a;
+    const Vec3T<V> t{V(1) + sign * n.x * n.x * a, sign * b, -sign * n.x};
+    const Vec3T<V> s{b, sign + n.y * n.y * a, -n.y};
+    return normalize(t * q.x + s * q.y + n * z);
 }
 
 template <class V>
@@ -306,7 +328,19 @@ struct ShadeRules {
     /// Where ray-origin offsets are measured from (offset_ray_origin): the eye; (0, 0, 0) in
     /// the stream engine, which renders relative to it.
     Vec3T<T> eye{T(0), T(0), T(0)};
+    /// Degree 6: Russian roulette ends the diffuse bounce of this generation's hits with
+    /// probability 1 - min(1, max channel of its throughput) (from kRouletteFromDepth on).
+    bool roulette = false;
+    /// What a ray's `throughput` is multiplied by to give its path's refl / trans / albedo
+    /// product: 1 in the recursive engine, the samples a slot sums in the stream engine, whose
+    /// throughput carries the sample's weight (the cut-off is scaled the same way).
+    T throughput_scale = T(1);
 };
+
+/// Degree 6: Russian roulette applies to the diffuse bounces of hits of this generation and
+/// deeper (the camera ray's hit is generation 0). Two unconditional bounces keep the light of
+/// the first indirect bounces free of roulette noise, where most of it is.
+inline constexpr int kRouletteFromDepth = 2;
 
 /// The ray that found a hit, at the hit.
 template <class V>
@@ -385,6 +419,35 @@ template <bool kShadows, class V, class T, class M, class Sink>
     }
 }
 
+/// Degree 6's diffuse bounce at a hit: a ray in a cosine-distributed direction about n (the
+/// side the arriving ray is on), of weight rho = base x diff per channel. The Lambert BRDF
+/// rho / pi times cos over the density cos / pi leaves rho: the direct term's diff (N.w) Col
+/// per unit of light, so direct and bounced light follow one reflectance. From generation
+/// kRouletteFromDepth on, the bounce survives with probability q = min(1, max channel of its
+/// path's throughput) and then weighs 1 / q: unbiased, and the paths worth little end early.
+template <class V, class T, class M, class Sink>
+[[gnu::noinline]] inline void spawn_bounce(const ShadeRules<T>& rules, const MaterialT<T>& m, const ColorT<V>& base,
+                                           const Vec3T<V>& n, const ArrivingRay<V>& ray, const Vec3T<V>& origin,
+                                           const V& cone, const M& active, Sink& sink) {
+    using namespace simd;
+    const auto key = sink.light_key();
+    auto h1 = key, h2 = key, h3 = key;
+    bounce_hashes(key, h1, h2, h3);
+    const ColorT<V> rho = base * V(m.diff);
+    ColorT<V> weight = mul(ray.weight, rho), throughput = mul(ray.throughput, rho);
+    auto send = active && (max(rho.x, max(rho.y, rho.z)) > V(0));
+    if (rules.roulette) {
+        const V q = min(V(1), max(throughput.x, max(throughput.y, throughput.z)) * V(rules.throughput_scale));
+        send = send && (V(unit_from_hash(h3)) < q);
+        const V inv = V(1) / select(q > V(0), q, V(1));
+        weight = weight * inv;
+        throughput = throughput * inv;
+    }
+    if (!any(send)) return;
+    sink.child(send, origin, cosine_direction(n, V(unit_from_hash(h1)), V(unit_from_hash(h2))), weight, throughput,
+               cone, RayKind::Diffuse);
+}
+
 /// The handout's shading of one hit (or one packet of hits), written once for the recursive
 /// baseline (V = double, one ray), the stream engine's scalar path (float) and its SIMD
 /// kernels (float batches): the surface colour (checker), the local terms by degree (with the
@@ -408,9 +471,10 @@ template <bool kShadows, class V, class T, class M, class Sink>
 /// triangles' corners lane by lane).
 /// The features are compile-time flags so a scene's pipeline carries no code for what it
 /// lacks: kLit (degree >= 1), kShadows (degree 5), kReflect (degree >= 3 and some refl),
-/// kRefract (degree >= 4 and some trans). p is the world hit point, n_out the unit outward
-/// normal (needed when kLit or the material is a checker), color the object's colour.
-template <bool kLit, bool kShadows, bool kReflect, bool kRefract, class V, class T, class M, class Sink,
+/// kRefract (degree >= 4 and some trans), kBounce (degree 6 and some diff: spawn_bounce).
+/// p is the world hit point, n_out the unit outward normal (needed when kLit or the material
+/// is a checker), color the object's colour.
+template <bool kLit, bool kShadows, bool kReflect, bool kRefract, bool kBounce, class V, class T, class M, class Sink,
           class ShadowPoint = KeepPoint>
 inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const LightT<T>* lights,
                       std::size_t n_lights, const ArrivingRay<V>& ray, const Vec3T<V>& p, const Vec3T<V>& n_out,
@@ -468,6 +532,13 @@ inline void shade_hit(const ShadeRules<T>& rules, const MaterialT<T>& m, const L
         sink.local(local);
         if (!rules.spawn) return;
         const V cone = ray.cone + V(rules.spread) * ray.t;
+        if constexpr (kBounce) {
+            if (m.diff > T(0)) {  // per material: uniform over a packet
+                // From the shadow rays' point: on a smooth mesh, off the flat triangle.
+                make_origin();
+                spawn_bounce(rules, m, base, n, ray, shadow_origin, cone, active, sink);
+            }
+        }
         // A child is traced unless the cut-off is on and its throughput is below it in
         // every channel.
         const auto kept = [&](const ColorT<V>& throughput) {

@@ -29,7 +29,7 @@ void Parser::image(Statement& st, const std::vector<Token>& toks) {
         else if (k == "height") s.height = st.integer(a, 1, 32768);
         else if (k == "spp") s.spp = st.integer(a, 1, 65536);
         else if (k == "depth") s.depth = st.integer(a, 0, 256);
-        else if (k == "degree") s.degree = st.integer(a, 0, 5);
+        else if (k == "degree") s.degree = st.integer(a, 0, 6);
         else if (k == "cutoff") s.cutoff = st.in_closed(a, 0.0, 1.0);
         else if (k == "adaptive") s.adaptive = st.in_closed(a, 0.0, 1.0);
         else if (k == "output") s.output = std::string(a.value);

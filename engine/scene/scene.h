@@ -88,7 +88,7 @@ struct RenderSettings {
     int height = 480;
     int spp = 1;
     int depth = 5;   ///< maximum number of reflection/refraction bounces after the primary hit
-    int degree = 5;  ///< 0 flat .. 5 shadows, cumulative (handout)
+    int degree = 5;  ///< 0 flat .. 5 shadows, cumulative (handout); 6 adds light bounced between surfaces
     double ambient = 0.1;  ///< alpha, the ambient fraction
     /// Weight cut-off: reflected / refracted rays whose throughput (product of the refl and
     /// trans weights from the camera) is below this in every channel are not traced; 0 = all.

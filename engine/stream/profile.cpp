@@ -42,9 +42,11 @@ std::string StreamProfile::text() const {
         out += line;
     }
     std::snprintf(line, sizeof line,
-                  "rays: primary %llu, shadow %llu, reflected %llu, refracted %llu, total %llu (%.2f Mrays/s wall)\n",
+                  "rays: primary %llu, shadow %llu, reflected %llu, refracted %llu, diffuse %llu, total %llu (%.2f Mrays/s "
+                  "wall)\n",
                   (unsigned long long)counts.primary, (unsigned long long)counts.shadow,
                   (unsigned long long)counts.reflected, (unsigned long long)counts.refracted,
+                  (unsigned long long)counts.diffuse,
                   (unsigned long long)counts.total(), wall_seconds > 0 ? double(counts.total()) / wall_seconds / 1e6 : 0.0);
     out += line;
     out += "(stage times are thread CPU time, summed over threads; Mrays/s = rays in / cpu s)\n";
@@ -52,15 +54,16 @@ std::string StreamProfile::text() const {
     for (const auto& g : generations) any_generation = any_generation || g.rays > 0 || g.shadow_rays > 0;
     if (any_generation) {
         std::snprintf(line, sizeof line, "%-10s %10s  %-32s %11s %9s %12s %11s %9s\n", "generation", "rays",
-                      "(primary/reflected/refracted)", "intersect s", "Mrays/s", "shadow rays", "occlusion s", "Mrays/s");
+                      "(primary/reflected/refracted/diffuse)", "intersect s", "Mrays/s", "shadow rays", "occlusion s", "Mrays/s");
         out += line;
         for (std::size_t d = 0; d < generations.size(); ++d) {
             const GenerationFigures& g = generations[d];
             if (g.rays == 0 && g.shadow_rays == 0) continue;
             const double isec = double(g.intersect_ns) * 1e-9, osec = double(g.occlusion_ns) * 1e-9;
             char kinds[80];
-            std::snprintf(kinds, sizeof kinds, "(%llu/%llu/%llu)", (unsigned long long)g.primary,
-                          (unsigned long long)g.reflected, (unsigned long long)g.refracted);
+            std::snprintf(kinds, sizeof kinds, "(%llu/%llu/%llu/%llu)", (unsigned long long)g.primary,
+                          (unsigned long long)g.reflected, (unsigned long long)g.refracted,
+                          (unsigned long long)g.diffuse);
             std::snprintf(line, sizeof line, "%-10zu %10llu  %-32s %11.4f %9.2f %12llu %11.4f %9.2f\n", d,
                           (unsigned long long)g.rays, kinds, isec, isec > 0 ? double(g.rays) / isec / 1e6 : 0.0,
                           (unsigned long long)g.shadow_rays, osec,
@@ -113,19 +116,22 @@ std::string StreamProfile::json() const {
         const double isec = double(g.intersect_ns) * 1e-9, osec = double(g.occlusion_ns) * 1e-9;
         std::snprintf(buf, sizeof buf,
                       "%s    {\"generation\": %zu, \"rays\": %llu, \"primary\": %llu, \"reflected\": %llu, "
-                      "\"refracted\": %llu, \"intersect_cpu_seconds\": %.6f, \"intersect_mrays_per_s\": %.3f, "
+                      "\"refracted\": %llu, \"diffuse\": %llu, \"intersect_cpu_seconds\": %.6f, \"intersect_mrays_per_s\": %.3f, "
                       "\"shadow_rays\": %llu, \"occlusion_cpu_seconds\": %.6f, \"occlusion_mrays_per_s\": %.3f}",
                       first ? "" : ",\n", d, (unsigned long long)g.rays, (unsigned long long)g.primary,
-                      (unsigned long long)g.reflected, (unsigned long long)g.refracted, isec,
+                      (unsigned long long)g.reflected, (unsigned long long)g.refracted, (unsigned long long)g.diffuse,
+                      isec,
                       isec > 0 ? double(g.rays) / isec / 1e6 : 0.0, (unsigned long long)g.shadow_rays, osec,
                       osec > 0 ? double(g.shadow_rays) / osec / 1e6 : 0.0);
         out += buf;
         first = false;
     }
     std::snprintf(buf, sizeof buf,
-                  "\n  ],\n  \"rays\": {\"primary\": %llu, \"shadow\": %llu, \"reflected\": %llu, \"refracted\": %llu}",
+                  "\n  ],\n  \"rays\": {\"primary\": %llu, \"shadow\": %llu, \"reflected\": %llu, \"refracted\": %llu, "
+                  "\"diffuse\": %llu}",
                   (unsigned long long)counts.primary, (unsigned long long)counts.shadow,
-                  (unsigned long long)counts.reflected, (unsigned long long)counts.refracted);
+                  (unsigned long long)counts.reflected, (unsigned long long)counts.refracted,
+                  (unsigned long long)counts.diffuse);
     out += buf;
     if (adaptive) {
         const AdaptivePhases& p = adaptive->seconds;

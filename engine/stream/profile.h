@@ -37,7 +37,7 @@ struct StageFigures {
 /// so a stage's generations add up to its row.
 struct GenerationFigures {
     std::uint64_t rays = 0;  ///< rays intersected in this generation
-    std::uint64_t primary = 0, reflected = 0, refracted = 0;  ///< `rays` by RayKind
+    std::uint64_t primary = 0, reflected = 0, refracted = 0, diffuse = 0;  ///< `rays` by RayKind
     std::uint64_t intersect_ns = 0;  ///< intersect stage, thread CPU time
     std::uint64_t shadow_rays = 0;   ///< shadow rays cast from this generation's hits
     std::uint64_t occlusion_ns = 0;  ///< occlusion stage, thread CPU time
@@ -46,6 +46,7 @@ struct GenerationFigures {
         primary += o.primary;
         reflected += o.reflected;
         refracted += o.refracted;
+        diffuse += o.diffuse;
         intersect_ns += o.intersect_ns;
         shadow_rays += o.shadow_rays;
         occlusion_ns += o.occlusion_ns;

@@ -96,9 +96,11 @@ inline std::uint64_t lanes_for(std::size_t n, int width) {
 }  // namespace stage_detail
 
 /// The shade stage for a scene's features (the same flags as PipelineStages).
-template <bool kLighting, bool kShadows, bool kReflect, bool kRefract>
+template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kBounce>
 struct ShadeStage {
-    static constexpr bool kSecondary = kReflect || kRefract;
+    static constexpr bool kSecondary = kReflect || kRefract || kBounce;
+    /// The most children one ray spawns: a reflected, a refracted and (degree 6) a diffuse one.
+    static constexpr std::size_t kChildrenPerRay = kBounce ? 3 : 2;
 
     /// The shading rules for rays of generation `depth`. The cut-off is defined on the refl /
     /// trans product alone, as in the recursive engine, and the stream's weights also carry
@@ -110,9 +112,11 @@ struct ShadeStage {
         return {.degree = s.degree,
                 .ambient = float(s.ambient),
                 .spawn = kSecondary && depth < s.depth,
-                .cutoff = float(s.cutoff / samples_per_slot),
+                .cutoff = s.degree >= 6 ? 0.f : float(s.cutoff / samples_per_slot),  // degree 6: roulette instead
                 .spread = sc.camera.spread,
-                .eye = {0.f, 0.f, 0.f}};  // the engine's origin is the eye (stream_scene.cpp)
+                .eye = {0.f, 0.f, 0.f},  // the engine's origin is the eye (stream_scene.cpp)
+                .roulette = depth >= kRouletteFromDepth,
+                .throughput_scale = float(samples_per_slot)};
     }
 
     /// Where shade_hit's results go on the scalar path: the local colour into the tile (with
@@ -129,6 +133,7 @@ struct ShadeStage {
         std::size_t i;              ///< the ray shaded
         SortedHits& hits;
         std::size_t k;              ///< its place among the slice's hits (SortedHits::order)
+        bool rekey;                 ///< degree 6: children take keys of their own (child_key)
 
         std::uint32_t light_key() const { return keys[i]; }
 
@@ -154,9 +159,10 @@ struct ShadeStage {
         void child(bool send, const Vec3f& from, const Vec3f& dir, const ColorT<float>& weight, const ColorT<float>&,
                    float cone, RayKind kind) {
             if (!send) return;
-            if (keys) next.key[next.count] = keys[i];  // area lights: the child inherits the key
+            // Area lights: the child inherits the key; degree 6: it takes its own.
+            if (keys) next.key[next.count] = rekey ? child_key(keys[i], std::uint32_t(kind)) : keys[i];
             push(next, next.count++, from, dir, weight, cone, px, kind);
-            ++(kind == RayKind::Reflected ? counts.reflected : counts.refracted);
+            ++counts.children(kind);
         }
     };
 
@@ -175,7 +181,7 @@ struct ShadeStage {
         // cache misses: fetch them a few rays ahead (in leaf order, neighbouring rays mostly
         // hit objects close in memory).
         constexpr std::size_t kPrefetchDistance = 8;
-        const std::uint32_t* keys = sc.features.area_lights ? rays.key.data() : nullptr;
+        const std::uint32_t* keys = sc.features.keys ? rays.key.data() : nullptr;
         for (std::size_t i = 0; i < rays.count; ++i) {
             if (i + kPrefetchDistance < rays.count && object[i + kPrefetchDistance] >= 0) {
                 const std::size_t ahead = std::size_t(object[i + kPrefetchDistance]);
@@ -208,7 +214,7 @@ struct ShadeStage {
             const ArrivingRay<float> arriving{o, d, t, rays.cone[i], w, w};
             const std::size_t k = hits.hits;
             if constexpr (kShadows) hits.order[k] = std::int32_t(i), ++hits.hits;
-            ScalarSink sink{accum, px, next, shadows, counts, keys, i, hits, k};
+            ScalarSink sink{accum, px, next, shadows, counts, keys, i, hits, k, rules.degree >= 6};
             const Vec3f n_out = apply_normal(ob.xf.m, nc);
             ColorT<float> color{sf.color[0], sf.color[1], sf.color[2]};
             if (m.texture) {  // the texture replaces the object's colour (render/texture.h)
@@ -228,8 +234,9 @@ struct ShadeStage {
                 return at + terminator_shift(ob.xf.m, smooth_corners<float>(*ob.xf.mesh, std::uint32_t(mesh_hits.prim[i])),
                                              mesh_hits.u[i], mesh_hits.v[i], meets_outside(n_out, d));
             };
-            shade_hit<kLighting, kShadows, kReflect, kRefract>(rules, m, sc.lights.data(), sc.lights.size(), arriving,
-                                                               p, n_out, color, true, sink, shadow_point);
+            shade_hit<kLighting, kShadows, kReflect, kRefract, kBounce>(rules, m, sc.lights.data(), sc.lights.size(),
+                                                                        arriving, p, n_out, color, true, sink,
+                                                                        shadow_point);
         }
     }
 
@@ -311,15 +318,16 @@ struct ShadeStage {
             // Past the last run, whole packets read a hit (gathered runs read its object's id).
             std::fill_n(order + hits, simd::kMaxLanes, hits > 0 ? order[hits - 1] : 0);
         }
-        // The children's regions (ShadeJob::next, next_refracted): at most one ray per hit
-        // each, plus a packet of slack for the compacting stores.
+        // The children's regions (ShadeJob::next, next_refracted, next_diffuse): at most one
+        // ray per hit each, plus a packet of slack for the compacting stores.
         const std::size_t region = simd::round_up_lanes(hits) + simd::kMaxLanes;
         RayStream& nx = ws.next;
         ShadowStream& sh = ws.shadows;
         std::size_t refracted = 0;  // the refracted children's count (the reflected: nx.count)
+        std::size_t diffuse = 0;    // the diffuse children's count
         if constexpr (kSecondary) {
-            nx.reserve(2 * region);
-            if (sc.features.area_lights) nx.reserve_keys();
+            nx.reserve(kChildrenPerRay * region);
+            if (sc.features.keys) nx.reserve_keys();
         }
         ShadeJob job{.ox = rays.ox.data(),
                      .oy = rays.oy.data(),
@@ -347,13 +355,18 @@ struct ShadeStage {
                      .lb = h.lb.data(),
                      .next = append_view(nx),
                      .next_refracted = region_view(nx, region, &refracted),
+                     .next_diffuse = kBounce ? region_view(nx, 2 * region, &diffuse) : RayAppend{},
                      .shadows = append_view(sh),
                      .prim = ws.mesh_hits.prim.data(),
                      .bu = ws.mesh_hits.u.data(),
                      .bv = ws.mesh_hits.v.data()};
-        if (sc.features.area_lights)
+        if (sc.features.keys) {
             job.key = rays.key.data(), job.next.key = nx.key.data(), job.next_refracted.key = nx.key.data() + region;
-        const int variant = (kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0);
+            if constexpr (kBounce) job.next_diffuse.key = nx.key.data() + 2 * region;
+            job.rekey = job.rules.degree >= 6;
+        }
+        const int variant =
+            (kLighting ? 1 : 0) | (kShadows ? 2 : 0) | (kReflect ? 4 : 0) | (kRefract ? 8 : 0) | (kBounce ? 16 : 0);
         const ShadeFn fn = gathered ? kt.shade_gathered[variant] : kt.shade[variant];
         if (gathered) {
             job.ids = object.data();
@@ -381,7 +394,9 @@ struct ShadeStage {
         if constexpr (kSecondary) {
             counts.reflected += nx.count;
             counts.refracted += refracted;
-            join_region(nx, region, refracted, sc.features.area_lights);
+            counts.diffuse += diffuse;
+            join_region(nx, region, refracted, sc.features.keys);
+            if constexpr (kBounce) join_region(nx, 2 * region, diffuse, sc.features.keys);
         }
     }
 

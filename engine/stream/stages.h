@@ -23,10 +23,10 @@
 
 namespace streamrt {
 
-template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
+template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kBounce, bool kJitter>
 struct PipelineStages {
-    static constexpr bool kSecondary = kReflect || kRefract;
-    using Shade = ShadeStage<kLighting, kShadows, kReflect, kRefract>;
+    static constexpr bool kSecondary = kReflect || kRefract || kBounce;
+    using Shade = ShadeStage<kLighting, kShadows, kReflect, kRefract, kBounce>;
 
     /// generate: camera rays for pixels [first, first + n_pixels) of the request's list
     /// (SampleRequest), its run of samples per pixel, consecutive, so a pixel's samples share
@@ -103,7 +103,7 @@ struct PipelineStages {
                               .fixed_offset = req.run.corner ? 0.f : 0.5f,
                               .sequence = kJitter && uses_sequence(sc.settings.pattern, req.run)};
         (lens ? kt.generate_lens : kt.generate)(job);
-        if (sc.features.area_lights) {
+        if (sc.features.keys) {
             // Each camera ray's light-sampling key (render/sampling.h light_key), from its
             // image pixel and sample number: the rays of a pixel are its samples in order.
             rays.reserve_keys();
@@ -205,13 +205,16 @@ struct PipelineStages {
         if (c.profile)  // by kind, outside the stage's time
             for (std::size_t i = 0; i < rays.count; ++i) {
                 const RayKind kind = RayKind(rays.kind[i]);
-                (kind == RayKind::Primary ? gen->primary : kind == RayKind::Reflected ? gen->reflected : gen->refracted) += 1;
+                (kind == RayKind::Primary     ? gen->primary
+                 : kind == RayKind::Reflected ? gen->reflected
+                 : kind == RayKind::Refracted ? gen->refracted
+                                              : gen->diffuse) += 1;
             }
         {
             StageTimer timer(c.fig(Stage::Shade));
-            // Room for every ray spawning both children and a shadow ray per light.
-            ws.next.reserve(kSecondary ? rays.count * 2 : 0);
-            if (sc.features.area_lights) ws.next.reserve_keys();
+            // Room for every ray spawning every child and a shadow ray per light.
+            ws.next.reserve(kSecondary ? rays.count * Shade::kChildrenPerRay : 0);
+            if (sc.features.keys) ws.next.reserve_keys();
             // Area lights send `samples` shadow rays each (StreamScene::shadow_rays_per_hit).
             if constexpr (kShadows) ws.shadows.reserve(rays.count * sc.shadow_rays_per_hit);
             if (c.shade_mode == ShadeMode::Scalar)
@@ -265,10 +268,10 @@ struct PipelineStages {
         }
         const std::vector<std::size_t> bounds =
             stage_detail::cut_into_slices(gen, ws.regroup, c.slice_rays, c.slots,
-                                          ws.pixel_rays, ws.pixel_slice, c.sc.features.area_lights);
+                                          ws.pixel_rays, ws.pixel_slice, c.sc.features.keys);
         for (std::size_t k = 0; k + 1 < bounds.size(); ++k) {
             RayStream slice = ws.take(), spawned = ws.take();
-            stage_detail::copy_rays(gen, bounds[k], bounds[k + 1] - bounds[k], slice, c.sc.features.area_lights);
+            stage_detail::copy_rays(gen, bounds[k], bounds[k + 1] - bounds[k], slice, c.sc.features.keys);
             trace_slice(c, depth, slice, spawned);
             ws.give(std::move(slice));
             descend(c, depth, std::move(spawned));

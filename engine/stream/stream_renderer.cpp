@@ -1,6 +1,8 @@
 #include "stream/stream_renderer.h"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <chrono>
 #include <mutex>
 
@@ -40,6 +42,7 @@ std::vector<std::string> StreamRenderer::built_stages() const {
     b.push_back(std::string(f.lighting ? "shade(lit" : "shade(flat") + (f.textures ? ",textured" : "") + how);
     if (f.reflect) b.push_back("spawn(reflect)");
     if (f.refract) b.push_back("spawn(refract)");
+    if (f.bounce) b.push_back("spawn(diffuse)");
     if (f.shadows)
         b.push_back(f.area_lights ? "occlusion(any-hit,area x " + std::to_string(f.area_samples) + ")"
                                   : std::string("occlusion(any-hit)"));
@@ -49,10 +52,10 @@ std::vector<std::string> StreamRenderer::built_stages() const {
     return b;
 }
 
-template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
+template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kBounce, bool kJitter>
 void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, const SampleRequest& req, float* accum,
                                  RayCounts& counts, StreamProfile* profile, const RenderProgress* cancel) {
-    using Stages = PipelineStages<kLighting, kShadows, kReflect, kRefract, kJitter>;
+    using Stages = PipelineStages<kLighting, kShadows, kReflect, kRefract, kBounce, kJitter>;
     const StreamScene& sc = self.scene_;
     // Memory in flight is bounded by the chunk, not the image: the request's pixels are cut
     // into chunks of whole pixels (all samples of a pixel in the same stream, hence packet).
@@ -70,23 +73,20 @@ void StreamRenderer::render_tile(const StreamRenderer& self, const Tile& tile, c
 
 StreamRenderer::TileFn StreamRenderer::select_tile_fn() const {
     // Every combination is instantiated; the scene picks one. A scene without lights or
-    // mirrors runs a pipeline that has no code for them.
+    // mirrors runs a pipeline that has no code for them. Feature bits: lighting 1, shadows 2,
+    // reflect 4, refract 8, jitter 16, bounce 32; bounces come with lighting only (degree 6),
+    // so the unlit ones are not built.
     const StreamFeatures& f = scene_.features;
     const int key = (f.lighting ? 1 : 0) | (f.shadows ? 2 : 0) | (f.reflect ? 4 : 0) | (f.refract ? 8 : 0) |
-                    (f.jitter ? 16 : 0);
-#define STREAMRT_TILE_FN(k) \
-    &render_tile<bool((k) & 1), bool((k) & 2), bool((k) & 4), bool((k) & 8), bool((k) & 16)>
-    static constexpr TileFn table[32] = {
-        STREAMRT_TILE_FN(0),  STREAMRT_TILE_FN(1),  STREAMRT_TILE_FN(2),  STREAMRT_TILE_FN(3),
-        STREAMRT_TILE_FN(4),  STREAMRT_TILE_FN(5),  STREAMRT_TILE_FN(6),  STREAMRT_TILE_FN(7),
-        STREAMRT_TILE_FN(8),  STREAMRT_TILE_FN(9),  STREAMRT_TILE_FN(10), STREAMRT_TILE_FN(11),
-        STREAMRT_TILE_FN(12), STREAMRT_TILE_FN(13), STREAMRT_TILE_FN(14), STREAMRT_TILE_FN(15),
-        STREAMRT_TILE_FN(16), STREAMRT_TILE_FN(17), STREAMRT_TILE_FN(18), STREAMRT_TILE_FN(19),
-        STREAMRT_TILE_FN(20), STREAMRT_TILE_FN(21), STREAMRT_TILE_FN(22), STREAMRT_TILE_FN(23),
-        STREAMRT_TILE_FN(24), STREAMRT_TILE_FN(25), STREAMRT_TILE_FN(26), STREAMRT_TILE_FN(27),
-        STREAMRT_TILE_FN(28), STREAMRT_TILE_FN(29), STREAMRT_TILE_FN(30), STREAMRT_TILE_FN(31)};
-#undef STREAMRT_TILE_FN
-    return table[key];
+                    (f.jitter ? 16 : 0) | (f.bounce ? 32 : 0);
+    static constexpr auto pick = []<int k>() -> TileFn {
+        if constexpr ((k & 32) && !(k & 1)) return nullptr;
+        else return &render_tile<bool(k & 1), bool(k & 2), bool(k & 4), bool(k & 8), bool(k & 32), bool(k & 16)>;
+    };
+    static constexpr auto table = []<int... k>(std::integer_sequence<int, k...>) {
+        return std::array<TileFn, sizeof...(k)>{pick.template operator()<k>()...};
+    }(std::make_integer_sequence<int, 64>{});
+    return table[std::size_t(key)];
 }
 
 void StreamRenderer::render_one_tile(const Tile& tile, float* rgb, RayCounts& counts, StreamProfile* profile,

@@ -72,7 +72,7 @@ class StreamRenderer {
     // accum: the request's slots (SampleRequest), 3 floats each, zeroed by the caller.
     using TileFn = void (*)(const StreamRenderer&, const Tile&, const SampleRequest&, float* accum, RayCounts&,
                             StreamProfile*, const RenderProgress* cancel);
-    template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kJitter>
+    template <bool kLighting, bool kShadows, bool kReflect, bool kRefract, bool kBounce, bool kJitter>
     static void render_tile(const StreamRenderer& self, const Tile& tile, const SampleRequest& req, float* accum,
                             RayCounts& counts, StreamProfile* profile, const RenderProgress* cancel);
     TileFn select_tile_fn() const;

@@ -70,7 +70,7 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
     object_count = n;
     fill_surfaces(scene);
 
-    bool any_refl = false, any_trans = false, any_fresnel = false;
+    bool any_refl = false, any_trans = false, any_fresnel = false, any_diff = false;
     for (const Material& m : scene.materials) {
         MaterialT<float> mat = MaterialT<float>::from(m);
         const glm::vec3 offset = cell_offset(m, eye);
@@ -83,6 +83,7 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
         any_refl |= m.refl > 0;
         any_trans |= m.trans > 0;
         any_fresnel |= mat.fresnel;  // reflects even with refl = 0 (at degree >= 4)
+        any_diff |= m.diff > 0;
     }
     convert_lights(scene);
     features.lighting = s.degree >= 1;
@@ -96,6 +97,8 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
         if (l.area) features.area_samples += l.samples;
     }
     features.area_lights = features.lighting && features.area_samples > 0;
+    features.bounce = s.degree >= 6 && s.depth >= 1 && any_diff;
+    features.keys = features.area_lights || features.bounce;
 }
 
 void StreamScene::fill_surfaces(const Scene& scene) {

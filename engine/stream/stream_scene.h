@@ -29,6 +29,10 @@ struct StreamFeatures {
     /// area_samples shadow rays for them through the occlusion stage.
     bool area_lights = false;
     int area_samples = 0;
+    /// Degree 6, depth >= 1 and some material has diff > 0: diffuse bounces (spawn(diffuse)).
+    bool bounce = false;
+    /// Rays carry keys (RayStream::key): area lights, or diffuse bounces.
+    bool keys = false;
 };
 
 struct StreamScene {

@@ -80,7 +80,7 @@ TEST_CASE("cli: bad command lines are one-line errors with exit status 2") {
     const fs::path scene = d.write("s.cfg", kSmallScene);
     const std::vector<std::pair<std::string, std::string>> cases = {
         {"--width 1000000000", "--width"}, {"--width 1e9", "--width"},   {"--height 0", "--height"},
-        {"--depth 1000000", "--depth"},    {"--spp 100000000", "--spp"}, {"--degree 6", "--degree"},
+        {"--depth 1000000", "--depth"},    {"--spp 100000000", "--spp"}, {"--degree 7", "--degree"},
         {"--engine gpu", "--engine"},      {"-j 0", "--jobs"},           {"--no-such-option", "no-such-option"},
     };
     for (const auto& [args, needle] : cases) {

@@ -44,7 +44,7 @@ std::vector<Child> children_at(double degrees) {
     const Vec3d d{std::sin(a), 0, std::cos(a)};
     const ArrivingRay<double> ray{Vec3d{0, 0, -1} - d, d, 1.0, 0.0, {1, 1, 1}, {1, 1, 1}};
     RecordingSink sink;
-    shade_hit<true, false, true, true>(rules, m, static_cast<const LightT<double>*>(nullptr), 0, ray, Vec3d{0, 0, 0},
+    shade_hit<true, false, true, true, false>(rules, m, static_cast<const LightT<double>*>(nullptr), 0, ray, Vec3d{0, 0, 0},
                                        Vec3d{0, 0, 1}, ColorT<double>{1, 1, 1}, true, sink);
     return sink.children;
 }

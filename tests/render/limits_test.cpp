@@ -214,7 +214,7 @@ TEST_CASE("limits: format_bytes") {
 
 TEST_CASE("limits: the parser caps absurd values (width 1e9, depth 1e6, spp 1e8)") {
     for (const char* text : {"image width=1e9\n", "image height=1000000000\n", "image depth=1e6\n",
-                             "image spp=1e8\n", "image degree=6\n", "image width=2147483648\n",
+                             "image spp=1e8\n", "image degree=7\n", "image width=2147483648\n",
                              "image width=-1\n", "image spp=1e308\n"}) {
         INFO(text);
         CHECK_THROWS_AS(parse_scene(text, "t.cfg"), SceneError);

@@ -386,8 +386,8 @@ TEST_CASE("parser: errors carry the exact line and column") {
         expect_error("image spp=65537", 1, 11, "[1, 65536]");
         expect_error("image depth=-1", 1, 13, "[0, 256]");
         expect_error("image depth=257", 1, 13, "[0, 256]");
-        expect_error("image degree=6", 1, 14, "[0, 5]");
-        expect_error("image degree=-1", 1, 14, "[0, 5]");
+        expect_error("image degree=7", 1, 14, "[0, 6]");
+        expect_error("image degree=-1", 1, 14, "[0, 6]");
         expect_error("ambient 1.5", 1, 9, "[0, 1]");
         expect_error("ambient -0.1", 1, 9, "[0, 1]");
         expect_error("material m ior=0", 1, 16, "'ior' must be > 0");

@@ -368,8 +368,8 @@ TEST_CASE("pipeline: per-generation profile of two facing planes, counted by han
         CHECK(prof.stages[int(Stage::Occlusion)].nanoseconds == occlusion_ns);
         const std::string txt = prof.text();
         CHECK(txt.find("generation") != std::string::npos);
-        CHECK(txt.find("(" + std::to_string(P) + "/0/0)") != std::string::npos);
-        CHECK(txt.find("(0/" + std::to_string(P) + "/" + std::to_string(P) + ")") != std::string::npos);
+        CHECK(txt.find("(" + std::to_string(P) + "/0/0/0)") != std::string::npos);
+        CHECK(txt.find("(0/" + std::to_string(P) + "/" + std::to_string(P) + "/0)") != std::string::npos);
         const std::string js = prof.json();
         CHECK(js.find("\"generations\": [") != std::string::npos);
         CHECK(js.find("{\"generation\": 3, \"rays\": " + std::to_string(2 * P) + ", \"primary\": 0, \"reflected\": " +
