@@ -3,7 +3,8 @@
 
 usage: scripts/render_gallery.py [--build DIR] [--out DIR]
 
-Each scene at 320x240 with its own settings (sRGB PNG, the default display colour) into
+Each scene at 320x240 with its own settings (the degree-6 scenes of scenes/gi/ at their own
+samples, the square ones at 256x256, into docs/img/gi_<scene>.png) (sRGB PNG, the default display colour) into
 docs/img/<scene>.png, and the strip of frames 0, 6, 12, 13, 18 and 23 of
 scenes/anim/orbit.cfg (160x120 each, side by side, 4-pixel white gaps) into
 docs/img/anim_orbit_strip.png. Needs /usr/bin/python3 with numpy and matplotlib (Debian's
@@ -17,6 +18,8 @@ import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 STILLS = ["soft_shadows", "dof", "fresnel", "textured", "emission"]
+# Degree 6 (docs/global-illumination.md): each at its own samples, square scenes square.
+GI_STILLS = [("gi/cornell", 256, 256), ("gi/sky_room", 320, 240), ("gi/glass_box", 256, 256)]
 STRIP_FRAMES = [0, 6, 12, 13, 18, 23]
 
 
@@ -33,6 +36,10 @@ def main():
     for name in STILLS:
         out = os.path.join(args.out, name + ".png")
         render(exe, "scenes/%s.cfg" % name, out, "--width", "320", "--height", "240")
+        print(out)
+    for name, width, height in GI_STILLS:
+        out = os.path.join(args.out, name.replace("/", "_") + ".png")
+        render(exe, "scenes/%s.cfg" % name, out, "--width", str(width), "--height", str(height))
         print(out)
     import matplotlib.image as mpimg
     import numpy as np
