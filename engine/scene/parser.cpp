@@ -215,6 +215,7 @@ Scene load_scene(const std::string& path, const ReadOptions& options) {
     return Parallelism(options.jobs).run([&] {
         Parser p(options);
         p.scene.path = path;
+        p.scene.inputs.push_back(SceneInput{path, "the scene file", {}});
         p.read_top(text.text(), path, identity_of(path), text.mapped());
         p.finish();
         return std::move(p.scene);
