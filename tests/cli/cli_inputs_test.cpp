@@ -116,3 +116,20 @@ TEST_CASE("cli: an output that is one of the scene's inputs is refused before re
                           ": is an input of the scene (included file named at " + own.string() + ":1:9)");
     }
 }
+
+// Proven against: run_merge without the parts check (cli/tiled.cpp): the part was merged over itself, exit 0.
+TEST_CASE("cli: merge refuses an output that is one of its parts") {
+    Dir d;
+    const fs::path scene = d.write("s.cfg", "image width=8 height=6 spp=1\nsphere\n");
+    // A part may have any name (docs/distributed.md), an image's too.
+    const fs::path part = d.path / "p.png";
+    REQUIRE(run_streamrt("-q " + q(scene) + " --shard 0/1 -o " + q(part)).code == 0);
+    const std::string bytes = slurp(part);
+    const Run r = run_streamrt("merge " + q(part) + " -o " + q(d.path / "." / "p.png"));
+    CHECK(r.code == 2);
+    CHECK(r.err == "streamrt: -o " + (d.path / "." / "p.png").string() + ": is one of the parts being merged\n");
+    CHECK(slurp(part) == bytes);
+    const Run ok = run_streamrt("merge -q " + q(part) + " -o " + q(d.path / "whole.png"));
+    CHECK(ok.code == 0);
+    CHECK(slurp(d.path / "whole.png").substr(1, 3) == "PNG");
+}
