@@ -114,9 +114,15 @@ struct FramePlan {
 int report_error(std::exception_ptr error, bool quiet = false);
 /// This process's rank when an MPI launcher started it (0 otherwise).
 int launcher_rank();
-/// Refuses, before rendering, an output in a missing or read-only folder, a folder, or the scene itself.
-void check_writable_path(const std::string& out, const std::string& scene_path);
-void check_output_path(const std::string& out, const std::string& scene_path);
+/// Refuses, before rendering, an output in a missing or read-only folder, or a folder.
+void check_writable_path(const std::string& out);
+/// The same, and an output whose extension names no image format.
+void check_output_path(const std::string& out);
+/// Refuses (exit status 2) a file to be written that is one the scene read (Scene::inputs):
+/// a UsageError naming `option` ("-o", "--checkpoint", ...), or with an empty option a
+/// SceneError at the scene's `output=`. `pattern`: the frames' name it was made from, if any.
+void check_not_input(const Scene& scene, const std::string& out, const std::string& option,
+                     const std::string& pattern);
 /// Applies the command line to a loaded scene and checks everything before rendering.
 /// `writes`: this process writes the output (false on MPI ranks other than 0).
 /// `check_isa`: --isa must be supported here (MPI ranks agree on it together instead).

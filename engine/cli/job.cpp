@@ -14,13 +14,25 @@ int launcher_rank() {
     return 0;
 }
 
-// A missing folder, a read-only folder or the scene file itself are refused before any
-// rendering starts.
-void check_writable_path(const std::string& out, const std::string& scene_path) {
+void check_not_input(const Scene& scene, const std::string& out, const std::string& option,
+                     const std::string& pattern) {
+    const SceneInput* in = scene.input_at(out);
+    if (!in) return;
+    // A frame's file is named with the pattern it came from, which is what the user typed.
+    const std::string named = pattern.empty() || pattern == out ? out : pattern + " (as " + out + ")";
+    const std::string why = ": is an input of the scene (" + in->describe() + ")";
+    if (option.empty()) {
+        if (scene.output_at.line > 0) throw SceneError(scene.output_at, "output=" + named + why);
+        throw UsageError("output " + named + " (the scene's default)" + why);
+    }
+    throw UsageError((option.back() == '=' ? option : option + " ") + named + why);
+}
+
+// A missing folder, a read-only folder or a folder are refused before any rendering starts
+// (the scene's own files are refused by check_not_input).
+void check_writable_path(const std::string& out) {
     std::error_code ec;
     const fs::path target = fs::absolute(out, ec);
-    if (fs::exists(scene_path, ec) && fs::exists(target, ec) && fs::equivalent(target, scene_path, ec))
-        throw UsageError("output '" + out + "' is the scene file itself");
     if (fs::is_directory(target, ec)) throw UsageError("output '" + out + "' is a folder");
     const fs::path dir = target.parent_path();
     if (!fs::is_directory(dir, ec)) throw UsageError("output folder '" + dir.string() + "' does not exist");
@@ -40,10 +52,10 @@ void check_writable_path(const std::string& out, const std::string& scene_path) 
     ::close(fd);
 }
 
-void check_output_path(const std::string& out, const std::string& scene_path) {
+void check_output_path(const std::string& out) {
     if (!image_format_for(out))
         throw UsageError("output '" + out + "': unknown image format (expected " + image_format_extensions() + ")");
-    check_writable_path(out, scene_path);
+    check_writable_path(out);
 }
 
 
@@ -93,12 +105,28 @@ Job make_job(const Options& opt, std::shared_ptr<const Scene> scene, bool writes
                          "one whole image (not --compare or a tiled render)");
     job.options.sample_map = !sample_map.empty();
     if (writes) {
-        if (!sample_map.empty()) check_writable_path(sample_map, opt.scene_path);
+        // No file written may be one the scene read (docs/scene-format.md, "Paths"): each is
+        // checked by identity before anything renders, and named as the user named it.
+        const Scene& scene = *job.scene;
+        const std::string image_option = opt.output.empty() ? "" : "-o";
+        const FramePlan frames = plan_frames(opt, s);
+        if (frames.any) {
+            for (int f = frames.first; f <= frames.last && f >= frames.first; ++f)
+                check_not_input(scene, frame_output_name(s.output, f).value_or(s.output), image_option, s.output);
+        } else {
+            check_not_input(scene, job.animated ? frame_output_name(s.output, 0).value_or(s.output) : s.output,
+                            image_option, s.output);
+        }
+        if (!sample_map.empty()) check_not_input(scene, sample_map, "--aov samples=", "");
+        if (!opt.profile_json.empty()) check_not_input(scene, opt.profile_json, "--profile=json", "");
+        if (!opt.tile_costs.empty()) check_not_input(scene, opt.tile_costs, "--tile-costs", "");
+        if (!opt.checkpoint.empty()) check_not_input(scene, opt.checkpoint, "--checkpoint", "");
+        if (!sample_map.empty()) check_writable_path(sample_map);
         // A shard part is a tile file (docs/distributed.md), whatever its name.
-        if (opt.shard_n > 0) check_writable_path(s.output, opt.scene_path);
-        else check_output_path(s.output, opt.scene_path);
-        if (!opt.profile_json.empty()) check_writable_path(opt.profile_json, opt.scene_path);
-        if (!opt.tile_costs.empty()) check_writable_path(opt.tile_costs, opt.scene_path);
+        if (opt.shard_n > 0) check_writable_path(s.output);
+        else check_output_path(s.output);
+        if (!opt.profile_json.empty()) check_writable_path(opt.profile_json);
+        if (!opt.tile_costs.empty()) check_writable_path(opt.tile_costs);
     }
     // Refuse, before allocating anything big, a render that cannot fit in this machine.
     const int jobs = opt.jobs > 0 ? opt.jobs : default_jobs();

@@ -1,32 +1,75 @@
 // streamrt: renders a .cfg scene (docs/scene-format.md) with the stream or the recursive engine.
 #include "cli/cli.h"
 #include "cli/progress.h"
+#include "core/nearest_name.h"
 
 namespace streamrt::cli {
 
 extern "C" void on_sigint(int) { g_cancel.store(true); }
 
+namespace {
+
+/// A whole number, sign and digits only: CLI11's Range would read "4.5" as out of range,
+/// which sends the user looking at the bounds instead of the decimal point.
+const CLI::Validator kInteger(
+    [](std::string& v) {
+        std::size_t i = !v.empty() && (v[0] == '-' || v[0] == '+') ? 1 : 0;
+        if (i == v.size()) return "'" + v + "' is not an integer";
+        for (; i < v.size(); ++i)
+            if (v[i] < '0' || v[i] > '9') return "'" + v + "' is not an integer";
+        return std::string();
+    },
+    "INT", "integer");
+
+/// The one line for a command line CLI11 refused: an unknown option gets the nearest known
+/// one when it is a likely slip ("--sp" for "--spp").
+std::string parse_error_line(const CLI::App& app, const CLI::ParseError& e, const std::vector<std::string>& args) {
+    if (!dynamic_cast<const CLI::ExtrasError*>(&e)) return e.what();
+    std::vector<std::string> names;
+    for (const CLI::Option* o : app.get_options()) {
+        for (const std::string& l : o->get_lnames()) names.push_back("--" + l);
+        for (const std::string& s : o->get_snames()) names.push_back("-" + s);
+    }
+    for (auto it = args.rbegin(); it != args.rend(); ++it) {  // args are reversed for CLI11
+        const std::string& a = *it;
+        if (a.size() < 2 || a[0] != '-') continue;
+        const std::string name = a.substr(0, a.find('='));
+        if (std::find(names.begin(), names.end(), name) != names.end()) continue;
+        if (const auto near = nearest_name(name, names))
+            return "unknown option '" + name + "': did you mean '" + *near + "'?";
+    }
+    return e.what();
+}
+
+}  // namespace
+
 int run(int argc, char** argv) {
     if (argc >= 2 && std::string(argv[1]) == "merge") return run_merge(argc - 1, argv + 1);
+    // "--profile json FILE" reads as the flag, then a scene named "json": say what was meant.
+    for (int i = 1; i + 1 < argc; ++i)
+        if (std::string(argv[i]) == "--profile" && (std::string(argv[i + 1]) == "json" || std::string(argv[i + 1]) == "text"))
+            throw UsageError(std::string("--profile ") + argv[i + 1] + ": the format is joined to the option, --profile=" +
+                             argv[i + 1] + (std::string(argv[i + 1]) == "json" ? " FILE (e.g. --profile=json prof.json)" : ""));
     Options opt;
     CLI::App app{"streamrt: a SIMD ray-stream ray tracer for .cfg scenes (see docs/scene-format.md)", "streamrt"};
     app.footer("Also: streamrt merge PART... -o OUT (the parts of --shard renders)");
     app.add_option("scene", opt.scene_path, "Scene file (.cfg)")->required();
-    app.add_option("-j,--jobs", opt.jobs, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
+    app.add_option("-j,--jobs", opt.jobs, "Worker threads (default: all cores)")->check(kInteger)->check(CLI::Range(1, 1024));
     app.add_option("-o,--output", opt.output, "Output image (.ppm, .png, .pfm or .exr); overrides the scene's");
-    app.add_option("--spp", opt.spp, "Samples per pixel")->check(CLI::Range(1, 65536));
-    app.add_option("--width", opt.width, "Image width in pixels")->check(CLI::Range(1, 32768));
-    app.add_option("--height", opt.height, "Image height in pixels")->check(CLI::Range(1, 32768));
+    app.add_option("--spp", opt.spp, "Samples per pixel")->check(kInteger)->check(CLI::Range(1, 65536));
+    app.add_option("--width", opt.width, "Image width in pixels")->check(kInteger)->check(CLI::Range(1, 32768));
+    app.add_option("--height", opt.height, "Image height in pixels")->check(kInteger)->check(CLI::Range(1, 32768));
     app.add_option("--degree", opt.degree, "Shading degree 0..5 (handout), 6: global illumination (path tracing)")
+        ->check(kInteger)
         ->check(CLI::Range(0, 6));
-    app.add_option("--depth", opt.depth, "Maximum bounces")->check(CLI::Range(0, 256));
+    app.add_option("--depth", opt.depth, "Maximum bounces")->check(kInteger)->check(CLI::Range(0, 256));
     app.add_option("--cutoff", opt.cutoff,
                    "Weight cut-off: reflected and refracted rays worth less than this in every channel are not "
                    "traced (default 0.001; 0 traces every ray; overrides the scene's image cutoff=)")
         ->check(CLI::Range(0.0, 1.0));
     app.add_option("--light-samples", opt.light_samples,
                    "Shadow rays per shaded point of every area light (overrides the lights' samples=)")
-        ->check(CLI::Range(1, 4096));
+        ->check(kInteger)->check(CLI::Range(1, 4096));
     app.add_option("--engine", opt.engine, "Renderer: stream (SIMD ray streams) or recursive (the handout's baseline)")
         ->check(CLI::IsMember(names_vector(kEngineNames)));
     app.add_option("--isa", opt.isa, "Force the stream kernels' level: sse2, sse4.2, avx2 or avx512 (default: best the CPU has)")
@@ -46,7 +89,7 @@ int run(int argc, char** argv) {
                    "Stream engine, meshes: packets of reflected and refracted rays that have scattered (from the "
                    "fourth bounce on) walk a mesh's tree as packets until at most N rays reach a node, then one "
                    "by one (default 16; 0: packets only)")
-        ->check(CLI::Range(0, 64));
+        ->check(kInteger)->check(CLI::Range(0, 64));
     app.add_option("--colorspace", opt.colorspace, "8-bit output encoding: srgb (default) or linear (the handout's)")
         ->check(CLI::IsMember(names_vector(kColorSpaceNames)));
     app.add_option("--tonemap", opt.tonemap, "Tone curve before calibration: clamp (default) or reinhard")
@@ -95,9 +138,18 @@ int run(int argc, char** argv) {
         if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
         // One line, like every other error (CLI11's own report adds a second line); under
         // an MPI launcher, from rank 0 only.
-        if (launcher_rank() == 0) std::fprintf(stderr, "streamrt: %s (see --help)\n", e.what());
+        if (launcher_rank() == 0)
+            std::fprintf(stderr, "streamrt: %s (see --help)\n", parse_error_line(app, e, args).c_str());
         return 2;
     }
+    // An empty name would silently mean "none given" (for -o: the scene's output=).
+    for (const char* file_option : {"-o", "--profile-json", "--checkpoint", "--tile-costs", "--aov"})
+        if (app.count(file_option) > 0 && app.get_option(file_option)->as<std::string>().empty())
+        {
+            const std::string o = file_option;
+            throw UsageError((o == "--profile-json" ? "--profile=json" : o) + ": an empty file name" +
+                             (o == "-o" ? " (leave -o out to write the scene's output=)" : ""));
+        }
     if (!opt.shard.empty()) parse_shard(opt.shard, opt.shard_k, opt.shard_n);
     const char* launcher = mpi_launcher_variable();
     if (launcher && !opt.mpi)

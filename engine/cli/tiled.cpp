@@ -170,7 +170,10 @@ int run_merge(int argc, char** argv) {
         std::fprintf(stderr, "streamrt merge: %s (see --help)\n", e.what());
         return 2;
     }
-    check_output_path(output, "");
+    // The parts are the merge's inputs: writing the image over one would lose it.
+    for (const std::string& part : parts)
+        if (same_file(output, part)) throw UsageError("-o " + output + ": is one of the parts being merged");
+    check_output_path(output);
     TileFileHeader header;
     const Framebuffer image = merge_parts(parts, header);
     RenderSettings display;

@@ -166,6 +166,7 @@ const Parser::ObjParts& Parser::obj_parts(const Statement& st, const Arg& a, boo
             parts.library = std::move(model.materials);
             parts.mtl_path = model.mtl_path;
             if (options_.copies && !parts.mtl_path.empty()) copy_file(parts.mtl_path);
+            if (!parts.mtl_path.empty()) record_input(parts.mtl_path, "material library", st, a.value_col);
             return parts;
         });
     return obj_parts_[i];
@@ -212,6 +213,7 @@ void Parser::include(Statement& st, const std::vector<Token>& toks, int depth) {
     FileText text;
     if (!text.open(target)) st.fail(t.column, "cannot open included file " + quote(shown));
     if (options_.copies) options_.copies->push_back(FileCopy{shown, std::string(text.text())});
+    record_input(shown, "included file", st, t.column);
     read_text(text.text(), shown, id, depth + 1);
 }
 

@@ -32,7 +32,10 @@ void Parser::image(Statement& st, const std::vector<Token>& toks) {
         else if (k == "degree") s.degree = st.integer(a, 0, 6);
         else if (k == "cutoff") s.cutoff = st.in_closed(a, 0.0, 1.0);
         else if (k == "adaptive") s.adaptive = st.in_closed(a, 0.0, 1.0);
-        else if (k == "output") s.output = std::string(a.value);
+        else if (k == "output") {
+            s.output = std::string(a.value);
+            scene.output_at = SourceLoc{st.file(), st.line(), a.value_col};
+        }
         else if (k == "frames") frame_range(st, a, s.frames_first, s.frames_last);
         else if (k == "sampler") s.pattern = st.word(a, kSamplePatternNames);
         else if (k == "calibration") s.calibration = st.word(a, kCalibrationNames);

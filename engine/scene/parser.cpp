@@ -193,8 +193,11 @@ void Parser::statement(std::string_view line, const std::string& file, int line_
     else if (w == "key") key(st, toks);
     else if (w == "mesh") one_pass_shape(st, toks, ShapeKind::Mesh);
     else if (auto kind = shape_from_word(w)) one_pass_shape(st, toks, *kind);
-    else
-        st.fail_here("unknown statement " + quote(w) + " (expected " + kStatementList + ")");
+    else {
+        const auto near = nearest_name(w, kStatementWords);
+        st.fail_here("unknown statement " + quote(w) + (near ? ": did you mean '" + *near + "'?" : std::string()) +
+                     " (expected " + kStatementList + ")");
+    }
 }
 
 }  // namespace scene_reader
@@ -212,6 +215,7 @@ Scene load_scene(const std::string& path, const ReadOptions& options) {
     return Parallelism(options.jobs).run([&] {
         Parser p(options);
         p.scene.path = path;
+        p.scene.inputs.push_back(SceneInput{path, "the scene file", {}});
         p.read_top(text.text(), path, identity_of(path), text.mapped());
         p.finish();
         return std::move(p.scene);

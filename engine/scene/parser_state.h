@@ -215,6 +215,7 @@ class Parser {
         std::error_code ec;
         if (!fs::is_regular_file(target, ec)) st.fail(col, "cannot open " + what + " file " + quote(target.string()));
         if (options_.copies) copy_file(target);
+        record_input(target.string(), what, st, col);
         try {
             auto item = load(target.string());
             const auto index = typename Map::mapped_type(list.size());
@@ -257,6 +258,14 @@ class Parser {
     std::map<fs::path, std::int32_t> textures_;  // by file identity (index in scene.textures)
 
     void copy_file(const fs::path& p);
+
+    /// Notes a file read, named at column `col` of the statement, in Scene::inputs.
+    /// A file read twice (a mesh with and without texture coordinates) is noted once.
+    void record_input(const std::string& path, const std::string& what, const Statement& st, int col) {
+        for (const SceneInput& in : scene.inputs)
+            if (in.path == path) return;
+        scene.inputs.push_back(SceneInput{path, what, SourceLoc{st.file(), st.line(), col}});
+    }
 
     void include(Statement& st, const std::vector<Token>& toks, int depth);
 

@@ -1,7 +1,10 @@
 #include "scene/scene.h"
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <numbers>
 #include <string>
 
@@ -59,6 +62,22 @@ void Scene::check_object_count(std::size_t limit) const {
                             std::to_string(limit) + " streamrt supports; this is object " + std::to_string(limit + 1);
     if (limit < object_locs.size() && object_locs[limit].file < files.size()) throw SceneError(where(limit), msg);
     throw SceneError(SourceLoc{path.empty() ? std::string("<scene>") : path, 0, 0}, msg);
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+    struct stat sa {}, sb {};
+    const bool a_exists = ::stat(a.c_str(), &sa) == 0, b_exists = ::stat(b.c_str(), &sb) == 0;
+    if (a_exists && b_exists) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    if (a_exists != b_exists) return false;
+    std::error_code ea, eb;
+    const auto ca = std::filesystem::weakly_canonical(a, ea), cb = std::filesystem::weakly_canonical(b, eb);
+    return !ea && !eb && ca == cb;
+}
+
+const SceneInput* Scene::input_at(const std::string& out) const {
+    for (const SceneInput& in : inputs)
+        if (same_file(out, in.path)) return &in;
+    return nullptr;
 }
 
 void Scene::add_object(Object o, const Material& m, const ObjectLoc& loc) {

@@ -131,6 +131,22 @@ inline Light rendered_light(Light l, const RenderSettings& s) {
     return l;
 }
 
+/// A file the reader read: the scene file, an included file, a mesh, an OBJ material library
+/// or a texture. A render never writes over one (the front ends check every file they would
+/// write against these before rendering).
+struct SceneInput {
+    std::string path;   ///< as read (relative to the working folder, or absolute)
+    std::string what;   ///< "the scene file", "included file", "mesh", "material library", "texture"
+    SourceLoc named_at; ///< the statement's argument that named it (line 0: the scene file itself)
+    /// "texture named at scenes/textured.cfg:14:18", for messages.
+    std::string describe() const { return named_at.line > 0 ? what + " named at " + named_at.str() : what; }
+};
+
+/// Whether a and b name the same file: the same device and inode when both exist (hard and
+/// symbolic links, "./" and ".." spellings all reach the same inode), else the same canonical
+/// path (a file that does not exist yet is some other file than one that does).
+bool same_file(const std::string& a, const std::string& b);
+
 /// The most objects a scene may hold: the stream engine's kernels carry the closest object's
 /// number in float lanes, which are exact up to 2^24.
 inline constexpr std::size_t kMaxSceneObjects = std::size_t(1) << 24;
@@ -147,6 +163,10 @@ struct Scene {
     /// Cold data, for messages only: the statement of each object (same indexing as objects).
     std::vector<ObjectLoc> object_locs;
     std::vector<std::string> files;  ///< the files objects came from (ObjectLoc::file)
+    /// Every file read (each once, in reading order): what no output may overwrite.
+    std::vector<SceneInput> inputs;
+    /// Where `image output=` was given (line 0: the scene names no output).
+    SourceLoc output_at;
     /// The keys of `key` statements (scene/animation.h); null for a scene without keys. The
     /// scene as read is at frame 0; scene_at_frame() builds the scene at another frame as a
     /// new scene (a parsed scene is never changed).
@@ -157,6 +177,8 @@ struct Scene {
     const Mesh* mesh_of(const Object& o) const {
         return o.kind == ShapeKind::Mesh && o.mesh < meshes.size() ? meshes[o.mesh].get() : nullptr;
     }
+    /// The input `path` would write over (same_file), or null.
+    const SceneInput* input_at(const std::string& path) const;
     /// The statement that made object i.
     SourceLoc where(std::size_t i) const {
         const ObjectLoc& l = object_locs[i];

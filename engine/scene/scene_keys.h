@@ -136,11 +136,20 @@ inline bool apply_transform_key(const Statement& st, const Arg& a, glm::dmat4& m
 
 inline std::optional<ShapeKind> shape_from_word(std::string_view w) { return canonical_shape_named(w); }
 
-/// The statement words, in the order the unknown-statement message lists them.
+/// The statement words, in the order the unknown-statement message lists them (and the
+/// names a mistyped word is matched against).
+inline const std::vector<std::string> kStatementWords = [] {
+    std::vector<std::string> words = {"image", "ambient", "background", "camera", "light", "material", "key"};
+    CanonicalShapes::for_each([&](auto s) { words.emplace_back(s.name); });
+    words.emplace_back("mesh");
+    words.emplace_back("include");
+    return words;
+}();
 inline const std::string kStatementList = [] {
-    std::string list = "image, ambient, background, camera, light, material, key, ";
-    CanonicalShapes::for_each([&](auto s) { list += std::string(s.name) + ", "; });
-    return list + "mesh or include";
+    std::string list;
+    for (std::size_t i = 0; i < kStatementWords.size(); ++i)
+        list += (i == 0 ? "" : i + 1 == kStatementWords.size() ? " or " : ", ") + kStatementWords[i];
+    return list;
 }();
 
 /// The statement words the chunked reader parses in parallel (mesh and include fall back to

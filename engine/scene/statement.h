@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/format_number.h"
+#include "core/nearest_name.h"
 #include "core/error.h"
 #include "core/transform.h"
 #include "scene/scene.h"
@@ -157,8 +158,9 @@ class Statement {
             Arg a{t.text.substr(0, eq), t.column, t.text.substr(eq + 1), t.column + int(eq) + 1};
             if (a.key.empty()) fail(t.column, "missing key before '=' in " + quote(t.text));
             if (std::none_of(allowed.begin(), allowed.end(), [&](std::string_view k) { return same(k, a.key); })) {
-                std::string msg = "unknown key " + quote(a.key) + " for '" + std::string(word()) +
-                                  "' (expected one of:";
+                std::string msg = "unknown key " + quote(a.key) + " for '" + std::string(word()) + "'";
+                if (const auto near = nearest_name(a.key, allowed)) msg += ": did you mean '" + *near + "'?";
+                msg += " (expected one of:";
                 for (auto k : allowed) (msg += ' ') += k;  // not " " + string: GCC 12's -Wrestrict false alarm
                 msg += ")";
                 fail(a.key_col, msg);

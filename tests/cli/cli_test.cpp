@@ -160,7 +160,7 @@ TEST_CASE("cli: output path mistakes are caught before rendering, nothing is cre
         const fs::path same = d.write("same.ppm", kSmallScene);
         const Run r = run_streamrt(q(same) + " -o " + q(same));
         CHECK(r.code == 2);
-        check_one_line_error(r, "is the scene file itself");
+        check_one_line_error(r, "-o " + same.string() + ": is an input of the scene (the scene file)");
         CHECK(slurp(same) == kSmallScene);
     }
     SUBCASE("a folder") {

@@ -316,6 +316,29 @@ TEST_CASE("parser: whitespace, comments and CRLF") {
     CHECK(s.where(1).line == 4);
 }
 
+// Proven against: the suggestion dropped from Statement::read_args (no "did you mean").
+TEST_CASE("parser: an unknown key or statement near a known one names it") {
+    const auto message = [](const std::string& text) {
+        try {
+            parse_scene(text, "t.cfg");
+        } catch (const SceneError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    CHECK(message("sphere colour=1,0,0").rfind("t.cfg:1:8: unknown key 'colour' for 'sphere': did you mean 'color'? "
+                                               "(expected one of: ", 0) == 0);
+    CHECK(message("camera eye=0,0,5 fvo=40").rfind("t.cfg:1:18: unknown key 'fvo' for 'camera': did you mean 'fov'? ",
+                                                   0) == 0);
+    CHECK(message("\nspheer color=1,0,0") ==
+          "t.cfg:2:1: unknown statement 'spheer': did you mean 'sphere'? (expected image, ambient, background, camera, "
+          "light, material, key, sphere, cube, cylinder, cone, torus, plane, disk, mesh or include)");
+    CHECK(message("inclued a.cfg").rfind("t.cfg:1:1: unknown statement 'inclued': did you mean 'include'? (", 0) == 0);
+    // Nothing near: the list alone.
+    CHECK(message("sphere bogus=1").rfind("t.cfg:1:8: unknown key 'bogus' for 'sphere' (expected one of: ", 0) == 0);
+    CHECK(message("foo 1").rfind("t.cfg:1:1: unknown statement 'foo' (expected image, ", 0) == 0);
+}
+
 TEST_CASE("parser: errors carry the exact line and column") {
     SUBCASE("statement words") {
         expect_error("foo 1", 1, 1, "unknown statement 'foo'");
