@@ -25,6 +25,7 @@ import argparse
 import math
 import os
 import pathlib
+import resource
 import statistics
 import subprocess
 import sys
@@ -40,21 +41,28 @@ SCENE = ROOT / "perf/scenes/gi/embree_cornell.cfg"
 SKIP = 77
 
 
+def run_timed(cmd, cwd=None):
+    """(wall seconds, CPU seconds: user + system) of one whole process (read, build, render,
+    write). The CPU time is the figure to trust on a loaded machine: it is what the process
+    did, not how long it waited for a core."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=cwd)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
 def run_embree(size, spp, out, threads):
-    """Wall seconds of one whole pathtracer process (read, build, render, write)."""
     cmd = ["pathtracer", "-c", str(MODELS / "cornell_box.ecs"), "--size", str(size), str(size), "--spp", str(spp),
            "--max-path-length", "8", "--threads", str(threads), "-o", str(out)]
-    start = time.perf_counter()
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=MODELS)
-    return time.perf_counter() - start
+    return run_timed(cmd, cwd=MODELS)
 
 
 def run_streamrt(exe, size, spp, out, threads, engine="stream"):
     cmd = [str(exe), "--quiet", "-j", str(threads), "--engine", engine, "--spp", str(spp), "--width", str(size),
            "--height", str(size), str(SCENE), "-o", str(out)]
-    start = time.perf_counter()
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-    return time.perf_counter() - start
+    return run_timed(cmd)
 
 
 def image(path):
@@ -78,9 +86,11 @@ def rmse(a, b):
 
 
 def timed(fn, reps):
-    """The median wall time of `reps` runs, and the spread (min, max)."""
-    times = [fn() for _ in range(reps)]
-    return statistics.median(times), min(times), max(times)
+    """Over `reps` runs: the median wall time and its spread (min, max), then the median CPU
+    time and its spread."""
+    runs = [fn() for _ in range(reps)]
+    wall, cpu = [r[0] for r in runs], [r[1] for r in runs]
+    return statistics.median(wall), min(wall), max(wall), statistics.median(cpu), min(cpu), max(cpu)
 
 
 def check_means(picture, reference, label):
@@ -140,7 +150,7 @@ def main():
     e_rmse = rmse(image(embree_path), ref)
     rows = [("Embree pathtracer", a.embree_spp, e_rmse) + e_time]
     print(f"Embree pathtracer {a.embree_spp} spp: RMSE {e_rmse:.5f}, wall {e_time[0]:.3f} s "
-          f"({e_time[1]:.3f} - {e_time[2]:.3f})", flush=True)
+          f"({e_time[1]:.3f} - {e_time[2]:.3f}), CPU {e_time[3]:.3f} s ({e_time[4]:.3f} - {e_time[5]:.3f})", flush=True)
     curve = []
     engines = ("stream", "recursive") if a.recursive else ("stream",)
     for spp in [int(s) for s in a.spp.split(",")]:
@@ -150,28 +160,30 @@ def main():
             e = rmse(streamrt_image(out), ref)
             rows.append((f"streamrt {engine}", spp, e) + t)
             if engine == "stream":
-                curve.append((spp, e, t[0]))
-            print(f"streamrt {engine} {spp} spp: RMSE {e:.5f}, wall {t[0]:.3f} s ({t[1]:.3f} - {t[2]:.3f})", flush=True)
+                curve.append((spp, e, t[0], t[3]))
+            print(f"streamrt {engine} {spp} spp: RMSE {e:.5f}, wall {t[0]:.3f} s ({t[1]:.3f} - {t[2]:.3f}), "
+                  f"CPU {t[3]:.3f} s ({t[4]:.3f} - {t[5]:.3f})", flush=True)
 
-    # The time to reach Embree's RMSE: from the first count at or below it (or the last one),
-    # with RMSE ~ spp^-1/2 and time ~ a + b spp fitted on the measured counts.
+    # The time to reach Embree's RMSE: from the count whose RMSE is nearest it, with RMSE ~
+    # spp^-1/2, and time ~ a + b spp fitted on the measured counts (wall and CPU alike).
     spps = np.array([c[0] for c in curve], dtype=float)
-    times = np.array([c[2] for c in curve])
-    b, a0 = np.polyfit(spps, times, 1)
     best = min(curve, key=lambda c: abs(math.log(c[1] / e_rmse)))
     need = best[0] * (best[1] / e_rmse) ** 2
-    t_need = a0 + b * need
-    print(f"streamrt reaches Embree's {a.embree_spp}-spp RMSE at about {need:.1f} spp: {t_need:.3f} s wall "
-          f"({t_need / e_time[0]:.3f}x Embree's {e_time[0]:.3f} s)")
+    for label, col, embree_t in (("wall", 2, e_time[0]), ("CPU", 3, e_time[3])):
+        b, a0 = np.polyfit(spps, np.array([c[col] for c in curve]), 1)
+        t_need = a0 + b * need
+        print(f"streamrt reaches Embree's {a.embree_spp}-spp RMSE at about {need:.1f} spp: {t_need:.3f} s {label} "
+              f"({t_need / embree_t:.3f}x Embree's {embree_t:.3f} s)")
     stream64 = work / f"streamrt_stream_{a.size}_64.pfm"
     if stream64.exists():
         check_means(streamrt_image(stream64), ref, "streamrt (stream, 64 spp)")
         check_means(image(embree_path), ref, f"Embree ({a.embree_spp} spp)")
     table = work / "embree_cornell.md"
     with open(table, "w") as f:
-        f.write("| renderer | spp | RMSE | wall s (median) | min | max |\n|---|---|---|---|---|---|\n")
+        f.write("| renderer | spp | RMSE | wall s (median) | min | max | CPU s (median) | min | max |\n"
+                "|---|---|---|---|---|---|---|---|---|\n")
         for r in rows:
-            f.write(f"| {r[0]} | {r[1]} | {r[2]:.5f} | {r[3]:.3f} | {r[4]:.3f} | {r[5]:.3f} |\n")
+            f.write(f"| {r[0]} | {r[1]} | {r[2]:.5f} | " + " | ".join(f"{v:.3f}" for v in r[3:]) + " |\n")
     print("table:", table)
     if a.out and stream64.exists():
         import matplotlib

@@ -99,7 +99,7 @@ inline void mesh_leaf_closest(const RayView& rays, std::size_t base, const Objec
                         std::uint32_t(std::popcount(movemask_bits(live))) <= kInstanceSingleRayLanes<B::size>
                             ? std::uint32_t(B::size)
                             : std::max(ob.mesh->single_ray_lanes,
-                                       scattered_packet_lanes(c.d, live, rays.single_ray_lanes)));
+                                       scattered_packet_lanes(c.d, live, hybrid_lanes_for(*ob.mesh, rays.single_ray_lanes))));
     best = xsimd::select(in_box, walked, best);
 }
 

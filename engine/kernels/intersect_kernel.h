@@ -258,7 +258,8 @@ void mesh_closest_impl(RayView rays, std::int32_t* object, const ObjectXf* objs,
             mesh_closest_packet(*objs[k].mesh, c.o, c.d, best, rays.prim ? rays.prim + i : nullptr,
                                 rays.bu ? rays.bu + i : nullptr, rays.bv ? rays.bv + i : nullptr,
                                 std::max(objs[k].mesh->single_ray_lanes,
-                                         scattered_packet_lanes(c.d, best > B(0.f), rays.single_ray_lanes)));
+                                         scattered_packet_lanes(c.d, best > B(0.f),
+                                                                hybrid_lanes_for(*objs[k].mesh, rays.single_ray_lanes))));
             best_id = xsimd::select(best < before, B(float(objs[k].id)), best_id);
         }
         if (xsimd::any(best < start)) store_closest(rays, object, i, best, best_id);

@@ -196,6 +196,20 @@ inline std::uint32_t lanes_meeting_children(const accel::WideNode& n, const Vec3
 /// and costs on the narrower ones (rays through a smooth lens).
 inline constexpr float kScatteredPacketCos = 0.3f;
 
+/// Meshes of fewer triangles keep the packet walk whatever their packets' directions: their
+/// trees are too shallow for the single rays' own walks to pay. Measured on diffuse bounces
+/// (docs/global-illumination.md, degree 6, intersect CPU time at -j1): Embree's Cornell box
+/// (5 meshes of 2 - 12 triangles) 0.112 s as packets against 0.139 s with the hand-over from
+/// generation 4 and 0.174 s from generation 1; the 3 674-triangle bunny in a box 0.33 s as
+/// packets against 0.24 s with the hand-over.
+inline constexpr std::uint32_t kHybridMinTriangles = 256;
+
+/// The hybrid threshold `lanes` (RayView::single_ray_lanes) for mesh m: 0 below
+/// kHybridMinTriangles triangles.
+inline std::uint32_t hybrid_lanes_for(const MeshView& m, std::uint32_t lanes) {
+    return m.n_tris < kHybridMinTriangles ? 0u : lanes;
+}
+
 /// The stream's hybrid threshold (RayView::single_ray_lanes) for the canonical packet with
 /// directions d and live lanes `live`: `lanes` when the packet is scattered (some live
 /// direction is more than acos(kScatteredPacketCos) from their mean), 0 otherwise.

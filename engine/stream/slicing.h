@@ -21,6 +21,18 @@ inline void copy_rays(const RayStream& src, std::size_t from, std::size_t n, Ray
     dst.count = n;
 }
 
+/// Copies ray i of `src` to place j of `dst` (every array, and the key when `keys`).
+inline void move_ray(const RayStream& src, std::size_t i, RayStream& dst, std::size_t j, bool keys) {
+    if (keys) dst.key[j] = src.key[i];
+    dst.ox[j] = src.ox[i], dst.oy[j] = src.oy[i], dst.oz[j] = src.oz[i];
+    dst.dx[j] = src.dx[i], dst.dy[j] = src.dy[i], dst.dz[j] = src.dz[i];
+    dst.t_max[j] = src.t_max[i];
+    dst.wr[j] = src.wr[i], dst.wg[j] = src.wg[i], dst.wb[j] = src.wb[i];
+    dst.cone[j] = src.cone[i];
+    dst.pixel[j] = src.pixel[i];
+    dst.kind[j] = src.kind[i];
+}
+
 /// Cuts a generation of more than `cap` rays into slices of at most `cap` rays that each
 /// hold all the rays of their pixels (pixels in order, as many whole pixels as fit), and
 /// regroups `gen` so each slice is contiguous, keeping the rays' order within a slice. A
@@ -59,15 +71,7 @@ inline std::vector<std::size_t> cut_into_slices(RayStream& gen, RayStream& scrat
     if (keys) scratch.reserve_keys();
     for (std::size_t i = 0; i < gen.count; ++i) {
         const std::size_t p = std::size_t(gen.pixel[i]);
-        const std::size_t j = at[pixel_slice[p] + pixel_rays[p]++ / cap]++;
-        if (keys) scratch.key[j] = gen.key[i];
-        scratch.ox[j] = gen.ox[i], scratch.oy[j] = gen.oy[i], scratch.oz[j] = gen.oz[i];
-        scratch.dx[j] = gen.dx[i], scratch.dy[j] = gen.dy[i], scratch.dz[j] = gen.dz[i];
-        scratch.t_max[j] = gen.t_max[i];
-        scratch.wr[j] = gen.wr[i], scratch.wg[j] = gen.wg[i], scratch.wb[j] = gen.wb[i];
-        scratch.cone[j] = gen.cone[i];
-        scratch.pixel[j] = gen.pixel[i];
-        scratch.kind[j] = gen.kind[i];
+        move_ray(gen, i, scratch, at[pixel_slice[p] + pixel_rays[p]++ / cap]++, keys);
     }
     scratch.count = gen.count;
     std::swap(gen, scratch);
