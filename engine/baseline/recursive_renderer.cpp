@@ -181,7 +181,8 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
         .cutoff = s.degree >= 6 ? 0.0 : s.cutoff,  // biased: degree 6 ends paths by roulette instead
         .spread = camera_.spread,
         .eye = camera_.origin,  // offsets measured from the eye, as the stream engine's
-        .roulette = depth >= kRouletteFromDepth};
+        .roulette = depth >= kRouletteFromDepth,
+        .sequence_bits = first_bounce_bits(s, depth)};
     // Weight 1: the caller multiplies what this ray brings back by its weight.
     const ArrivingRay<double> arriving{ray.origin, ray.dir, hit.t, ray.cone, {1, 1, 1}, ray.throughput};
     const MaterialT<double>& material = materials_[object.material];
@@ -220,7 +221,7 @@ ColorT<double> RecursiveRenderer::render_sample(int x, int y, SampleRun run, int
         ray.dir = cam.direction(double(x + ps.x), double(y + ps.y));
     }
     ++counts.primary;
-    return trace(ray, 0, counts, light_key(pixel, run.first + j));
+    return trace(ray, 0, counts, camera_key(s.degree, s.spp, pixel, run.first + j));
 }
 
 ColorT<double> RecursiveRenderer::render_pixel(int x, int y, RayCounts& counts) const {

@@ -299,6 +299,36 @@ inline void light_sample_hashes(const U& key, std::uint32_t light, std::uint32_t
 // the path's choices so far, dimension) only: both engines and every thread count draw the
 // same ones. Below degree 6 children inherit their parent's key, as before.
 
+/// The bits a camera sample's number takes in a degree-6 camera key: enough for [0, spp).
+inline int path_sample_bits(int spp) {
+    int bits = 0;
+    while (bits < 31 && (1u << bits) < std::uint32_t(spp)) ++bits;
+    return bits;
+}
+
+/// The key of camera sample `sample` (of at most `spp`) of pixel `pixel` (row-major index):
+/// below degree 6, light_key; at degree 6 the path's number, pixel << path_sample_bits(spp) |
+/// sample (modulo 2^32), from which the first bounce reads the pixel and the sample back
+/// (first_bounce_point). Every use of a key hashes it first, so numbered keys serve the light
+/// samples and the child keys as well as hashed ones, and distinct paths get distinct keys
+/// while pixel x spp stays under 2^32.
+inline std::uint32_t camera_key(int degree, int spp, std::uint64_t pixel, int sample) {
+    if (degree < 6) return light_key(pixel, sample);
+    const int bits = path_sample_bits(spp);
+    return (std::uint32_t(pixel) << bits) | (std::uint32_t(sample) & ((1u << bits) - 1u));
+}
+
+/// The first bounce's two numbers for a camera ray of degree-6 key `key`: point (sample) of
+/// the pixel's own scrambled (0,2)-sequence (sequence_sample, scrambled apart from the
+/// camera's), so the first bounces of a pixel's samples cover the hemisphere evenly, as its
+/// camera rays cover the pixel. Deeper bounces draw hashed numbers.
+template <class U>
+inline auto first_bounce_point(const U& key, int bits) {
+    const U pixel = key >> bits;
+    const U sample = key & U((1u << bits) - 1u);
+    return sequence_sample(hash32(pixel ^ U(0x68bc21ebu)), sample);
+}
+
 /// The key of a ray spawned at degree 6 by a ray of key `key`; `kind` is its RayKind.
 template <class U>
 inline U child_key(const U& key, std::uint32_t kind) {

@@ -331,11 +331,19 @@ struct ShadeRules {
     /// Degree 6: Russian roulette ends the diffuse bounce of this generation's hits with
     /// probability 1 - min(1, max channel of its throughput) (from kRouletteFromDepth on).
     bool roulette = false;
+    /// Degree 6, camera rays' hits with the stratified sampler: the bounce takes its direction
+    /// from first_bounce_point(key, sequence_bits); -1: from hashes.
+    int sequence_bits = -1;
     /// What a ray's `throughput` is multiplied by to give its path's refl / trans / albedo
     /// product: 1 in the recursive engine, the samples a slot sums in the stream engine, whose
     /// throughput carries the sample's weight (the cut-off is scaled the same way).
     T throughput_scale = T(1);
 };
+
+/// ShadeRules::sequence_bits for hits of generation `depth` (the camera rays' are 0).
+inline int first_bounce_bits(const RenderSettings& s, int depth) {
+    return s.degree >= 6 && depth == 0 && s.pattern == SamplePattern::Stratified ? path_sample_bits(s.spp) : -1;
+}
 
 /// Degree 6: Russian roulette applies to the diffuse bounces of hits of this generation and
 /// deeper (the camera ray's hit is generation 0). Two unconditional bounces keep the light of
@@ -444,8 +452,12 @@ template <class V, class T, class M, class Sink>
         throughput = throughput * inv;
     }
     if (!any(send)) return;
-    sink.child(send, origin, cosine_direction(n, V(unit_from_hash(h1)), V(unit_from_hash(h2))), weight, throughput,
-               cone, RayKind::Diffuse);
+    V u1 = V(unit_from_hash(h1)), u2 = V(unit_from_hash(h2));
+    if (rules.sequence_bits >= 0) {
+        const auto q = first_bounce_point(key, rules.sequence_bits);
+        u1 = V(q.x), u2 = V(q.y);
+    }
+    sink.child(send, origin, cosine_direction(n, u1, u2), weight, throughput, cone, RayKind::Diffuse);
 }
 
 /// The handout's shading of one hit (or one packet of hits), written once for the recursive

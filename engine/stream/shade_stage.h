@@ -116,6 +116,7 @@ struct ShadeStage {
                 .spread = sc.camera.spread,
                 .eye = {0.f, 0.f, 0.f},  // the engine's origin is the eye (stream_scene.cpp)
                 .roulette = depth >= kRouletteFromDepth,
+                .sequence_bits = first_bounce_bits(s, depth),
                 .throughput_scale = float(samples_per_slot)};
     }
 

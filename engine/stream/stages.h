@@ -104,13 +104,14 @@ struct PipelineStages {
                               .sequence = kJitter && uses_sequence(sc.settings.pattern, req.run)};
         (lens ? kt.generate_lens : kt.generate)(job);
         if (sc.features.keys) {
-            // Each camera ray's light-sampling key (render/sampling.h light_key), from its
-            // image pixel and sample number: the rays of a pixel are its samples in order.
+            // Each camera ray's key (render/sampling.h camera_key), from its image pixel and
+            // sample number: the rays of a pixel are its samples in order.
             rays.reserve_keys();
             std::size_t k = 0;
             for (int q = first; q < first + n_pixels; ++q) {
                 const std::uint32_t pixel = image_pixel(req.pixel(q));
-                for (int j = 0; j < count; ++j, ++k) rays.key[k] = light_key(pixel, req.run.first + j);
+                for (int j = 0; j < count; ++j, ++k)
+                    rays.key[k] = camera_key(sc.settings.degree, sc.settings.spp, pixel, req.run.first + j);
             }
         }
     }
