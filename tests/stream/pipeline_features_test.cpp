@@ -91,6 +91,30 @@ TEST_CASE("pipeline: spawn stages only with reflective or transmissive materials
     CHECK(has(stages_of(scene(5, 2, 1, true, kGlass)), "spawn(refract)"));
 }
 
+TEST_CASE("pipeline: the diffuse spawn stage only at degree 6, with a diffuse material and depth") {
+    // Matte (diff 1 by default): bounces at degree 6 from depth 1; never below degree 6.
+    for (int degree = 0; degree <= 6; ++degree)
+        for (int depth : {0, 2}) {
+            CAPTURE(degree);
+            CAPTURE(depth);
+            const auto st = stages_of(scene(degree, depth, 1, true, kMatte));
+            CAPTURE(joined(st));
+            CHECK(has(st, "spawn(diffuse)") == (degree == 6 && depth >= 1));
+        }
+    // Mirrors and glass without a diffuse part: degree 5's stages, no diffuse spawn.
+    const auto specular = stages_of(scene(6, 3, 1, true,
+                                          "sphere diff=0 refl=0.8 translate=2,0,0\nsphere diff=0 trans=0.9 ior=1.5\n"));
+    CAPTURE(joined(specular));
+    CHECK_FALSE(has(specular, "spawn(diffuse)"));
+    CHECK(has(specular, "spawn(reflect)"));
+    CHECK(has(specular, "spawn(refract)"));
+    CHECK(has(specular, "occlusion(any-hit)"));
+    // Lit by the sky alone: bounces, no occlusion stage.
+    const auto sky = stages_of(scene(6, 3, 1, false, kMatte));
+    CHECK(has(sky, "spawn(diffuse)"));
+    CHECK_FALSE(has_prefix(sky, "occlusion"));
+}
+
 TEST_CASE("pipeline: centre sampling at spp 1, jittered above") {
     CHECK(has(stages_of(scene(2, 1, 1, true, kMatte)), "generate(centre)"));
     CHECK_FALSE(has(stages_of(scene(2, 1, 1, true, kMatte)), "generate(jittered)"));
