@@ -81,8 +81,10 @@ def one_streamrt_line(r):
 
 
 def scenes():
-    """Every scene of scenes/ (top level, meshes/ and one of degrees/: includes and meshes)."""
-    return sorted(SCENES.glob("*.cfg")) + [SCENES / "meshes" / "mesh.cfg", SCENES / "degrees" / "degree5.cfg"]
+    """Every scene of scenes/ (top level, meshes/ and one of degrees/: includes and meshes; the
+    Cornell box at degree 6: paths whose numbers come from their pixel and sample alone)."""
+    return sorted(SCENES.glob("*.cfg")) + [SCENES / "meshes" / "mesh.cfg", SCENES / "degrees" / "degree5.cfg",
+                                           SCENES / "gi" / "cornell.cfg"]
 
 
 def reference(args, scene, out, extra=(), size=SIZE, spp="2"):
@@ -109,7 +111,7 @@ def group_usage(args, tmp):
 
 
 def group_shard(args, tmp):
-    for scene in [SCENES / "whitted.cfg", SCENES / "meshes" / "mesh.cfg"]:
+    for scene in [SCENES / "whitted.cfg", SCENES / "meshes" / "mesh.cfg", SCENES / "gi" / "cornell.cfg"]:
         want = reference(args, scene, tmp / "ref.pfm")
         parts = []
         for k in range(3):
