@@ -162,6 +162,33 @@ std::string sample_map_path(const Options& opt) {
     return path;
 }
 
+/// What the closing line adds when an adaptive render did not keep its request (empty when
+/// it did): what was asked, what stopped it, and how to go further. A request cut short by
+/// the cap used to end with exit status 0 and no word (issue 52).
+std::string cut_short_note(const Options& opt, const Job& job, const AdaptiveSummary& a) {
+    using Cut = AdaptiveSummary::Cut;
+    const Cut cut = a.cut();
+    if (cut == Cut::NotCut) return a.time_limited ? ", time limit reached" : "";
+    char asked[96], why[256];
+    if (a.target_error > 0)
+        std::snprintf(asked, sizeof asked, "target error %g not reached", a.target_error);
+    else
+        std::snprintf(asked, sizeof asked, "threshold %g not reached", a.threshold);
+    if (cut == Cut::TimeLimit) {
+        std::snprintf(why, sizeof why, "the time limit (--time-limit %g s) stopped it", opt.time_limit.value_or(0));
+    } else if (cut == Cut::Cap) {
+        const char* from = job.adaptive_cap_from == AdaptiveCapFrom::Given   ? "--spp"
+                           : job.adaptive_cap_from == AdaptiveCapFrom::Scene ? "the scene's spp; --spp raises it"
+                                                                              : "the default; --spp raises it";
+        std::snprintf(why, sizeof why, "%llu pixel(s) stopped at the cap of %d samples (%s)",
+                      static_cast<unsigned long long>(a.above_at_cap), a.cap, from);
+    } else {
+        std::snprintf(why, sizeof why, "every pixel met its threshold %g (--adaptive: a smaller one goes further)",
+                      a.threshold);
+    }
+    return std::string("; ") + asked + ": " + why;
+}
+
 /// The summary line.
 void print_summary(const Options& opt, const Job& job, int jobs, const std::string& how, double seconds,
                    const RayCounts& counts, double setup_seconds, double write_seconds,
@@ -170,10 +197,10 @@ void print_summary(const Options& opt, const Job& job, int jobs, const std::stri
     const RenderSettings& s = job.render_settings;
     const std::string frame = job.frame >= 0 ? ", frame " + std::to_string(job.frame) : "";
     const double mrays = counts.total() / std::max(seconds, 1e-9) / 1e6;
-    char spp[160];
+    char spp[512];
     if (adaptive)
         std::snprintf(spp, sizeof spp, "spp %.2f adaptive (at most %d, estimated error %.3g%s)", adaptive->mean_spp,
-                      s.spp, adaptive->estimated_rmse, adaptive->time_limited ? ", time limit reached" : "");
+                      s.spp, adaptive->estimated_rmse, cut_short_note(opt, job, *adaptive).c_str());
     else
         std::snprintf(spp, sizeof spp, "spp %d", s.spp);
     std::printf("%s: %dx%d, %s, degree %d, %s engine%s, -j%d: %.3f s, %llu rays (%.2f Mrays/s), set-up %.3f s -> %s"

@@ -198,13 +198,16 @@ void start_round_one(TileTallies& t, const std::uint8_t* above_image, const floa
 }
 
 /// A tile's pixels once its rounds are over: the means into `image`, the sample counts and
-/// standard errors into `map` (when not null); returns the tile's sum of samples and adds its
-/// pixels' shares of the image's squared error to `error`.
-double finish_tile(const TileTallies& t, const float* corner_rgb, int w, Framebuffer& image, Framebuffer* map,
-                   double& error) {
+/// standard errors into `map` (when not null); returns the tile's sum of samples, sets `error`
+/// to its pixels' shares of the image's squared error and `at_cap` to its pixels that reached
+/// the cap still above their stopping point (the closing line says the cap cut them short).
+double finish_tile(const TileTallies& t, const float* corner_rgb, int w, const AdaptiveRule& rule, Framebuffer& image,
+                   Framebuffer* map, double& error, std::uint64_t& at_cap) {
     double n = 0;
     error = 0;
+    at_cap = 0;
     for_each_pixel(t, corner_rgb, w, [&](int x, int y, const auto& tally) {
+        if (tally.n >= rule.cap && rule.above(tally.scaled_variance(), tally.n)) ++at_cap;
         const ColorT<double> mean = tally.mean();
         float* px = image.pixel(x, y);
         px[0] = float(mean.x), px[1] = float(mean.y), px[2] = float(mean.z);
@@ -303,6 +306,7 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     // The image's estimated RMSE from each tile's sum of its pixels' shares: the tiles' sums
     // are taken in parallel and added in tile order, the same figure for every -j.
     std::vector<double> tile_error(tiles.size());
+    std::vector<std::uint64_t> tile_at_cap(tiles.size());
     const auto rmse_of_tiles = [&] {
         double sum = 0;
         for (const double e : tile_error) sum += e;
@@ -395,7 +399,8 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                             }
                     }
                     // A tile the cancel skipped has no tallies: its pixels keep their corners' means.
-                    tile_samples[i] = finish_tile(t, corner_rgb.data(), w, image, keep_map ? &map : nullptr, tile_error[i]);
+                    tile_samples[i] = finish_tile(t, corner_rgb.data(), w, prepared.adaptive, image,
+                                                  keep_map ? &map : nullptr, tile_error[i], tile_at_cap[i]);
                     if (progress) progress->add_rays(counts);
                 });
                 if (last_round > 0) summary.rounds = last_round + 1;
@@ -450,7 +455,8 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
 
     if (!fused_done) {
         par.for_each_index(tiles.size(), 1, [&](std::size_t i) {
-            tile_samples[i] = finish_tile(tiles[i], corner_rgb.data(), w, image, keep_map ? &map : nullptr, tile_error[i]);
+            tile_samples[i] = finish_tile(tiles[i], corner_rgb.data(), w, prepared.adaptive, image,
+                                          keep_map ? &map : nullptr, tile_error[i], tile_at_cap[i]);
         });
         lap(phases.final_pass);
     }
@@ -459,6 +465,9 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
     for (const double n : tile_samples) samples += n;
     summary.mean_spp = samples / (double(w) * double(h));
     summary.cap = prepared.adaptive.cap;
+    summary.threshold = prepared.adaptive.threshold;
+    summary.target_error = stop.target_error;
+    for (const std::uint64_t n : tile_at_cap) summary.above_at_cap += n;
     summary.estimated_rmse = rmse_of_tiles();
     prepared.last_adaptive = summary;
     prepared.sample_map = std::move(map);

@@ -163,8 +163,19 @@ RenderJob build_render_job(std::shared_ptr<const Scene> scene, const RenderOverr
     // The frame's scene is made when the engine is prepared (prepare_job).
     if (o.frame && *o.frame < 0) throw UsageError("frame must be >= 0");
     if (s.adaptive > 0) {
-        // spp is the most a pixel takes; a scene's one sample would leave nothing to adapt.
-        if (s.spp == 1 && !o.spp) s.spp = kDefaultAdaptiveCap;
+        // spp is the most a pixel takes. Given with the request, it is kept; a scene that asks
+        // for adaptive sampling itself (image adaptive=) names its cap with its spp. Otherwise
+        // the scene's spp is a uniform count: as a cap it cut a request short without a word
+        // (whitted.cfg's spp=4 stopped --target-error 0.005 at an estimated 0.0203), so the
+        // cap is then at least kDefaultAdaptiveCap, as it is for a scene's one sample, which
+        // would leave nothing to adapt.
+        const bool scene_asks = job.scene->settings.adaptive > 0;
+        if (o.spp) {
+            job.adaptive_cap_from = AdaptiveCapFrom::Given;
+        } else if ((s.spp == 1 || !scene_asks) && s.spp < kDefaultAdaptiveCap) {
+            s.spp = kDefaultAdaptiveCap;
+            job.adaptive_cap_from = AdaptiveCapFrom::Default;
+        }
         if (s.spp < 2) throw UsageError("adaptive sampling needs spp >= 2, the most samples a pixel may take");
         if (s.pattern == SamplePattern::Grid)
             throw UsageError("adaptive sampling needs sampler stratified or random (grid puts every round's samples "

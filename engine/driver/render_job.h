@@ -85,6 +85,14 @@ bool set_override(RenderOverrides& o, const std::string& name, const std::string
 /// The override names, comma-separated, for messages.
 std::string override_names();
 
+/// Where an adaptive render's cap (its spp, the most samples a pixel takes) came from, so
+/// that a request the cap cut short can say which cap and how to raise it.
+enum class AdaptiveCapFrom {
+    Given,    ///< spp given with the request (--spp, spp=)
+    Scene,    ///< the scene's spp
+    Default,  ///< kDefaultAdaptiveCap: the scene's spp was 1, or a uniform count below it
+};
+
 struct RenderJob {
     /// The scene as read, immutable and shared (jobs made from one parsed scene share it). A
     /// front end may let go of it (reset) once the engine is prepared and nothing is prepared
@@ -99,6 +107,7 @@ struct RenderJob {
     EngineOptions options;
     std::unique_ptr<StreamProfile> profile;  ///< when profiling (options.profile points to it)
     int threads = 0;                         ///< <= 0: all cores
+    AdaptiveCapFrom adaptive_cap_from = AdaptiveCapFrom::Scene;
 };
 
 /// The job for `scene` with the overrides applied to its settings (the scene is not

@@ -185,6 +185,19 @@ Result make_result(RenderResult&& r, const RenderJob& job, EngineKind engine, do
         a["estimated_rmse"] = r.adaptive->estimated_rmse;
         a["rounds"] = r.adaptive->rounds;
         a["time_limited"] = r.adaptive->time_limited;
+        a["cap"] = r.adaptive->cap;
+        a["cap_from"] = job.adaptive_cap_from == AdaptiveCapFrom::Given   ? "spp"
+                        : job.adaptive_cap_from == AdaptiveCapFrom::Scene ? "scene"
+                                                                          : "default";
+        a["above_at_cap"] = r.adaptive->above_at_cap;
+        // What kept the request (target_error, or adaptive's threshold in every pixel) from
+        // being met, as the command line's closing line says it: None when it was met.
+        using Cut = AdaptiveSummary::Cut;
+        const Cut cut = r.adaptive->cut();
+        a["cut_short_by"] = cut == Cut::NotCut      ? py::object(py::none())
+                            : cut == Cut::TimeLimit ? py::object(py::str("time_limit"))
+                            : cut == Cut::Cap       ? py::object(py::str("cap"))
+                                                    : py::object(py::str("threshold"));
         py::dict phases;  // wall seconds, as --profile reports them
         phases["corners"] = r.adaptive->seconds.corners;
         phases["neighbour_rule"] = r.adaptive->seconds.neighbour_rule;
@@ -307,7 +320,8 @@ PYBIND11_MODULE(streamrt, m) {
         .def_readonly("profile", &Result::profile, "the content of --profile=json as a dict, or None")
         .def_readonly("engine", &Result::engine, "'stream' or 'recursive'")
         .def_readonly("adaptive", &Result::adaptive,
-                      "adaptive sampling: {'mean_spp', 'estimated_rmse', 'rounds', 'time_limited', 'sample_map'} "
+                      "adaptive sampling: {'mean_spp', 'estimated_rmse', 'rounds', 'time_limited', 'cap', 'cap_from', "
+                      "'above_at_cap', 'cut_short_by', 'seconds', 'sample_map'} "
                       "(sample_map: height x width x 3, samples taken and estimated error per pixel), or None")
         .def("__repr__", [](const Result& r) {
             return "<streamrt.Result " + r.engine + " " + std::to_string(r.image.shape(1)) + "x" +

@@ -44,8 +44,11 @@ class Result:
         """'stream' or 'recursive'."""
     @property
     def adaptive(self) -> Optional[dict[str, Any]]:
-        """Adaptive sampling: 'mean_spp', 'estimated_rmse', 'rounds', 'time_limited' and
-        'sample_map' (height x width x 3: samples taken, estimated standard error, 0); else None."""
+        """Adaptive sampling: 'mean_spp', 'estimated_rmse', 'rounds', 'time_limited', 'cap' (the
+        most samples a pixel took) and 'cap_from' ('spp', 'scene' or 'default'), 'above_at_cap'
+        (pixels the cap stopped above their threshold), 'cut_short_by' (None when the request
+        was met, else 'cap', 'time_limit' or 'threshold'), 'seconds' and 'sample_map' (height x
+        width x 3: samples taken, estimated standard error, 0); else None."""
 
 def render(
     scene: str | Scene,

@@ -266,7 +266,25 @@ struct AdaptiveSummary {
     int rounds = 0;             ///< rounds run
     bool time_limited = false;  ///< --time-limit stopped the refinement
     int cap = 0;                ///< the most samples a pixel may take (--spp)
+    double threshold = 0;       ///< T, each pixel's stopping point at 16 samples
+    double target_error = 0;    ///< the image's target (--target-error; 0: none)
+    /// Pixels that hold `cap` samples with their error still above their stopping point:
+    /// the cap, not T, ended them.
+    std::uint64_t above_at_cap = 0;
     AdaptivePhases seconds;     ///< wall time by phase
+
+    /// Why the render ended short of what was asked, so that no front end reports a request
+    /// as kept when it was not: NotCut when it was kept (the image's target reached, or
+    /// without one every pixel under its stopping point); TimeLimit when --time-limit ran
+    /// out first; Cap when pixels were still above their stopping point at the cap;
+    /// Threshold when every pixel met T and the image's estimate is still above the target.
+    enum class Cut { NotCut, TimeLimit, Cap, Threshold };
+    Cut cut() const {
+        const bool kept = target_error > 0 ? estimated_rmse <= target_error : above_at_cap == 0 && !time_limited;
+        if (kept) return Cut::NotCut;
+        if (time_limited) return Cut::TimeLimit;
+        return above_at_cap > 0 ? Cut::Cap : Cut::Threshold;
+    }
 };
 
 }  // namespace streamrt

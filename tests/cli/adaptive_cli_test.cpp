@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <string>
 #include <set>
@@ -53,16 +54,24 @@ TEST_CASE("cli adaptive: --profile states the samples, rounds and wall time by p
                                "--profile-json " + q(json) + " --aov samples=" + q(d.path / "n.pfm"));
     REQUIRE(r.code == 0);
     INFO(r.out);
-    // The profile's mean is the closing line's; the rounds are the corners, then 4 and 8 more
-    // samples: 3 when some pixel reaches the cap of 16 (the sample map says whether one did).
+    // The mean is counted here from the sample map, not read back from the closing line: camera
+    // rays per pixel are the 41 x 31 corners, each traced once (4 of every pixel's samples), and
+    // every sample a pixel took beyond its corners. The rounds are the corners, then 4 and 8
+    // more samples: 3 when some pixel reaches the cap of 16 (the sample map says whether one did).
     const std::size_t closing = r.out.find(", spp ");
     REQUIRE(closing != std::string::npos);
     const std::string mean = r.out.substr(closing + 6, r.out.find(' ', closing + 6) - closing - 6);
     const streamrt::Framebuffer map = streamrt::read_image((d.path / "n.pfm").string());
     float most = 0;
+    double beyond_corners = 0;
     for (int y = 0; y < 30; ++y)
-        for (int x = 0; x < 40; ++x) most = std::max(most, map.pixel(x, y)[0]);
+        for (int x = 0; x < 40; ++x) {
+            most = std::max(most, map.pixel(x, y)[0]);
+            beyond_corners += map.pixel(x, y)[0] - 4.0;
+        }
     REQUIRE(most == 16.f);
+    const double counted = (41.0 * 31.0 + beyond_corners) / (40.0 * 30.0);
+    CHECK(std::stod(mean) == doctest::Approx(counted).epsilon(0.01 / counted));  // printed with 2 decimals
     CHECK(r.out.find("adaptive: " + mean + " samples per pixel (at most 16), 3 round(s), estimated error ") !=
           std::string::npos);
     CHECK(r.out.find("; wall s: corners ") != std::string::npos);
@@ -89,6 +98,90 @@ TEST_CASE("cli adaptive: the scene's image adaptive= key, and spp 1 takes the de
     const Run e = run_streamrt(q(bad));
     CHECK(e.code == 2);
     check_one_line_error(e, bad.string() + ":1:24: ");
+}
+
+TEST_CASE("cli adaptive: a request the cap, the clock or the threshold cut short is said on the closing line") {
+    Dir d;
+    // spp=4: a uniform count, not a cap for --adaptive or --target-error.
+    const fs::path scene = d.write("s4.cfg", std::string(kScene) + "image spp=4\n");
+    const std::string out = " -o " + q(d.path / "a.pfm") + " --aov samples=" + q(d.path / "n.pfm");
+    const auto pixels_above_at_cap = [&](int cap, double t) {
+        // The documented stopping point, worked out here: a pixel of n samples stops once its
+        // standard error (the sample map's green) is at most T (n / 16)^(3/4). Rounding of the
+        // map's float error can move a pixel within 0.1 % of its point: the count is a range.
+        const streamrt::Framebuffer map = streamrt::read_image((d.path / "n.pfm").string());
+        const double point = t * std::pow(cap / 16.0, 0.75);
+        int surely = 0, maybe = 0;
+        for (int y = 0; y < 30; ++y)
+            for (int x = 0; x < 40; ++x) {
+                const float* m = map.pixel(x, y);
+                if (m[0] != float(cap)) continue;
+                surely += m[1] > point * 1.001;
+                maybe += m[1] > point * 0.999;
+            }
+        return std::pair{surely, maybe};
+    };
+    const auto count_in = [](const std::string& line, const std::string& before) {
+        const std::size_t at = line.find(before);
+        if (at == std::string::npos || !std::isdigit(static_cast<unsigned char>(line[at + before.size()]))) return -1;
+        return std::stoi(line.substr(at + before.size()));
+    };
+    SUBCASE("the cap --spp gave") {
+        const Run r = run_streamrt(q(scene) + out + " --target-error 0.0001 --spp 4");
+        REQUIRE(r.code == 0);
+        INFO(r.out);
+        CHECK(r.out.find("(at most 4, estimated error ") != std::string::npos);
+        const int n = count_in(r.out, "; target error 0.0001 not reached: ");
+        const auto [surely, maybe] = pixels_above_at_cap(4, 0.0001);
+        CHECK(surely > 0);
+        CHECK(n >= surely);
+        CHECK(n <= maybe);
+        CHECK(r.out.find(" pixel(s) stopped at the cap of 4 samples (--spp)), degree 5") != std::string::npos);
+    }
+    SUBCASE("without --spp the cap is 64, not the scene's uniform 4") {
+        const Run r = run_streamrt(q(scene) + out + " --adaptive 0.0001");
+        REQUIRE(r.code == 0);
+        INFO(r.out);
+        const int n = count_in(r.out, "(at most 64, estimated error ");
+        CHECK(n >= 0);
+        const int above = count_in(r.out, "; threshold 0.0001 not reached: ");
+        const auto [surely, maybe] = pixels_above_at_cap(64, 0.0001);
+        CHECK(surely > 0);
+        CHECK(above >= surely);
+        CHECK(above <= maybe);
+        CHECK(r.out.find(" pixel(s) stopped at the cap of 64 samples (the default; --spp raises it))") !=
+              std::string::npos);
+    }
+    SUBCASE("a scene that asks for adaptive sampling keeps its spp as the cap") {
+        const fs::path own = d.write("own.cfg", std::string(kScene) + "image spp=8 adaptive=0.0001\n");
+        const Run r = run_streamrt(q(own) + out);
+        REQUIRE(r.code == 0);
+        INFO(r.out);
+        CHECK(r.out.find("(at most 8, estimated error ") != std::string::npos);
+        CHECK(r.out.find(" pixel(s) stopped at the cap of 8 samples (the scene's spp; --spp raises it))") !=
+              std::string::npos);
+    }
+    SUBCASE("the clock: the first round always covers the image, then a limit long past stops it") {
+        const Run r = run_streamrt(q(scene) + out + " --target-error 0.0001 --time-limit 1e-9");
+        REQUIRE(r.code == 0);
+        INFO(r.out);
+        CHECK(r.out.find("; target error 0.0001 not reached: the time limit (--time-limit 1e-09 s) stopped it)") !=
+              std::string::npos);
+    }
+    SUBCASE("every pixel met a coarse threshold, the image's target is not met") {
+        const Run r = run_streamrt(q(scene) + out + " --target-error 0.0001 --adaptive 0.9 --spp 64");
+        REQUIRE(r.code == 0);
+        INFO(r.out);
+        CHECK(r.out.find("; target error 0.0001 not reached: every pixel met its threshold 0.9 (--adaptive: a smaller "
+                         "one goes further))") != std::string::npos);
+    }
+    SUBCASE("a request kept says nothing more") {
+        const Run r = run_streamrt(q(scene) + out + " --target-error 0.5");
+        REQUIRE(r.code == 0);
+        INFO(r.out);
+        CHECK(r.out.find("(at most 64, estimated error ") != std::string::npos);
+        CHECK(r.out.find("not reached") == std::string::npos);
+    }
 }
 
 TEST_CASE("cli adaptive: refusals, one line each, nothing written") {
