@@ -114,10 +114,19 @@ struct FramePlan {
 int report_error(std::exception_ptr error, bool quiet = false);
 /// This process's rank when an MPI launcher started it (0 otherwise).
 int launcher_rank();
+/// What named a file this run writes, for the messages that refuse it: an option ("-o",
+/// "--checkpoint", "--aov samples=", ...) or, when `option` is empty, the scene's output=
+/// (SceneError at its file:line:col; without one, the scene's default name).
+struct NamedBy {
+    std::string option;
+    const Scene* scene = nullptr;
+    /// Throws (exit status 2): "OPTION NAME: WHY", "file:line:col: output=NAME: WHY".
+    [[noreturn]] void refuse(const std::string& name, const std::string& why) const;
+};
 /// Refuses, before rendering, an output in a missing or read-only folder, or a folder.
-void check_writable_path(const std::string& out);
+void check_writable_path(const std::string& out, const NamedBy& by);
 /// The same, and an output whose extension names no image format.
-void check_output_path(const std::string& out);
+void check_output_path(const std::string& out, const NamedBy& by);
 /// Refuses (exit status 2) a file to be written that is one the scene read (Scene::inputs):
 /// a UsageError naming `option` ("-o", "--checkpoint", ...), or with an empty option a
 /// SceneError at the scene's `output=`. `pattern`: the frames' name it was made from, if any.

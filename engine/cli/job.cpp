@@ -14,29 +14,31 @@ int launcher_rank() {
     return 0;
 }
 
+[[noreturn]] void NamedBy::refuse(const std::string& name, const std::string& why) const {
+    if (!option.empty()) throw UsageError((option.back() == '=' ? option : option + " ") + name + ": " + why);
+    if (scene && scene->output_at.line > 0) throw SceneError(scene->output_at, "output=" + name + ": " + why);
+    throw UsageError("output " + name + " (the scene's default): " + why);
+}
+
 void check_not_input(const Scene& scene, const std::string& out, const std::string& option,
                      const std::string& pattern) {
     const SceneInput* in = scene.input_at(out);
     if (!in) return;
     // A frame's file is named with the pattern it came from, which is what the user typed.
     const std::string named = pattern.empty() || pattern == out ? out : pattern + " (as " + out + ")";
-    const std::string why = ": is an input of the scene (" + in->describe() + ")";
-    if (option.empty()) {
-        if (scene.output_at.line > 0) throw SceneError(scene.output_at, "output=" + named + why);
-        throw UsageError("output " + named + " (the scene's default)" + why);
-    }
-    throw UsageError((option.back() == '=' ? option : option + " ") + named + why);
+    NamedBy{option, &scene}.refuse(named, "is an input of the scene (" + in->describe() + ")");
 }
 
 // A missing folder, a read-only folder or a folder are refused before any rendering starts
-// (the scene's own files are refused by check_not_input).
-void check_writable_path(const std::string& out) {
+// (the scene's own files are refused by check_not_input), naming the option or the scene's
+// output= that named the file: a user with both cannot tell which one a bare folder came from.
+void check_writable_path(const std::string& out, const NamedBy& by) {
     std::error_code ec;
     const fs::path target = fs::absolute(out, ec);
-    if (fs::is_directory(target, ec)) throw UsageError("output '" + out + "' is a folder");
+    if (fs::is_directory(target, ec)) by.refuse(out, "is a folder");
     const fs::path dir = target.parent_path();
-    if (!fs::is_directory(dir, ec)) throw UsageError("output folder '" + dir.string() + "' does not exist");
-    if (::access(dir.c_str(), W_OK) != 0) throw UsageError("output folder '" + dir.string() + "' is not writable");
+    if (!fs::is_directory(dir, ec)) by.refuse(out, "output folder '" + dir.string() + "' does not exist");
+    if (::access(dir.c_str(), W_OK) != 0) by.refuse(out, "output folder '" + dir.string() + "' is not writable");
     // access() says yes to root everywhere; creating a file is what matters (read-only file
     // systems, /proc, ...). The probe is an unnamed file (O_TMPFILE): a process killed at any
     // moment leaves nothing in the folder. File systems without O_TMPFILE get a named probe,
@@ -47,15 +49,13 @@ void check_writable_path(const std::string& out) {
         fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
         if (fd >= 0) ::unlink(probe.c_str());
     }
-    if (fd < 0)
-        throw UsageError("output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
+    if (fd < 0) by.refuse(out, "output folder '" + dir.string() + "' is not writable: " + std::strerror(errno));
     ::close(fd);
 }
 
-void check_output_path(const std::string& out) {
-    if (!image_format_for(out))
-        throw UsageError("output '" + out + "': unknown image format (expected " + image_format_extensions() + ")");
-    check_writable_path(out);
+void check_output_path(const std::string& out, const NamedBy& by) {
+    if (!image_format_for(out)) by.refuse(out, "unknown image format (expected " + image_format_extensions() + ")");
+    check_writable_path(out, by);
 }
 
 
@@ -121,12 +121,13 @@ Job make_job(const Options& opt, std::shared_ptr<const Scene> scene, bool writes
         if (!opt.profile_json.empty()) check_not_input(scene, opt.profile_json, "--profile=json", "");
         if (!opt.tile_costs.empty()) check_not_input(scene, opt.tile_costs, "--tile-costs", "");
         if (!opt.checkpoint.empty()) check_not_input(scene, opt.checkpoint, "--checkpoint", "");
-        if (!sample_map.empty()) check_writable_path(sample_map);
+        if (!sample_map.empty()) check_writable_path(sample_map, {"--aov samples="});
         // A shard part is a tile file (docs/distributed.md), whatever its name.
-        if (opt.shard_n > 0) check_writable_path(s.output);
-        else check_output_path(s.output);
-        if (!opt.profile_json.empty()) check_writable_path(opt.profile_json);
-        if (!opt.tile_costs.empty()) check_writable_path(opt.tile_costs);
+        const NamedBy image_by{image_option, &scene};
+        if (opt.shard_n > 0) check_writable_path(s.output, image_by);
+        else check_output_path(s.output, image_by);
+        if (!opt.profile_json.empty()) check_writable_path(opt.profile_json, {"--profile=json"});
+        if (!opt.tile_costs.empty()) check_writable_path(opt.tile_costs, {"--tile-costs"});
     }
     // Refuse, before allocating anything big, a render that cannot fit in this machine.
     const int jobs = opt.jobs > 0 ? opt.jobs : default_jobs();

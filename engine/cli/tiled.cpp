@@ -173,7 +173,7 @@ int run_merge(int argc, char** argv) {
     // The parts are the merge's inputs: writing the image over one would lose it.
     for (const std::string& part : parts)
         if (same_file(output, part)) throw UsageError("-o " + output + ": is one of the parts being merged");
-    check_output_path(output);
+    check_output_path(output, {"-o"});
     TileFileHeader header;
     const Framebuffer image = merge_parts(parts, header);
     RenderSettings display;

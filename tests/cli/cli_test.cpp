@@ -142,6 +142,22 @@ TEST_CASE("cli: output path mistakes are caught before rendering, nothing is cre
         CHECK(r.code == 2);
         check_one_line_error(r, "output folder '" + (d.path / "no" / "such").string() + "' does not exist");
         CHECK(!fs::exists(d.path / "no"));
+        // The line names what named the file: the option, or the scene's output= at its
+        // file:line:col (the value's column: "image width=8 height=6 output=" is 30 characters).
+        CHECK(r.err == "streamrt: -o " + out.string() + ": output folder '" + (d.path / "no" / "such").string() +
+                           "' does not exist\n");
+        const fs::path own = d.write("own.cfg", "image width=8 height=6 output=" + out.string() + "\nsphere\n");
+        const Run by_scene = run_streamrt(q(own));
+        CHECK(by_scene.code == 2);
+        CHECK(by_scene.err == "streamrt: " + own.string() + ":1:31: output=" + out.string() + ": output folder '" +
+                                  (d.path / "no" / "such").string() + "' does not exist\n");
+        const Run by_profile = run_streamrt(q(scene) + " -o " + q(d.path / "x.png") + " --profile=json " +
+                                            q(d.path / "no" / "p.json"));
+        CHECK(by_profile.code == 2);
+        CHECK(by_profile.err == "streamrt: --profile=json " + (d.path / "no" / "p.json").string() + ": output folder '" +
+                                    (d.path / "no").string() + "' does not exist\n");
+        CHECK(!fs::exists(d.path / "no"));
+        CHECK(!fs::exists(d.path / "x.png"));
     }
     SUBCASE("read-only folder") {
         // root may write anywhere permissions say otherwise; /proc refuses new files even to root.
