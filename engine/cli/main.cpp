@@ -55,7 +55,7 @@ int run(int argc, char** argv) {
     app.footer("Also: streamrt merge PART... -o OUT (the parts of --shard renders)");
     app.add_option("scene", opt.scene_path, "Scene file (.cfg)")->required();
     app.add_option("-j,--jobs", opt.jobs, "Worker threads (default: all cores)")->check(kInteger)->check(CLI::Range(1, 1024));
-    app.add_option("-o,--output", opt.output, "Output image (.ppm, .png, .pfm or .exr); overrides the scene's");
+    app.add_option("-o,--output", opt.output, "Output image (" + image_format_extensions() + "); overrides the scene's");
     app.add_option("--spp", opt.spp, "Samples per pixel")->check(kInteger)->check(CLI::Range(1, 65536));
     app.add_option("--width", opt.width, "Image width in pixels")->check(kInteger)->check(CLI::Range(1, 32768));
     app.add_option("--height", opt.height, "Image height in pixels")->check(kInteger)->check(CLI::Range(1, 32768));

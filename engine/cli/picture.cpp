@@ -101,7 +101,9 @@ int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBu
         const RenderResult base = render_once(EngineKind::Recursive, true);
         eo.profile = stream_profile;
         const RenderResult str = render_once(EngineKind::Stream, true);
+        const auto write_start = Clock::now();
         if (!write_image(output, str.image, display_of(s), wo)) throw Interrupted{};
+        const double write_seconds = since(write_start);
         const ImageDifference d = compare_images(str.image, base.image);
         std::printf("%s: %dx%d, spp %d, degree %d, -j%d, isa %s\n", opt.scene_path.c_str(), s.width, s.height, s.spp,
                     s.degree, par.jobs(), isa_name(eo.isa));
@@ -113,8 +115,12 @@ int render_picture(const Options& opt, Job& job, Parallelism& par, const SceneBu
         std::printf("difference (stream vs recursive, calibrated): max %.5f, rmse %.6f, psnr %.2f dB, "
                     "pixels off by > 1/255: %.4f%%\n",
                     d.max_abs, d.rmse, d.psnr, 100.0 * d.share_over);
-        std::printf("image (stream engine) -> %s\n", output.c_str());
         report_profile(opt, job.profile.get());
+        // Every render ends with the summary line (README): here the stream engine's, whose
+        // picture was written, whatever --engine said.
+        job.engine = EngineKind::Stream;
+        print_summary(opt, job, par.jobs(), ", compared with the recursive engine", str.seconds, str.counts,
+                      str.setup_seconds, write_seconds, str.adaptive);
         return 0;
     }
 

@@ -359,6 +359,13 @@ TEST_CASE("cli: --compare writes the stream engine's picture and honours --profi
     REQUIRE(r.code == 0);
     CHECK(r.out.find("speedup:") != std::string::npos);
     CHECK(r.out.find("stream profile:") != std::string::npos);
+    // It ends, as every render does (README), with the summary line: the stream engine's, whose
+    // picture was written, after the comparison and the profile.
+    const std::size_t last = r.out.rfind('\n', r.out.size() - 2);
+    const std::string summary = r.out.substr(last == std::string::npos ? 0 : last + 1);
+    CHECK(summary.rfind(scene.string() + ": 32x24, spp 1, degree 5, stream engine, compared with the recursive engine, -j2: ",
+                        0) == 0);
+    CHECK(summary.find(" -> " + out.string() + " (read ") != std::string::npos);
     check_same_as_in_process_stream(scene, out);
     const std::string j = slurp(json);
     CHECK(j.rfind("{", 0) == 0);

@@ -39,3 +39,13 @@ TEST_CASE("cli: usage mistakes name the fix") {
     CHECK(r.err.rfind("streamrt: " + colour.string() + ":1:8: unknown key 'colour' for 'sphere': did you mean 'color'? "
                       "(expected one of: ", 0) == 0);
 }
+
+TEST_CASE("cli: --help names every image format -o writes") {
+    // Written by hand, not from the format registry: .hdr worked and --help left it out.
+    const Run r = run_streamrt("--help");
+    CHECK(r.code == 0);
+    CHECK(r.out.find("Output image (.ppm, .png, .pfm, .exr or .hdr); overrides the scene's") != std::string::npos);
+    const Run m = run_streamrt("merge --help");
+    CHECK(m.code == 0);
+    CHECK(m.out.find("Output image (.ppm, .png, .pfm, .exr or .hdr)") != std::string::npos);
+}

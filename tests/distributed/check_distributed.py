@@ -87,6 +87,12 @@ def scenes():
                                            SCENES / "gi" / "cornell.cfg"]
 
 
+def summary_rays(stdout):
+    """The rays of a summary line (`..., 12345 rays (6.78 Mrays/s), ...`), or None."""
+    m = re.search(r", (\d+) rays \([0-9.]+ Mrays/s\)", stdout)
+    return int(m[1]) if m else None
+
+
 def reference(args, scene, out, extra=(), size=SIZE, spp="2"):
     r = run([args.streamrt, "-j2", scene, "-o", out, *size, "--spp", spp, "-q", *extra])
     check(r.returncode == 0, f"{scene.name}: single-process render failed: {r.stderr.strip()}")
@@ -258,8 +264,10 @@ def group_checkpoint(args, tmp):
             break
         out.unlink(missing_ok=True)
     ref = tmp / "ref.pfm"
-    r = run([args.streamrt, "-j2", scene, "-o", ref, *big])
+    loud = [a for a in big if a != "-q"]  # the summary lines: the rays traced
+    r = run([args.streamrt, "-j2", scene, "-o", ref, *loud])
     check(r.returncode == 0, f"reference render failed: {r.stderr.strip()}")
+    whole_rays = summary_rays(r.stdout)
     check(p.returncode == 130, f"interrupted checkpointed render (spp {spp}): exit {p.returncode}: {err.strip()!r}")
     if p.returncode == 130:
         check(not out.exists(), "an interrupted render left an image")
@@ -283,9 +291,17 @@ def group_checkpoint(args, tmp):
         r = run([args.streamrt, "-j2", scene, "-o", out, *big, "--checkpoint", journal])
         check(r.returncode == 2 and one_line(r), f"existing journal without --resume: {r.stderr.strip()!r}")
         check(not out.exists(), "a refused resume wrote an image")
-        r = run([args.streamrt, "-j2", scene, "-o", out, *big, "--checkpoint", journal, "--resume"])
+        r = run([args.streamrt, "-j2", scene, "-o", out, *loud, "--checkpoint", journal, "--resume"])
         check(r.returncode == 0, f"resume failed: {r.stderr.strip()}")
         check(out.exists() and out.read_bytes() == ref.read_bytes(), "the resumed render differs from the uninterrupted one")
+        # The resumed run's rays and rate are its own: with the rays the journal's tiles took
+        # before, they add up to the uninterrupted render's (counting them in the rate once
+        # gave 2,331,886 Mrays/s).
+        now = summary_rays(r.stdout)
+        before = re.search(r" tiles resumed \((\d+) rays traced before, not in the rate\)", r.stdout)
+        check(before is not None and now is not None and whole_rays is not None and int(before[1]) > 0
+              and now + int(before[1]) == whole_rays,
+              f"resumed: rays now {now} + before {before and before[1]} != the whole render's {whole_rays}: {r.stdout!r}")
         check(not journal.exists(), "the journal is left after the image was written")
     # Tile costs: one line per tile, rays and seconds.
     costs = tmp / "costs.csv"
