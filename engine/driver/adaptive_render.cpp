@@ -349,7 +349,13 @@ Framebuffer render_adaptive_image(PreparedRender& prepared, Parallelism& par, Re
                 for (int y = own.y0; y < own.y1; ++y)
                     std::copy_n(&rgb[std::size_t(y - own.y0) * std::size_t(own.width()) * 3], std::size_t(own.width()) * 3,
                                 &corner_rgb[(std::size_t(y) * std::size_t(w + 1) + std::size_t(own.x0)) * 3]);
-                if (progress) progress->add(counts);
+                if (progress) {
+                    // Progress counts tiles (tiles_total) and a block holds up to 2 x 2 of them:
+                    // counted as one, round 0 ended at a quarter of the bar.
+                    progress->add(counts);
+                    const int tiles = ((x1 - x0 + kTileSize - 1) / kTileSize) * ((y1 - y0 + kTileSize - 1) / kTileSize);
+                    progress->tiles_done += tiles - 1;
+                }
             });
             summary.rounds = 1;
             lap(phases.corners);

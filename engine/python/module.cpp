@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -159,7 +160,9 @@ RenderResult render_watched(const RenderJob& job, EngineKind engine, const py::o
     }
     if (interrupted) throw std::move(*interrupted);
     if (failure) std::rethrow_exception(failure);
-    if (!progress.is_none()) progress(watch.tiles_total, watch.tiles_total);
+    // The closing call reports the tiles the render counted, not the total taken for granted:
+    // a render that lost count of its tiles says so.
+    if (!progress.is_none()) progress(watch.tiles_done.load(), watch.tiles_total);
     return result;
 }
 
@@ -235,6 +238,15 @@ std::shared_ptr<const Scene> read_any(const py::object& scene, int threads) {
         return std::make_shared<const Scene>(read_scene(s, threads));
     }
     const std::string text = scene.cast<std::string>();
+    // One line ending in .cfg is a path, not scene text: a mistyped name was read as a scene
+    // and refused as "unknown statement 'scenes/whited.cfg'", hiding what was wrong.
+    std::error_code ec;
+    if (text.find('\n') == std::string::npos && text.ends_with(".cfg") && !std::filesystem::exists(text, ec)) {
+        const py::object error = py::module_::import("builtins").attr("FileNotFoundError")(
+            ENOENT, "no such scene file (one line ending in .cfg is read as a path)", text);
+        PyErr_SetObject(PyExc_FileNotFoundError, error.ptr());
+        throw py::error_already_set();
+    }
     py::gil_scoped_release release;
     return std::make_shared<const Scene>(read_scene(text, threads));
 }

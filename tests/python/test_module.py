@@ -2,6 +2,7 @@
 
 Every expected value comes from outside the module: the command line's PFM, files parsed here,
 or values worked out from the scene text."""
+import json
 import os
 import pathlib
 import signal
@@ -16,6 +17,7 @@ import streamrt
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 STREAMRT = os.environ.get("STREAMRT_BINARY", str(ROOT / "build/engine/streamrt"))
 WHITTED = str(ROOT / "scenes/whitted.cfg")
+RANDOM_SPHERES = str(ROOT / "scenes/random_spheres.cfg")
 
 
 def read_pfm(path):
@@ -34,6 +36,14 @@ def cli_pfm(scene, *args):
         out = os.path.join(d, "x.pfm")
         subprocess.run([STREAMRT, scene, "-q", "-o", out, *args], check=True)
         return read_pfm(out)
+
+
+def cli_profile(scene, *args):
+    """The --profile=json of a command-line render, read here."""
+    with tempfile.TemporaryDirectory() as d:
+        out, prof = os.path.join(d, "x.pfm"), os.path.join(d, "p.json")
+        subprocess.run([STREAMRT, scene, "-q", "-o", out, "--profile=json", prof, *args], check=True)
+        return json.loads(pathlib.Path(prof).read_text())
 
 
 def test_image_is_the_command_lines_pfm_bit_for_bit():
@@ -64,6 +74,20 @@ def test_overrides_give_the_command_lines_picture(overrides, flags):
     np.testing.assert_array_equal(r.image, cli_pfm(WHITTED, "--width", "48", "--height", "32", *flags))
 
 
+def test_accel_and_threads_reach_the_engine():
+    # Every accel and thread count gives the same picture, so the picture alone passed with both
+    # options ignored. The profile names what ran: random_spheres.cfg's spheres take the
+    # hierarchy by default (its intersect stage lists no kinds), the flat loop over kinds with
+    # accel="flat"; and the threads.
+    size = dict(width=48, height=32)
+    r = streamrt.render(RANDOM_SPHERES, **size, accel="flat", threads=1, profile=True)
+    want = cli_profile(RANDOM_SPHERES, "--width", "48", "--height", "32", "--accel", "flat", "-j", "1")
+    assert r.profile["threads"] == want["threads"] == 1
+    assert "intersect[sphere,plane]" in r.profile["built"]
+    assert r.profile["built"] == want["built"]
+    assert "intersect[]" in streamrt.render(RANDOM_SPHERES, **size, profile=True).profile["built"]
+
+
 def test_adaptive_result_carries_the_sample_map_of_the_command_line():
     r = streamrt.render(WHITTED, width=48, height=32, spp=16, adaptive=0.01)
     assert r.adaptive is not None
@@ -87,6 +111,40 @@ def test_adaptive_result_carries_the_sample_map_of_the_command_line():
     assert p["adaptive"]["rounds"] == 3 and p["adaptive"]["cap"] == 16
     assert p["adaptive"]["mean_spp"] == pytest.approx(r.adaptive["mean_spp"], abs=1e-6)
     assert streamrt.render(WHITTED, width=48, height=32, spp=16).adaptive is None
+
+
+def test_adaptive_result_says_what_cut_the_request_short():
+    size = dict(width=48, height=32)
+    a = streamrt.render(WHITTED, **size, spp=4, target_error=0.0001).adaptive
+    assert (a["cut_short_by"], a["cap"], a["cap_from"]) == ("cap", 4, "spp")
+    # Pixels at the cap above their stopping point T (n / 16)^(3/4), counted here from the
+    # sample map (within 0.1 % of the point the map's float error may fall either side).
+    counts, errors = a["sample_map"][..., 0], a["sample_map"][..., 1]
+    point = 0.0001 * (4 / 16) ** 0.75
+    surely = int(((counts == 4) & (errors > point * 1.001)).sum())
+    maybe = int(((counts == 4) & (errors > point * 0.999)).sum())
+    assert 0 < surely <= a["above_at_cap"] <= maybe
+    with tempfile.TemporaryDirectory() as d:
+        line = subprocess.run([STREAMRT, WHITTED, "-o", os.path.join(d, "x.pfm"), "--width", "48", "--height", "32",
+                               "--spp", "4", "--target-error", "0.0001"], check=True, capture_output=True, text=True).stdout
+    assert f"target error 0.0001 not reached: {a['above_at_cap']} pixel(s) stopped at the cap of 4 samples (--spp)" in line
+    # Without spp the scene's uniform 4 is no cap: 64, and a coarse target is met.
+    met = streamrt.render(WHITTED, **size, target_error=0.2).adaptive
+    assert (met["cut_short_by"], met["cap"], met["cap_from"]) == (None, 64, "default")
+    timed = streamrt.render(WHITTED, **size, target_error=0.0001, time_limit=1e-9).adaptive
+    assert timed["cut_short_by"] == "time_limit" and timed["time_limited"]
+    coarse = streamrt.render(WHITTED, **size, spp=64, target_error=0.0001, adaptive=0.9).adaptive
+    assert coarse["cut_short_by"] == "threshold" and coarse["above_at_cap"] == 0
+
+
+def test_a_one_line_cfg_name_that_is_no_file_is_no_such_file():
+    missing = str(ROOT / "scenes/whited.cfg")
+    with pytest.raises(FileNotFoundError) as e:
+        streamrt.render(missing)
+    assert e.value.filename == missing
+    # Without the .cfg ending one line is still scene text, read and refused as such.
+    with pytest.raises(streamrt.SceneError, match="unknown statement 'whited'"):
+        streamrt.render("whited")
 
 
 def test_scene_text_and_flat_colours():
@@ -113,9 +171,19 @@ def test_scene_errors_carry_file_line_and_column():
 
 
 def test_profile_is_the_json_of_the_command_line():
-    r = streamrt.render(WHITTED, width=32, height=32, profile=True)
+    r = streamrt.render(WHITTED, width=32, height=32, threads=2, profile=True)
     assert r.profile is not None
-    assert r.profile["isa"]
+    # The command line's own --profile=json: the same fields and every figure that is not a
+    # time (the rays of each stage and generation, the pipeline, the level, the lanes).
+    cli = cli_profile(WHITTED, "--width", "32", "--height", "32", "-j", "2")
+    assert set(r.profile) == set(cli)
+    for key in ("isa", "lanes", "threads", "built", "rays"):
+        assert r.profile[key] == cli[key], key
+
+    def untimed(rows):
+        return [{k: v for k, v in row.items() if "seconds" not in k and "mrays" not in k} for row in rows]
+    assert untimed(r.profile["stages"]) == untimed(cli["stages"])
+    assert untimed(r.profile["generations"]) == untimed(cli["generations"])
     # the per-generation rows split the intersect and occlusion stages
     gens = r.profile["generations"]
     stages = {s["stage"]: s for s in r.profile["stages"]}
@@ -126,10 +194,14 @@ def test_profile_is_the_json_of_the_command_line():
 
 
 def test_progress_reaches_every_tile():
-    seen = []
-    streamrt.render(WHITTED, width=64, height=48, progress=lambda done, total: seen.append((done, total)))
-    assert seen[-1] == (12, 12)  # 64x48 in 16x16 tiles
-    assert all(d <= t for d, t in seen)
+    # The closing call carries the tiles the render counted (it was (total, total) whatever
+    # the render did): uniform, and adaptive, whose first round traces blocks of 2 x 2 tiles.
+    for adaptive in ({}, dict(spp=16, adaptive=0.01)):
+        seen = []
+        streamrt.render(WHITTED, width=64, height=48, progress=lambda done, total: seen.append((done, total)), **adaptive)
+        assert seen[-1] == (12, 12), adaptive  # 64x48 in 16x16 tiles
+        assert all(d <= t for d, t in seen)
+        assert all(a[0] <= b[0] for a, b in zip(seen, seen[1:]))
 
 
 def test_ctrl_c_cancels_the_render_and_raises_keyboard_interrupt():
