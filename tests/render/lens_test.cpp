@@ -16,6 +16,7 @@
 #include "render/camera_rays.h"
 #include "render/sampling.h"
 #include "scene/parser.h"
+#include "render/look_at_oracle.h"
 #include "stream/stream_renderer.h"
 
 using namespace streamrt;
@@ -177,6 +178,29 @@ TEST_CASE("thin lens: the generate(lens) kernel traces the scalar formulas' rays
             CHECK(rays.dy[i] == d.y);
             CHECK(rays.dz[i] == d.z);
         }
+        // Independently of the lens and sample templates the kernel shares, from the docs'
+        // thin lens (camera aperture=0.2 focus=3) on the docs' look-at camera written in the
+        // test: every ray leaves the lens disc (radius 0.2 around the eye, across the view) and
+        // crosses the plane in focus, 3 along the view, where the pinhole ray of a point in its
+        // pixel's lattice cell does (cell k % 3, k / 3 of 3 x 2); a pixel's 6 rays leave from
+        // 6 different points of the lens.
+        const test::LookAtOracle oracle({1, 2, 6}, {0, 0.5, 0}, {0, 1, 0}, 50, 37, 23);
+        REQUIRE(cols == 3);
+        for (std::size_t i = 0; i < n; ++i) {
+            const glm::dvec3 o{rays.ox[i], rays.oy[i], rays.oz[i]}, dir{rays.dx[i], rays.dy[i], rays.dz[i]};
+            CHECK(glm::length(o - oracle.eye) <= 0.2 * (1 + 1e-6));
+            CHECK(std::fabs(glm::dot(o - oracle.eye, oracle.forward)) < 1e-6);
+            const glm::dvec2 at = oracle.image_position(o, dir, 3.0);
+            const double cx0 = px[i] + (ks[i] % 3) / 3.0, cy0 = 3.0 + (ks[i] / 3) / 2.0, eps = 1e-4;
+            CHECK(at.x > cx0 - eps);
+            CHECK(at.x < cx0 + 1.0 / 3 + eps);
+            CHECK(at.y > cy0 - eps);
+            CHECK(at.y < cy0 + 0.5 + eps);
+        }
+        for (std::size_t first = 0; first + spp <= n; first += spp)
+            for (std::size_t i = first; i < first + spp; ++i)
+                for (std::size_t j = first; j < i; ++j)
+                    CHECK((rays.ox[i] != rays.ox[j] || rays.oy[i] != rays.oy[j] || rays.oz[i] != rays.oz[j]));
     });
 }
 
