@@ -413,23 +413,27 @@ def group_mpi_faults(args, tmp):
 
     # Ctrl-C reaches the ranks (a terminal sends it to the whole foreground group): the job
     # winds down together, exit 130, no image; the journal is resumed by 3 ranks, same bytes.
-    big = ["--width", "320", "--height", "240", "--spp", "8", "-q"]
-    want = reference(args, scene, tmp / "ref_big.pfm", size=big[:4], spp="8")
+    # The render is long by construction against the interrupt's delay: rank 0 creates the
+    # journal before the first tile is handed out, the ranks are interrupted within one 5 ms
+    # poll of it, and 640x480 at 64 spp is 81 M rays, about 1 s for two ranks here (the 320x240
+    # at 8 spp this test rendered ended 0.04 s after it started, and the interrupt 0.5 s after
+    # the journal always came too late: the interrupt-and-resume path was skipped with a pass).
+    # A render that ends before its interrupt now fails.
+    big = ["--width", "640", "--height", "480", "--spp", "64", "-q"]
+    want = reference(args, scene, tmp / "ref_big.pfm", size=big[:4], spp="64")
     journal, out = tmp / "mpi.journal", tmp / "interrupted.pfm"
     cmd = mpirun(args, 2) + ["--mpi", "-j1", scene, "-o", out, *big, "--checkpoint", journal]
     p = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=e)
-    # Interrupt half a second after the render began (rank 0 creates the journal then; a fixed
-    # wait from the launch missed the render when the machine was quick).
-    for _ in range(1000):
-        if journal.exists() or p.poll() is not None:
-            break
-        time.sleep(0.01)
-    time.sleep(0.5)
+    deadline = time.time() + 60 * SCALE
+    while not journal.exists() and p.poll() is None and time.time() < deadline:
+        time.sleep(0.005)
+    interrupted_at = time.time()
     for child in rank_pids(p.pid):
         os.kill(int(child), signal.SIGINT)
     _, err = p.communicate(timeout=60 * SCALE)
+    check(p.returncode != 0, f"Ctrl-C under MPI: the render ended (exit 0) before its interrupt, "
+          f"{time.time() - interrupted_at:.2f} s after it was sent: make it longer")
     if p.returncode == 0:
-        print("note: the MPI render finished before the interrupt")
         return
     check(p.returncode == 130, f"Ctrl-C under MPI: exit {p.returncode}: {err.strip()!r}")
     check(len([line for line in err.splitlines() if line.startswith("streamrt")]) == 1,
