@@ -11,7 +11,8 @@ stratified, made once and cached in BUILD/perf/reference/. Writes
   BUILD/perf/error_vs_time.csv     scene, engine, sampler, spp, seconds, rmse, psnr, relmse
   BUILD/perf/precision.csv         scene, sampler, spp, stream-vs-recursive rmse/psnr/relmse at
                                    equal spp and equal samples: what single precision costs
-(BUILD/perf-quick/ with --quick) and, when matplotlib is there (/usr/bin/python3), one log-log plot per scene into docs/img/
+(BUILD/perf-quick/ with --quick) and, when matplotlib is there (/usr/bin/python3), one log-log plot per scene into --out
+(build/perf/img/; --out docs/img for the docs' pictures)
 (scripts/plot_perf.py --errors draws them again from the CSV).
 Seconds are streamrt's render clock (-j as given, default 2), median of --runs. The renders run
 in this process through the streamrt Python module (build/python, docs/python.md): the
@@ -52,7 +53,8 @@ def main(argv=None):
     ap.add_argument("--runs", type=int, default=1, help="timed renders per point (median)")
     ap.add_argument("--thresholds", default="0.08,0.04,0.02,0.01,0.005",
                     help="adaptive sampling's thresholds T (comma-separated; empty: no adaptive curve)")
-    ap.add_argument("--img", default=os.path.join(pc.ROOT, "docs", "img"), help="where the plots go")
+    ap.add_argument("--out", "--img", dest="img", default=os.path.join(pc.ROOT, "build", "perf", "img"),
+                    help="where the plots go (default build/perf/img; the docs' pictures: --out docs/img)")
     args = ap.parse_args(argv)
     w = args.width or (160 if args.quick else 320)
     h = args.height or (90 if args.quick else 180)

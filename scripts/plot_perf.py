@@ -3,10 +3,12 @@
 Debian's python3-matplotlib: run with /usr/bin/python3).
 
 usage: /usr/bin/python3 scripts/plot_perf.py [--results build/perf/results.json]
-                                             [--errors build/perf/error_vs_time.csv] [--img docs/img]
+                                             [--errors build/perf/error_vs_time.csv] [--out build/perf/img]
 Writes scaling_resolution.png, scaling_objects.png, scaling_threads.png (from results.json)
 evt_<scene>.png (from error_vs_time.csv) and kernels_sphere.png (from perf/kernel_bench's JSON,
-whose summary table is printed in Markdown) into --img.
+whose summary table is printed in Markdown) into --out: build/perf/img/ unless asked otherwise,
+so that a quick run never rewrites the pictures the docs show (--out docs/img does, on purpose).
+Exits 1 when there is nothing to plot.
 """
 import argparse
 import csv
@@ -195,9 +197,11 @@ def main(argv=None):
     ap.add_argument("--errors", default=os.path.join(ROOT, "build", "perf", "error_vs_time.csv"))
     ap.add_argument("--kernels", default=os.path.join(ROOT, "build", "perf", "kernels.json"),
                     help="perf/kernel_bench --benchmark_out JSON (a summary table is printed)")
-    ap.add_argument("--img", default=os.path.join(ROOT, "docs", "img"))
+    ap.add_argument("--out", "--img", dest="img", default=os.path.join(ROOT, "build", "perf", "img"),
+                    help="where the PNGs go (default build/perf/img; the docs' pictures: --out docs/img)")
     ap.add_argument("--suffix", default="", help="appended to each PNG name")
     args = ap.parse_args(argv)
+    os.makedirs(args.img, exist_ok=True)
     made = []
     if os.path.exists(args.results):
         made += plot_results(args.results, args.img, args.suffix)
@@ -209,7 +213,10 @@ def main(argv=None):
     for p in made:
         print("plot:", p)
     if not made:
-        print("nothing to plot: run scripts/perf_suite.py and/or scripts/error_vs_time.py first")
+        # A run that plotted nothing is a failure: a script chain (perf_suite.py && plot_perf.py)
+        # must not report success with no pictures.
+        print("nothing to plot: run scripts/perf_suite.py and/or scripts/error_vs_time.py first", file=sys.stderr)
+        return 1
     return 0
 
 
