@@ -23,7 +23,7 @@ Groups (all by default):
               render, write, from the summary line) and peak RSS, into
               results_endtoend.{json,md}; --before DIR also runs DIR/engine/streamrt (an older
               build) alternately with this one, for a before/after measured in one run.
---quick runs a ~2 minute subset (one run after the warm-up, fewer cases).
+--quick runs a subset of about half a minute (27 s measured; one run after the warm-up, fewer cases).
 Times are streamrt's own render clock (scene parsing, hierarchy build and image writing
 excluded); "wall" is the whole process. Peak memory is the process's maximum RSS (wait4).
 Then: /usr/bin/python3 scripts/plot_perf.py  and  scripts/compare_results.py OLD NEW.
@@ -234,7 +234,7 @@ def endtoend(exe, before_exe, args, gen_dir, out_dir):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--quick", action="store_true", help="a ~2 minute smoke run")
+    ap.add_argument("--quick", action="store_true", help="a smoke run of about half a minute")
     ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"), help="build folder (default build/)")
     ap.add_argument("--runs", type=int, help="timed runs per case (default 3, quick 1)")
     ap.add_argument("--warmup", type=int, default=1, help="untimed runs before (default 1)")
