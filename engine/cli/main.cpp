@@ -101,10 +101,12 @@ int run(int argc, char** argv) {
         ->check(CLI::IsMember(names_vector(kSamplePatternNames)));
     app.add_option("--adaptive", opt.adaptive,
                    "Adaptive sampling: a pixel of n samples stops once the standard error of its mean (RMS over R, G, "
-                   "B) is at most T (n / 16)^(3/4) (T at 16 samples, e.g. 0.03); --spp is the most it takes (default 64)")
+                   "B) is at most T (n / 16)^(3/4) (T at 16 samples, e.g. 0.03); --spp is the most it takes (without it: the "
+                   "larger of 64 and the scene's spp, or the scene's spp when the scene asks for adaptive sampling)")
         ->check(CLI::Range(0.0, 1.0));
     app.add_option("--target-error", opt.target_error,
-                   "Adaptive sampling until the image's estimated RMSE is at most E")
+                   "Adaptive sampling until the image's estimated RMSE is at most E (the cap as for --adaptive; the "
+                   "closing line says when the cap or the clock stopped it first)")
         ->check(CLI::Range(1e-9, 1.0));
     app.add_option("--time-limit", opt.time_limit,
                    "Adaptive sampling: stop refining after S seconds of rendering and write the picture so far")
