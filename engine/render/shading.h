@@ -193,8 +193,8 @@ inline ColorT<V> ambient_light(int degree, T alpha, const MaterialT<T>& m, const
 
 /// A direction about the unit normal n with density cos(theta) / pi (the Lambert BRDF's
 /// importance), from (u1, u2) in [0, 1)^2: the concentric disc lifted onto the hemisphere
-/// (Malley's method), in the frame of Duff et al. (2017), which has no branch and no
-/// singularity but n.z = -1 exactly (sign picks the stable half). The disc's angle comes from
+/// (Malley's method), in the frame of Duff et al. (2017): no branch, and no division by
+/// zero (sign + n.z is at least 1 in magnitude, sign taking n.z's side). The disc's angle comes from
 /// simd/stable_math.h, so every ISA level and the double engine get the same direction bits
 /// for the same numbers, up to their precision.
 template <class V>
