@@ -57,6 +57,16 @@ std::string box(int spp, int depth) {
            "sphere color=0.9,0.9,0.5 diff=0.8 scale=0.4 translate=-0.3,0.4,-0.2\n";
 }
 
+/// Renders `text` with each engine (-j2) and hands the result to `check`.
+template <class Check>
+void in_both_engines(const std::string& text, const char* name, Check check) {
+    for (EngineKind engine : kEngines) {
+        CAPTURE(engine_name(engine));
+        Parallelism par(2);
+        check(render_scene(parse_scene(text, name), engine, par));
+    }
+}
+
 }  // namespace
 
 TEST_CASE("degree 6: a convex diffuse sphere under a uniform sky is rho L, at any spp, in both engines") {
@@ -68,10 +78,7 @@ TEST_CASE("degree 6: a convex diffuse sphere under a uniform sky is rho L, at an
         "background 0.5,0.7,0.9\n"
         "camera eye=0,0,3 look=0,0,0 up=0,1,0 fov=60\n"
         "sphere color=0.8,0.6,0.4 diff=0.5 ambi=1\n";
-    for (EngineKind engine : kEngines) {
-        CAPTURE(engine_name(engine));
-        Parallelism par(2);
-        const RenderResult r = render_scene(parse_scene(text, "sky_sphere.cfg"), engine, par);
+    in_both_engines(text, "sky_sphere.cfg", [](const RenderResult& r) {
         const float* centre = r.image.pixel(8, 8);
         CHECK(centre[0] == doctest::Approx(0.8 * 0.5 * 0.5).epsilon(1e-5));
         CHECK(centre[1] == doctest::Approx(0.6 * 0.5 * 0.7).epsilon(1e-5));
@@ -79,7 +86,7 @@ TEST_CASE("degree 6: a convex diffuse sphere under a uniform sky is rho L, at an
         const float* corner = r.image.pixel(0, 0);  // beside the sphere: the sky itself
         CHECK(corner[0] == doctest::Approx(0.5).epsilon(1e-6));
         CHECK(r.counts.diffuse > 0);
-    }
+    });
 }
 
 TEST_CASE("degree 6: inside a closed emitting sphere, depth 2 gives Le (1 + rho + rho^2) exactly") {
@@ -90,17 +97,14 @@ TEST_CASE("degree 6: inside a closed emitting sphere, depth 2 gives Le (1 + rho 
         "camera eye=0,0,0 look=0,0,-1 up=0,1,0 fov=60\n"
         "sphere color=1,0.5,0.25 diff=0.5 emission=0.4,0.4,0.4 scale=2\n";
     const double rho[3] = {0.5, 0.25, 0.125};
-    for (EngineKind engine : kEngines) {
-        CAPTURE(engine_name(engine));
-        Parallelism par(2);
-        const RenderResult r = render_scene(parse_scene(text, "furnace.cfg"), engine, par);
+    in_both_engines(text, "furnace.cfg", [&](const RenderResult& r) {
         for (int c = 0; c < 3; ++c) {
             CAPTURE(c);
             const double expected = 0.4 * (1 + rho[c] + rho[c] * rho[c]);
             for (int y = 0; y < 8; ++y)
                 for (int x = 0; x < 8; ++x) CHECK(r.image.pixel(x, y)[c] == doctest::Approx(expected).epsilon(1e-5));
         }
-    }
+    });
 }
 
 TEST_CASE("degree 6: with Russian roulette and a deep cap, the closed sphere converges to Le / (1 - rho)") {
@@ -111,10 +115,7 @@ TEST_CASE("degree 6: with Russian roulette and a deep cap, the closed sphere con
         "camera eye=0,0,0 look=0,0,-1 up=0,1,0 fov=60\n"
         "sphere color=1,0.8,0.6 diff=0.7 emission=0.3,0.3,0.3 scale=2\n";
     const double rho[3] = {0.7, 0.56, 0.42};
-    for (EngineKind engine : kEngines) {
-        CAPTURE(engine_name(engine));
-        Parallelism par(2);
-        const RenderResult r = render_scene(parse_scene(text, "furnace_rr.cfg"), engine, par);
+    in_both_engines(text, "furnace_rr.cfg", [&](const RenderResult& r) {
         const Stats s = pixel_stats(r.image);
         for (int c = 0; c < 3; ++c) {
             CAPTURE(c);
@@ -123,7 +124,7 @@ TEST_CASE("degree 6: with Russian roulette and a deep cap, the closed sphere con
             CHECK(s.sd[c] > 0);  // roulette is on: the pixels differ
             CHECK(std::abs(s.mean[c] - expected) < 4 * standard_error);
         }
-    }
+    });
 }
 
 TEST_CASE("degree 6 keeps degree 5's direct and specular light where nothing is diffuse") {
