@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Second command of the README (and the first step of CI): install the dependencies, build
-# from scratch (Release) and run the whole test suite with ctest: 3 min 52 s on a fresh clone
-# on 2 free cores with the packages already installed (2026-11-28; 311 tests, ctest 37 s of it),
-# up to 12 minutes when other work loads the machine; most of it is the build. The slow checks
+# from scratch (Release) and run the whole test suite with ctest: 7 min 55 s on a fresh clone
+# on 2 free cores (AMD EPYC, AVX2) with the packages already installed (2026-12-02; 370 tests,
+# ctest 91 s of it; 3 min 52 s and 311 tests on 2026-11-28, before degree 6's shade kernels and
+# pipelines); most of it is the build. The slow checks
 # (the parser fuzzer, the ASan+UBSan build and its suite) are run after it by .ci/run, or by
 # hand: scripts/fuzz.sh 60, JOBS=2 scripts/sanitize.sh asan.
 set -euo pipefail
