@@ -311,11 +311,13 @@ inline int path_sample_bits(int spp) {
 /// sample (modulo 2^32), from which the first bounce reads the pixel and the sample back
 /// (first_bounce_point). Every use of a key hashes it first, so numbered keys serve the light
 /// samples and the child keys as well as hashed ones, and distinct paths get distinct keys
-/// while pixel x spp stays under 2^32.
+/// while pixel x spp stays under 2^32. A sample number that does not fit (adaptive sampling's
+/// pixel corners, kCornerSampleNumber) keeps light_key: numbered, a corner would share its key,
+/// hence its every number, with sample 0 of the pixel of the same index.
 inline std::uint32_t camera_key(int degree, int spp, std::uint64_t pixel, int sample) {
-    if (degree < 6) return light_key(pixel, sample);
     const int bits = path_sample_bits(spp);
-    return (std::uint32_t(pixel) << bits) | (std::uint32_t(sample) & ((1u << bits) - 1u));
+    if (degree < 6 || (std::uint32_t(sample) >> bits) != 0) return light_key(pixel, sample);
+    return (std::uint32_t(pixel) << bits) | std::uint32_t(sample);
 }
 
 /// The first bounce's two numbers for a camera ray of degree-6 key `key`: point (sample) of

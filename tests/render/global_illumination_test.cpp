@@ -8,6 +8,7 @@
 #include <string>
 
 #include "driver/render.h"
+#include "render/sampling.h"
 #include "scene/parser.h"
 
 using namespace streamrt;
@@ -217,4 +218,14 @@ TEST_CASE("degree 6: the error falls at least as fast as spp^(-1/2)") {
         if (last > 0) CHECK(e <= 0.55 * last);
         last = e;
     }
+}
+
+TEST_CASE("degree 6: camera keys number the paths; corners and lower degrees keep their hashed keys") {
+    // 16 spp: 4 bits for the sample; pixel 5, sample 3 is 5 x 16 + 3.
+    CHECK(camera_key(6, 16, 5, 3) == 5u * 16u + 3u);
+    CHECK(camera_key(6, 9, 5, 8) == 5u * 16u + 8u);  // 9 samples still take 4 bits
+    CHECK(camera_key(5, 16, 5, 3) == light_key(5, 3));
+    // An adaptive corner's sample number does not fit: its key must not be pixel 7's sample 0's.
+    CHECK(camera_key(6, 16, 7, kCornerSampleNumber) == light_key(7, kCornerSampleNumber));
+    CHECK(camera_key(6, 16, 7, kCornerSampleNumber) != camera_key(6, 16, 7, 0));
 }
