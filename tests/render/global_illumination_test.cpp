@@ -220,7 +220,7 @@ TEST_CASE("degree 6: the error falls at least as fast as spp^(-1/2)") {
     }
 }
 
-TEST_CASE("degree 6: camera keys number the paths; corners and lower degrees keep their hashed keys") {
+TEST_CASE("degree 6: camera keys number the paths, corners and lower degrees keep their hashed keys") {
     // 16 spp: 4 bits for the sample; pixel 5, sample 3 is 5 x 16 + 3.
     CHECK(camera_key(6, 16, 5, 3) == 5u * 16u + 3u);
     CHECK(camera_key(6, 9, 5, 8) == 5u * 16u + 8u);  // 9 samples still take 4 bits
