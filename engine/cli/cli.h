@@ -85,6 +85,7 @@ struct Options {
     // Adaptive sampling (docs/adaptive-sampling.md).
     std::optional<double> adaptive, target_error, time_limit;
     std::string aov;  ///< --aov samples=FILE: the per-pixel sample counts and error estimates
+    std::string memory_limit;  ///< --memory-limit SIZE (core/memory_budget.h); empty: the available memory
     /// Rendered tile by tile (render_tiles) rather than as one image.
     bool tiled() const { return mpi || shard_n > 0 || !checkpoint.empty() || !tile_costs.empty(); }
 };

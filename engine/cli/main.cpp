@@ -1,6 +1,7 @@
 // streamrt: renders a .cfg scene (docs/scene-format.md) with the stream or the recursive engine.
 #include "cli/cli.h"
 #include "cli/progress.h"
+#include "core/memory_budget.h"
 #include "core/nearest_name.h"
 
 namespace streamrt::cli {
@@ -56,6 +57,9 @@ int run(int argc, char** argv) {
     app.add_option("scene", opt.scene_path, "Scene file (.cfg)")->required();
     app.add_option("-j,--jobs", opt.jobs, "Worker threads (default: all cores)")->check(kInteger)->check(CLI::Range(1, 1024));
     app.add_option("-o,--output", opt.output, "Output image (" + image_format_extensions() + "); overrides the scene's");
+    app.add_option("--memory-limit", opt.memory_limit,
+                   "The most memory the process may hold, e.g. 4G or 512M (default: the available memory, within "
+                   "a control group's limit, less a margin); reading, building, rendering and writing count against it");
     app.add_option("--spp", opt.spp, "Samples per pixel")->check(kInteger)->check(CLI::Range(1, 65536));
     app.add_option("--width", opt.width, "Image width in pixels")->check(kInteger)->check(CLI::Range(1, 32768));
     app.add_option("--height", opt.height, "Image height in pixels")->check(kInteger)->check(CLI::Range(1, 32768));
@@ -153,6 +157,7 @@ int run(int argc, char** argv) {
                              (o == "-o" ? " (leave -o out to write the scene's output=)" : ""));
         }
     if (!opt.shard.empty()) parse_shard(opt.shard, opt.shard_k, opt.shard_n);
+    if (!opt.memory_limit.empty()) MemoryBudget::set_limit(parse_memory_size(opt.memory_limit));
     const char* launcher = mpi_launcher_variable();
     if (launcher && !opt.mpi)
         throw UsageError(std::string("started by an MPI launcher (") + launcher +

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "image/image_io.h"
 #include "kernels/stream_walk_memory.h"
 #include "mesh/mesh.h"
@@ -91,26 +92,12 @@ double physical_memory_bytes() {
     return double(pages) * double(page);
 }
 
-std::string format_bytes(double bytes) {
-    const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
-    int u = 0;
-    while (u < 4 && bytes >= 1024) {
-        bytes /= 1024;
-        ++u;
-    }
-    char buf[64];
-    if (bytes >= 1e6) std::snprintf(buf, sizeof buf, "%.3g %s", bytes, units[u]);
-    else if (u == 0) std::snprintf(buf, sizeof buf, "%.0f %s", bytes, units[u]);
-    else std::snprintf(buf, sizeof buf, "%.1f %s", bytes, units[u]);
-    return buf;
-}
-
 void check_render_memory(const Scene& scene, const RenderSettings& s, bool stream_engine, int threads,
                          double limit_bytes) {
-    if (limit_bytes < 0) limit_bytes = physical_memory_bytes();
-    if (!(limit_bytes > 0)) return;
+    if (limit_bytes == 0) return;
+    const MemoryBudget budget = limit_bytes < 0 ? MemoryBudget::now() : MemoryBudget::of(limit_bytes);
     const MemoryEstimate e = estimate_render_memory(scene, s, stream_engine, threads);
-    if (e.total_bytes <= limit_bytes) return;
+    if (e.total_bytes <= budget.left()) return;
     std::string msg = "image " + std::to_string(s.width) + "x" + std::to_string(s.height) + ", spp " +
                       std::to_string(s.spp) + ", depth " + std::to_string(s.depth) + " would need about " +
                       format_bytes(e.total_bytes) + " of memory (framebuffer " + format_bytes(e.framebuffer_bytes) +
@@ -118,9 +105,9 @@ void check_render_memory(const Scene& scene, const RenderSettings& s, bool strea
                       ", output " + format_bytes(e.output_bytes) + ", " + std::to_string(e.threads) + " thread" +
                       (e.threads > 1 ? "s" : "") + " x " + format_bytes(e.per_thread_bytes) +
                       (stream_engine ? " of ray streams" : " of stack");
-    msg += ") but this machine has " + format_bytes(limit_bytes) +
-           "; lower --width/--height, --spp, --depth or -j";
-    throw UsageError(msg);
+    msg += ") but " + budget.describe() + "; lower --width/--height, --spp, --depth or -j" +
+           (MemoryBudget::limit() > 0 ? ", or raise --memory-limit" : "");
+    throw MemoryShortage(msg);
 }
 
 }  // namespace streamrt

@@ -1,9 +1,10 @@
 #pragma once
 // Limits checked before anything big is allocated: a render whose worst-case memory exceeds
-// the machine's physical memory is refused with a message saying what it would need.
+// the memory budget (core/memory_budget.h) is refused with a message saying what it would need.
 #include <cstdint>
 #include <string>
 
+#include "core/memory_budget.h"  // format_bytes, MemoryShortage
 #include "scene/scene.h"
 
 namespace streamrt {
@@ -36,15 +37,13 @@ inline MemoryEstimate estimate_render_memory(const Scene& scene, bool stream_eng
 /// Physical memory of the machine: sysconf(_SC_PHYS_PAGES) * page size (0 if unknown).
 double physical_memory_bytes();
 
-/// Throws UsageError (one line, what it would need and what there is) when the estimate
-/// exceeds `limit_bytes` (default: physical memory; a limit <= 0 means unknown: no check).
+/// Throws MemoryShortage (one line, what it would need and what there is) when the estimate
+/// exceeds `limit_bytes` (default, -1: the memory budget now, core/memory_budget.h; 0: no check).
 void check_render_memory(const Scene& scene, const RenderSettings& settings, bool stream_engine, int threads,
                          double limit_bytes = -1);
 inline void check_render_memory(const Scene& scene, bool stream_engine, int threads, double limit_bytes = -1) {
     check_render_memory(scene, scene.settings, stream_engine, threads, limit_bytes);
 }
 
-/// "12.0 GiB", "512 KiB", "3.5e+70 GiB".
-std::string format_bytes(double bytes);
 
 }  // namespace streamrt

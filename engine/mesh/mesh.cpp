@@ -9,9 +9,11 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
+#include "core/memory_budget.h"
 #include "core/srgb.h"
 #include "core/vec3.h"
 #include "mesh/mesh_bytes.h"
@@ -25,6 +27,15 @@ std::size_t Mesh::memory_bytes() const {
            block_of.size() * sizeof(std::uint32_t) + index.size() * sizeof(std::uint32_t) +
            vertex_normals.size() * sizeof(float) + corner_uv.size() * sizeof(float) +
            vertex_colors.size() * sizeof(float) + bvh.memory_bytes();
+}
+
+double Mesh::build_bytes(std::size_t vertices, std::size_t triangles, bool uv, bool colors) {
+    // Per vertex: its normal (and colour). Per triangle: the peak of Mesh::build, measured
+    // (docs/performance.md, "Memory per vertex and triangle"): the kept vertex numbers (12),
+    // the hierarchy builder's references (32) and nodes, then the finished arrays.
+    constexpr double kPerTriangle = 120, kPerTriangleUv = 4 + 24;
+    return double(vertices) * 3 * sizeof(float) * (colors ? 2 : 1) +
+           double(triangles) * (kPerTriangle + (uv ? kPerTriangleUv : 0.0));
 }
 
 std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<float>& positions,
@@ -61,33 +72,40 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
     const std::size_t n_tris = kept.size() / 3;
     if (colors.size() == 3 * n_verts) m->vertex_colors = colors;
 
-    // Area-weighted vertex normals (the cross product's length is twice the area). The sums
-    // are freed before the hierarchy is built: on a 10M-triangle mesh they are 120 MB of the
-    // peak (docs/performance.md, "A 10M-triangle mesh").
-    {
-        std::vector<double> acc(3 * n_verts, 0.0);
-        for (std::size_t k = 0; k < n_tris; ++k) {
-            const std::uint32_t* t = &kept[3 * k];
-            const Vec3d n = cross(vertex(t[1]) - vertex(t[0]), vertex(t[2]) - vertex(t[0]));
-            for (int j = 0; j < 3; ++j) {
-                acc[3 * t[j]] += n.x;
-                acc[3 * t[j] + 1] += n.y;
-                acc[3 * t[j] + 2] += n.z;
-            }
+    // Area-weighted vertex normals (the cross product's length is twice the area), summed in
+    // the normals' own floats: no array of double sums (24 bytes a vertex) beside them. Each
+    // face's normal is computed in double and rounded once; a vertex sums a handful of them
+    // (6 on a closed mesh, on average), in file order, so the sum keeps float's precision.
+    // Coordinates far from 1 (beyond 1e10 or below 1e-10) are scaled towards it first, so that
+    // the products stay inside float's range: one factor for the whole mesh keeps the weights.
+    double largest = 0.0;
+    for (const float p : positions) largest = std::max(largest, double(std::fabs(p)));
+    const double scale = largest > 1e10 || (largest < 1e-10 && largest > 0.0) ? 1.0 / largest : 1.0;
+    m->vertex_normals.assign(3 * n_verts, 0.f);
+    for (std::size_t k = 0; k < n_tris; ++k) {
+        const std::uint32_t* t = &kept[3 * k];
+        const Vec3d n = cross((vertex(t[1]) - vertex(t[0])) * scale, (vertex(t[2]) - vertex(t[0])) * scale);
+        for (int j = 0; j < 3; ++j) {
+            float* acc = &m->vertex_normals[3 * std::size_t(t[j])];
+            acc[0] += float(n.x);
+            acc[1] += float(n.y);
+            acc[2] += float(n.z);
         }
-        m->vertex_normals.resize(3 * n_verts);
+    }
+    {
         const bool given = normals.size() == 3 * n_verts;
         for (std::size_t v = 0; v < n_verts; ++v) {
-            Vec3d n{acc[3 * v], acc[3 * v + 1], acc[3 * v + 2]};
+            float* out = &m->vertex_normals[3 * v];
+            Vec3d n{out[0], out[1], out[2]};
             if (given) {
                 const Vec3d g{normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]};
                 if (const double g_len = length(g); g_len > 0.0 && std::isfinite(g_len)) n = g;
             }
             const double len = length(n);
-            n = len > 0.0 ? n * (1.0 / len) : Vec3d{0, 0, 1};
-            m->vertex_normals[3 * v] = float(n.x);
-            m->vertex_normals[3 * v + 1] = float(n.y);
-            m->vertex_normals[3 * v + 2] = float(n.z);
+            n = len > 0.0 && std::isfinite(len) ? n * (1.0 / len) : Vec3d{0, 0, 1};
+            out[0] = float(n.x);
+            out[1] = float(n.y);
+            out[2] = float(n.z);
         }
     }
 
@@ -176,41 +194,48 @@ void append_corner_uv(const ObjData& d, std::size_t first, std::size_t count, st
 
 std::shared_ptr<const Mesh> build_checked(const std::string& path, const std::vector<float>& positions,
                                           const std::vector<std::uint32_t>& tris, const std::vector<float>& corner_uv,
-                                          const std::vector<float>& colors = {}) {
+                                          const std::vector<float>& colors, MemoryBudget& budget) {
     const std::size_t faces = tris.size() / 3;
+    if (faces == 0) throw std::runtime_error("OBJ file has no faces");  // before anything is built
+    budget.need(Mesh::build_bytes(positions.size() / 3, faces, !corner_uv.empty(), colors.size() == positions.size()),
+                "building its " + std::to_string(faces) + " triangles");
     auto mesh = Mesh::build(path, positions, tris, {}, corner_uv, {}, colors);
     if (mesh->triangle_count() == 0)
-        throw std::runtime_error(faces == 0 ? "OBJ file has no faces"
-                                            : "OBJ file has no triangles of non-zero area (" +
-                                                  std::to_string(faces) + " degenerate)");
+        throw std::runtime_error("OBJ file has no triangles of non-zero area (" + std::to_string(faces) + " degenerate)");
     return mesh;
 }
 
 }  // namespace
 
 std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv, bool with_colors) {
-    const MeshBytes file(path);  // mapped, or inflated from a .gz file
-    ObjData d = parse_obj(file.text(), path, {.keep_uv = with_uv, .keep_colors = with_colors});
+    MemoryBudget budget = MemoryBudget::now();  // read as this file's reading starts
+    std::optional<MeshBytes> file(std::in_place, path, budget);  // mapped, or inflated from a .gz file
+    ObjData d = parse_obj(file->text(), path, {.keep_uv = with_uv, .keep_colors = with_colors, .budget = &budget});
     std::vector<float> corner_uv;
     if (with_uv) {
-        if (!d.uv_gaps.empty()) obj_fail_at(file.text(), path, d.uv_gaps.front().offset, kNeedsUv);
+        if (!d.uv_gaps.empty()) obj_fail_at(file->text(), path, d.uv_gaps.front().offset, kNeedsUv);
+        budget.need(double(d.triangle_uv.size()) * 2 * sizeof(float), "its texture coordinates");
         corner_uv.reserve(2 * d.triangle_uv.size());
         append_corner_uv(d, 0, d.triangles.size() / 3, corner_uv);
     }
     if (with_colors) {
         if (d.colorless_offset != std::size_t(-1))
-            obj_fail_at(file.text(), path, d.colorless_offset,
+            obj_fail_at(file->text(), path, d.colorless_offset,
                         "vertex without a colour (v x y z r g b), which vertex_colors=true needs");
         // An OBJ file's colours are display values in [0, 1] (8-bit codes over 255, as the
         // tools that write them store them): decoded from sRGB to linear light, clamped first.
         for (float& c : d.colors) c = float(srgb_eotf(std::clamp(double(c), 0.0, 1.0)));
     }
-    return build_checked(path, d.positions, d.triangles, corner_uv, d.colors);
+    // Every message that quotes the text is said: it is given back before the mesh is built.
+    budget.release(double(file->text().size()));
+    file.reset();
+    return build_checked(path, d.positions, d.triangles, corner_uv, d.colors, budget);
 }
 
 ObjModel load_obj_model(const std::string& path, bool with_uv) {
-    const MeshBytes file(path);  // mapped, or inflated from a .gz file
-    const ObjData d = parse_obj(file.text(), path, {.keep_uv = true});
+    MemoryBudget budget = MemoryBudget::now();  // read as this file's reading starts
+    const MeshBytes file(path, budget);  // mapped, or inflated from a .gz file
+    const ObjData d = parse_obj(file.text(), path, {.keep_uv = true, .budget = &budget});
     ObjModel model;
     // The library (tinyobjloader reads MTL files): the materials in file order, their numbers by name.
     std::map<std::string, int> ids;
@@ -259,6 +284,7 @@ ObjModel load_obj_model(const std::string& path, bool with_uv) {
     };
     std::map<int, Group> groups;
     const std::size_t n_tris = d.triangles.size() / 3;
+    budget.need(double(n_tris) * (3 * sizeof(std::uint32_t) + 6 * sizeof(float)), "grouping its triangles by material");
     for (std::size_t u = 0, first = 0; first < n_tris; ++u) {
         const std::size_t end = u < d.material_uses.size() ? std::min(d.material_uses[u].first_triangle, n_tris) : n_tris;
         if (end > first) {
@@ -271,6 +297,8 @@ ObjModel load_obj_model(const std::string& path, bool with_uv) {
         first = std::max(first, end);
     }
     for (const auto& [key, g] : groups) {
+        budget.need(Mesh::build_bytes(d.positions.size() / 3, g.tris.size() / 3, !g.corner_uv.empty(), false),
+                    "building its " + std::to_string(g.tris.size() / 3) + " triangles of one material");
         auto mesh = Mesh::build(path, d.positions, g.tris, {}, g.corner_uv);
         if (mesh->triangle_count() == 0) continue;  // a group of degenerate faces only
         const int material = key >= 0 && std::size_t(key) < model.materials.size() ? key : -1;

@@ -45,6 +45,10 @@ struct Mesh {
     /// A copy whose kernels switch a packet to single rays at `lanes` active lanes or fewer
     /// (MeshView::single_ray_lanes), for measuring the switch point (perf/mesh_bench.cpp).
     std::shared_ptr<const Mesh> with_single_ray_lanes(std::uint32_t lanes) const;
+    /// About the most build() holds at once beyond its inputs, for a mesh of `vertices` and
+    /// `triangles` (with texture coordinates, with colours): what a reader counts against its
+    /// memory budget before it builds (core/memory_budget.h).
+    static double build_bytes(std::size_t vertices, std::size_t triangles, bool uv, bool colors);
     /// Fills blocks and block_of from tri and the BVH's leaves (mesh_blocks.cpp).
     void build_triangle_blocks();
     /// Points kernel_view at this mesh's arrays.

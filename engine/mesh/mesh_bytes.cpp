@@ -1,11 +1,13 @@
 #include "mesh/mesh_bytes.h"
 
-#include <unistd.h>
+#include <sys/mman.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <cctype>
+#include <new>
 #include <stdexcept>
+#include <utility>
 
 namespace streamrt {
 
@@ -17,13 +19,6 @@ bool ends_with_gz(const std::string& path) {
            std::tolower(static_cast<unsigned char>(path[n - 1])) == 'z';
 }
 
-/// Half this machine's memory: more than that inflated is refused (a scan's text is a few GB
-/// at most; a gzip bomb would otherwise end in the out-of-memory killer).
-std::size_t default_limit() {
-    const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
-    return pages > 0 && page > 0 ? std::size_t(pages) * std::size_t(page) / 2 : std::size_t(1) << 32;
-}
-
 }  // namespace
 
 bool is_gzip_path(const std::string& path) { return ends_with_gz(path); }
@@ -32,21 +27,47 @@ std::string without_gzip_suffix(const std::string& path) {
     return ends_with_gz(path) ? path.substr(0, path.size() - 3) : path;
 }
 
-InflatedBytes inflate_gzip(std::string_view in, std::size_t limit) {
+InflatedBytes& InflatedBytes::operator=(InflatedBytes&& o) noexcept {
+    if (this != &o) {
+        this->~InflatedBytes();
+        data_ = std::exchange(o.data_, nullptr);
+        size_ = std::exchange(o.size_, 0);
+        capacity_ = std::exchange(o.capacity_, 0);
+    }
+    return *this;
+}
+
+InflatedBytes::~InflatedBytes() {
+    if (data_) ::munmap(data_, capacity_);
+    data_ = nullptr;
+}
+
+void InflatedBytes::reserve(std::size_t capacity) {
+    if (capacity <= capacity_) return;
+    void* p = data_ ? ::mremap(data_, capacity_, capacity, MREMAP_MAYMOVE)
+                    : ::mmap(nullptr, capacity, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE,
+                             -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    data_ = static_cast<char*>(p);
+    capacity_ = capacity;
+}
+
+InflatedBytes inflate_gzip(std::string_view in, MemoryBudget& budget) {
     z_stream z{};
     if (inflateInit2(&z, 16 + MAX_WBITS) != Z_OK) throw std::runtime_error("cannot start gzip decompression");
     struct End {
         z_stream& z;
         ~End() { inflateEnd(&z); }
     } end{z};
-    // zlib counts in 32-bit uInt: input and output go in pieces of at most 1 GiB.
-    constexpr std::size_t kPiece = std::size_t(1) << 30;
-    InflatedBytes out(std::min(limit, std::max<std::size_t>(4 * in.size(), std::size_t(1) << 16)));
-    std::size_t used = 0, fed = 0;
+    // zlib counts in 32-bit uInt: input and output go in pieces of at most 1 GiB. Output is
+    // counted against the budget a piece of at most kCounted bytes at a time, before zlib
+    // writes it: past the budget by less than one piece, never by the whole text.
+    constexpr std::size_t kPiece = std::size_t(1) << 30, kCounted = std::size_t(1) << 24;
+    InflatedBytes out;
+    std::size_t used = 0, counted = 0, fed = 0;
     const auto consumed = [&] { return fed - z.avail_in; };  // compressed bytes read so far
-    const auto fail = [&](const std::string& what) {
-        throw std::runtime_error(what + " at byte " + std::to_string(consumed()) + " of the compressed file");
-    };
+    const auto where = [&] { return " at byte " + std::to_string(consumed()) + " of the compressed file"; };
+    const auto fail = [&](const std::string& what) { throw std::runtime_error(what + where()); };
     for (;;) {
         if (z.avail_in == 0 && fed < in.size()) {
             const std::size_t n = std::min(in.size() - fed, kPiece);
@@ -54,12 +75,17 @@ InflatedBytes inflate_gzip(std::string_view in, std::size_t limit) {
             z.avail_in = uInt(n);
             fed += n;
         }
-        if (used == out.size()) {
-            if (out.size() >= limit)
-                fail("gzip data inflates to more than " + std::to_string(limit) + " bytes (half this machine's memory)");
-            out.resize(std::min(limit, 2 * out.size()));
+        if (used == counted) {
+            const double piece = std::min(double(kCounted), budget.left());
+            if (!(piece >= 1))
+                throw MemoryShortage("gzip data inflates past " + budget.describe() + where() +
+                                     "; --memory-limit raises it");
+            budget.need(piece, "inflating");
+            counted += std::size_t(piece);
+            if (counted > out.capacity())
+                out.reserve(std::max(counted, std::min(2 * out.capacity(), counted + kPiece)));
         }
-        const std::size_t room = std::min(out.size() - used, kPiece);
+        const std::size_t room = std::min(counted - used, kPiece);
         z.next_out = reinterpret_cast<Bytef*>(out.data() + used);
         z.avail_out = uInt(room);
         const int rc = inflate(&z, Z_NO_FLUSH);
@@ -78,15 +104,19 @@ InflatedBytes inflate_gzip(std::string_view in, std::size_t limit) {
         // No output room used up and nothing left to read: the stream stops before its end.
         if (z.avail_out != 0 && z.avail_in == 0 && fed == in.size()) fail("gzip data ends early (a truncated file?)");
     }
-    out.resize(used);
+    budget.release(double(counted - used));  // counted ahead, never written
+    out.set_size(used);
     return out;
 }
 
-MeshBytes::MeshBytes(const std::string& path) {
+MeshBytes::MeshBytes(const std::string& path, MemoryBudget& budget) {
     file_.emplace();
     if (!file_->open(path)) throw std::runtime_error("cannot open mesh file");
+    // The mapped text becomes resident as the reader goes through it: it counts.
+    budget.need(double(file_->text().size()), "its text");
     if (is_gzip_path(path)) {
-        inflated_ = inflate_gzip(file_->text(), default_limit());
+        inflated_ = inflate_gzip(file_->text(), budget);
+        budget.release(double(file_->text().size()));
         file_.reset();  // the compressed bytes are no longer needed
     }
 }

@@ -1,6 +1,7 @@
 #include "mesh/obj_reader.h"
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -540,6 +541,12 @@ ObjData parse_obj(std::string_view bytes, const std::string& name, const ObjRead
         totals.v += c.v, totals.vt += c.vt, totals.vn += c.vn;
     }
 
+    MemoryBudget* const budget = options.budget;
+    if (budget)
+        budget->need(double(totals.v) * sizeof(float) * (options.keep_colors ? 6 : 3) +
+                         double(totals.vt) * 2 * sizeof(float),
+                     "its " + count_of(totals.v, kVertex) +
+                         (totals.vt > 0 ? " and " + count_of(totals.vt, kTexcoord) : std::string()));
     ObjData out;
     // Huge pages for the large arrays (some faults instead of thousands), asked for before
     // they are first written.
@@ -552,7 +559,14 @@ ObjData parse_obj(std::string_view bytes, const std::string& name, const ObjRead
     out.texcoords.resize(2 * totals.vt);
     if (options.keep_colors) fresh(out.colors, 3 * totals.v);
     out.normal_count = totals.vn;
+    // The faces' memory is known only once their lines are read: each chunk counts what it
+    // took, and the chunks not started yet are skipped once the budget is passed (past it
+    // by at most a chunk's faces per thread).
+    const double face_room = budget ? budget->left() : 0.0;
+    std::atomic<std::size_t> face_bytes{0};
+    std::atomic<bool> past_budget{false};
     parallel_for_index(chunks.size(), 1, [&](std::size_t k) {
+        if (past_budget.load(std::memory_order_relaxed)) return;
         Chunk& c = chunks[k];
         c.tri.reserve(std::size_t(c.end - c.begin) / 6);  // "f 1 2 3\n" lines of 6-digit numbers, without growing
         if (options.keep_uv) c.tri_uv.reserve(c.tri.capacity());
@@ -562,7 +576,12 @@ ObjData parse_obj(std::string_view bytes, const std::string& name, const ObjRead
             c.error_at = f.at;
             c.error = f.message;
         }
+        const std::size_t took = (c.tri.size() + c.tri_uv.size()) * sizeof(std::uint32_t);
+        if (budget && double(face_bytes.fetch_add(took) + took) > face_room) past_budget.store(true);
     });
+    std::size_t chunk_triangles = 0;
+    for (const Chunk& c : chunks) chunk_triangles += c.tri.size() / 3;
+    if (budget) budget->need(double(face_bytes.load()), "its faces (" + std::to_string(chunk_triangles) + " triangles read so far)");
     for (const Chunk& c : chunks)  // the first error in the file
         if (c.error_at) obj_fail_at(bytes, name, std::size_t(c.error_at - bytes.data()), c.error);
     for (const Chunk& c : chunks)  // the first vertex without a colour in the file
@@ -576,6 +595,10 @@ ObjData parse_obj(std::string_view bytes, const std::string& name, const ObjRead
         c.tri_before = triangles;
         triangles += c.tri.size() / 3;
     }
+    // Copied out of the chunks, which are freed as they go: both are held only chunk by chunk.
+    if (budget)
+        budget->need(double(triangles) * 3 * sizeof(std::uint32_t) * (options.keep_uv ? 2 : 1),
+                     "its " + std::to_string(triangles) + " triangles");
     fresh(out.triangles, 3 * triangles);
     if (options.keep_uv) fresh(out.triangle_uv, 3 * triangles);
     parallel_for_index(chunks.size(), 1, [&](std::size_t k) {
@@ -590,6 +613,7 @@ ObjData parse_obj(std::string_view bytes, const std::string& name, const ObjRead
         for (const auto& [first, n] : c.polygons)
             triangulate(out.positions.data(), tri + 3 * first, uv ? uv + 3 * first : nullptr, n, scratch);
     });
+    if (budget) budget->release(double(face_bytes.load()));
 
     const char* library = nullptr;
     for (const Chunk& c : chunks)

@@ -14,6 +14,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/memory_budget.h"
+
 namespace streamrt {
 
 /// What an OBJ file holds for meshes. `vn` lines are counted (faces may refer to them) but
@@ -53,6 +55,9 @@ struct ObjReadOptions {
     bool keep_colors = false;          ///< fill colors and colorless_offset
     std::size_t chunk_bytes = 1 << 20;  ///< a chunk's size, extended to the next line end (tests: tiny)
     std::size_t max_vertices = 0xffffffffu;  ///< more are refused (vertex numbers are 32-bit)
+    /// What the arrays may take (core/memory_budget.h): counted before they are allocated
+    /// (vertices once counted, faces chunk by chunk as they are read); nullptr: no budget.
+    MemoryBudget* budget = nullptr;
 };
 
 /// Parses the bytes of an OBJ file named `name` (for messages). Throws std::runtime_error with

@@ -397,6 +397,10 @@ void read_body(Body& body, const PlyHeader& h, const PlyReadOptions& options, Pl
             for (int s = 8; s < 11; ++s) colors = colors && std::count(slot.begin(), slot.end(), s) == 1;
             uvs = uvs && options.keep_uv;
             colors = colors && options.keep_colors;
+            if (options.budget)
+                options.budget->need(double(e.count) * sizeof(float) *
+                                         (3 + (normals ? 3 : 0) + (uvs ? 2 : 0) + (colors ? 3 : 0)),
+                                     "its " + std::to_string(e.count) + " vertices");
             out.positions.reserve(3 * std::size_t(e.count));  // bounded by the file's length (parse_header)
             if (normals) out.normals.reserve(3 * std::size_t(e.count));
             if (uvs) out.uvs.reserve(2 * std::size_t(e.count));
@@ -408,6 +412,10 @@ void read_body(Body& body, const PlyHeader& h, const PlyReadOptions& options, Pl
             if (!indices && is_index_list(e, p)) indices = &p;
             if (!texcoords && options.keep_uv && is_texcoord_list(e, p)) texcoords = &p;
         }
+        // A face of n corners is n - 2 triangles: counted as one here, the rest once read.
+        if (face && options.budget)
+            options.budget->need(double(e.count) * (3 * sizeof(std::uint32_t) + (texcoords ? 6 * sizeof(float) : 0)),
+                                 "its " + std::to_string(e.count) + " faces");
         if (face) out.triangles.reserve(3 * std::size_t(e.count));
         if (texcoords) out.corner_uv.reserve(6 * std::size_t(e.count));
         std::vector<std::uint32_t> corners;  // one face's vertex numbers
@@ -496,9 +504,15 @@ PlyData parse_ply(std::string_view bytes, const std::string& name, const PlyRead
 }
 
 std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv, bool with_colors) {
-    const MeshBytes bytes(path);  // mapped, or inflated from a .gz file
-    const PlyData data = parse_ply(bytes.text(), path, {.keep_uv = with_uv, .keep_colors = with_colors});
+    MemoryBudget budget = MemoryBudget::now();  // read as this file's reading starts
+    PlyData data;
+    {
+        const MeshBytes bytes(path, budget);  // mapped, or inflated from a .gz file
+        data = parse_ply(bytes.text(), path, {.keep_uv = with_uv, .keep_colors = with_colors, .budget = &budget});
+        budget.release(double(bytes.text().size()));  // given back before the mesh is built
+    }
     const std::size_t faces = data.triangles.size() / 3;
+    if (faces == 0) throw std::runtime_error("PLY file has no faces");  // before anything is built
     std::vector<float> corner_uv;
     if (with_uv) {
         if (!data.corner_uv.empty()) {
@@ -517,11 +531,11 @@ std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv,
         throw std::runtime_error(
             "vertex_colors=true needs colours at the vertices, and this PLY file has none (vertex properties red "
             "green blue)");
+    budget.need(Mesh::build_bytes(data.positions.size() / 3, faces, !corner_uv.empty(), !data.colors.empty()),
+                "building its " + std::to_string(faces) + " triangles");
     auto mesh = Mesh::build(path, data.positions, data.triangles, {}, corner_uv, data.normals, data.colors);
     if (mesh->triangle_count() == 0)
-        throw std::runtime_error(faces == 0 ? "PLY file has no faces"
-                                            : "PLY file has no triangles of non-zero area (" + std::to_string(faces) +
-                                                  " degenerate)");
+        throw std::runtime_error("PLY file has no triangles of non-zero area (" + std::to_string(faces) + " degenerate)");
     return mesh;
 }
 

@@ -13,6 +13,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/memory_budget.h"
+
 namespace streamrt {
 
 struct Mesh;
@@ -32,6 +34,9 @@ struct PlyData {
 struct PlyReadOptions {
     bool keep_uv = false;      ///< PlyData::uvs and corner_uv
     bool keep_colors = false;  ///< PlyData::colors
+    /// What the arrays may take (core/memory_budget.h): each element's arrays are counted from
+    /// its declared count before they are allocated; nullptr: no budget.
+    MemoryBudget* budget = nullptr;
 };
 
 /// Parses the bytes of a PLY file named `name` (for messages). Throws std::runtime_error

@@ -21,6 +21,8 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/memory_budget.h"
+#include "driver/limits.h"
 #include "driver/render.h"
 #include "driver/render_job.h"
 #include "image/image_compare.h"
@@ -215,16 +217,30 @@ Result make_result(RenderResult&& r, const RenderJob& job, EngineKind engine, do
 }
 
 /// The keyword arguments every call takes, as the command line's overrides.
-RenderOverrides overrides_of(const py::kwargs& kw, bool& profile, py::object& progress) {
+/// memory_limit=: the process's memory budget for one call (core/memory_budget.h), as the
+/// command line's --memory-limit; the one before is back when the call returns.
+struct ScopedMemoryLimit {
+    double before = MemoryBudget::limit();
+    ~ScopedMemoryLimit() { MemoryBudget::set_limit(before); }
+    void set(const py::handle& value) {
+        const double bytes = py::isinstance<py::str>(value) ? parse_memory_size(value.cast<std::string>(), "memory_limit")
+                                                            : value.cast<double>();
+        if (!(bytes >= 1)) throw UsageError("memory_limit: expected a positive size (bytes, or text such as '4G')");
+        MemoryBudget::set_limit(bytes);
+    }
+};
+
+RenderOverrides overrides_of(const py::kwargs& kw, bool& profile, py::object& progress, ScopedMemoryLimit& memory) {
     RenderOverrides o;
     for (const auto& [key, value] : kw) {
         const std::string k = py::str(key);
         if (value.is_none()) continue;
         if (k == "profile") profile = value.cast<bool>();
         else if (k == "progress") progress = py::reinterpret_borrow<py::object>(value);
+        else if (k == "memory_limit") memory.set(value);
         else if (!set_override(o, k, py::str(value).cast<std::string>()))
             throw py::type_error("unexpected keyword argument '" + k + "' (expected one of: " + override_names() +
-                                 ", profile, progress)");
+                                 ", profile, progress, memory_limit)");
     }
     return o;
 }
@@ -254,11 +270,14 @@ std::shared_ptr<const Scene> read_any(const py::object& scene, int threads) {
 Result render(const py::object& scene, const py::kwargs& kw) {
     bool profile = false;
     py::object progress = py::none();
-    const RenderOverrides o = overrides_of(kw, profile, progress);
+    ScopedMemoryLimit memory;
+    const RenderOverrides o = overrides_of(kw, profile, progress, memory);
     const auto start = Clock::now();
     std::shared_ptr<const Scene> sc = read_any(scene, o.threads.value_or(0));
     const double read_seconds = since(start);
     RenderJob job = build_render_job(std::move(sc), o, profile);
+    // Refused before anything big is allocated, as on the command line.
+    check_render_memory(*job.scene, job.render_settings, true, job.threads > 0 ? job.threads : default_jobs());
     RenderResult r = render_watched(job, job.engine, progress);
     return make_result(std::move(r), job, job.engine, read_seconds);
 }
@@ -266,11 +285,14 @@ Result render(const py::object& scene, const py::kwargs& kw) {
 py::dict compare(const py::object& scene, const py::kwargs& kw) {
     bool profile = false;
     py::object progress = py::none();
-    const RenderOverrides o = overrides_of(kw, profile, progress);
+    ScopedMemoryLimit memory;
+    const RenderOverrides o = overrides_of(kw, profile, progress, memory);
     const auto start = Clock::now();
     std::shared_ptr<const Scene> sc = read_any(scene, o.threads.value_or(0));
     const double read_seconds = since(start);
     RenderJob job = build_render_job(std::move(sc), o, profile);
+    // Refused before anything big is allocated, as on the command line.
+    check_render_memory(*job.scene, job.render_settings, true, job.threads > 0 ? job.threads : default_jobs());
     RenderResult stream = render_watched(job, EngineKind::Stream, progress);
     RenderResult recursive = render_watched(job, EngineKind::Recursive, progress);
     const ImageDifference d = compare_images(stream.image, recursive.image);
@@ -320,6 +342,8 @@ PYBIND11_MODULE(streamrt, m) {
             PyErr_SetObject(scene_error.ptr(), err.ptr());
         } catch (const UsageError& e) {
             PyErr_SetString(PyExc_ValueError, e.what());
+        } catch (const MemoryShortage& e) {
+            PyErr_SetString(PyExc_MemoryError, e.what());
         } catch (const RenderError& e) {
             PyErr_SetString(PyExc_RuntimeError, e.what());
         }
@@ -393,7 +417,8 @@ PYBIND11_MODULE(streamrt, m) {
           "render(scene, **overrides) -> Result\n\n"
           "scene: a path to a .cfg file or the text of one. overrides: the command line's\n"
           "(width, height, spp, depth, degree, sampler, cutoff, light_samples, engine, isa, accel,\n"
-          "threads, frame), profile=True for the stream profile, progress=callable(done, total).");
+          "threads, frame), profile=True for the stream profile, progress=callable(done, total),\n"
+          "memory_limit=bytes or '4G' (the command line's --memory-limit; MemoryError past it).");
     m.def("compare", &compare, py::arg("scene"),
           "compare(scene, **overrides) -> dict: both engines' Results ('stream', 'recursive') and\n"
           "their difference ('speedup', 'rmse', 'psnr', 'max_abs', 'share_over').");

@@ -74,8 +74,12 @@ def render(
     time_limit: Optional[float] = ...,
     profile: bool = ...,
     progress: Optional[Callable[[int, int], None]] = ...,
+    memory_limit: Optional[int | str] = ...,
 ) -> Result:
-    """Renders a scene (a .cfg path or its text) with the command line's overrides."""
+    """Renders a scene (a .cfg path or its text) with the command line's overrides.
+
+    memory_limit: the most memory the process may hold during the call (bytes, or '4G'),
+    as --memory-limit; MemoryError when reading or rendering would need more."""
 
 def compare(scene: str | Scene, **overrides: Any) -> dict[str, Any]:
     """Both engines: 'stream' and 'recursive' Results, 'speedup', 'rmse', 'psnr', 'max_abs', 'share_over'."""

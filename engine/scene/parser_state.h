@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/memory_budget.h"
 #include "mesh/mesh.h"
 #include "scene/file_text.h"
 #include "scene/parser.h"
@@ -222,6 +223,11 @@ class Parser {
             list.push_back(std::move(item));
             known.emplace(id, index);
             return index;
+        } catch (const MemoryShortage& e) {
+            // Not a mistake in the scene (exit status 1), but said at the same place.
+            SourceLoc at = st.where();
+            at.column = col;
+            throw MemoryShortage(at.str() + ": " + quote(target.string()) + ": " + e.what());
         } catch (const std::exception& e) {
             st.fail(col, quote(target.string()) + ": " + e.what());
         }

@@ -120,10 +120,16 @@ TEST_CASE("cli: a render that cannot fit in memory is refused before it starts")
                                    "image width=64 height=64 depth=256 degree=5 spp=65536\n"
                                    "material glass refl=0.5 trans=0.5 ior=1.5\nsphere material=glass\n");
     const Run r = run_streamrt(q(scene) + " -j 64 -o " + q(d.path / "deep.png"));
-    CHECK(r.code == 2);
+    CHECK(r.code == 1);  // a shortage of memory, not a mistake in the scene
     check_one_line_error(r, "would need about");
     CHECK(r.err.find("64 threads x") != std::string::npos);
-    CHECK(r.err.find("but this machine has") != std::string::npos);
+    CHECK(r.err.find("but the memory budget of ") != std::string::npos);
+    CHECK(r.err.find("(the available memory less a margin)") != std::string::npos);
+    // With --memory-limit the budget is the limit less what the process holds.
+    const Run limited = run_streamrt(q(scene) + " -j 2 --spp 4 --memory-limit 1M -o " + q(d.path / "deep.png"));
+    CHECK(limited.code == 1);
+    check_one_line_error(limited, "(--memory-limit 1.0 MiB less what the process held before)");
+    CHECK(!fs::exists(d.path / "deep.png"));
     CHECK(!fs::exists(d.path / "deep.png"));
     // The same scene is fine for the recursive engine (its memory is its stack)...
     const Run rec = run_streamrt("--check --engine recursive -j 64 " + q(scene) + " -o " + q(d.path / "deep.png"));

@@ -78,8 +78,8 @@ inline std::string check_scene(const Scene& sc) {
         if (!(est.total_bytes >= est.framebuffer_bytes) || !(est.framebuffer_bytes > 0)) return "memory estimate";
         try {
             check_render_memory(sc, stream == 1, 2);
-        } catch (const UsageError& e) {
-            if (std::string(e.what()).find('\n') != std::string::npos) return "multi-line usage error";
+        } catch (const MemoryShortage& e) {
+            if (std::string(e.what()).find('\n') != std::string::npos) return "multi-line memory error";
         }
     }
     return "";

@@ -173,12 +173,12 @@ TEST_CASE("limits: a render above the limit is refused with what it would need")
     CHECK_NOTHROW(check_render_memory(sc, true, 2, 24.0 * 1024 * 1024 * 1024));
     try {
         check_render_memory(sc, true, 2, 8.0 * 1024 * 1024 * 1024);
-        FAIL("expected a UsageError");
-    } catch (const UsageError& e) {
+        FAIL("expected a MemoryShortage");
+    } catch (const MemoryShortage& e) {
         const std::string m = e.what();
         CHECK(m.find("image 32768x32768, spp 1, depth 5 would need about 12.0 GiB of memory") == 0);
         CHECK(m.find("framebuffer 12.0 GiB") != std::string::npos);
-        CHECK(m.find("but this machine has 8.0 GiB") != std::string::npos);
+        CHECK(m.find("but the memory budget of 8.0 GiB;") != std::string::npos);
         CHECK(m.find('\n') == std::string::npos);
     }
     // Refused before bounded-depth tracing (2^depth estimate: "about 28.4 GiB" for depth 14 at
@@ -198,8 +198,8 @@ TEST_CASE("limits: a render above the limit is refused with what it would need")
     CHECK(huge.total_bytes > 64.0 * 1024 * 1024 * 1024);
     try {
         check_render_memory(deep, true, 64, 24.0 * 1024 * 1024 * 1024);
-        FAIL("expected a UsageError");
-    } catch (const UsageError& e) {
+        FAIL("expected a MemoryShortage");
+    } catch (const MemoryShortage& e) {
         const std::string m = e.what();
         CHECK(m.find("spp 65536, depth 256 would need about") != std::string::npos);
         CHECK(m.find("64 threads x") != std::string::npos);

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdio>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -15,10 +16,12 @@
 namespace streamrt::test {
 
 /// Peak resident memory (KiB, VmHWM) of one `streamrt` run with these arguments, which must
-/// succeed; -1 where this process may not trace its children. Read when the child is about
-/// to exit (ptrace's exit stop, its memory still mapped): wait4's ru_maxrss would not do,
-/// Linux carries the parent's peak across the exec.
-inline long child_peak_rss_kib(const std::vector<std::string>& args) {
+/// succeed (or, given `exit_code`, whose status is stored there); -1 where this process may
+/// not trace its children. Read when the child is about to exit (ptrace's exit stop, its
+/// memory still mapped): wait4's ru_maxrss would not do, Linux carries the parent's peak
+/// across the exec. The child's stderr goes to `stderr_path` when given.
+inline long child_peak_rss_kib(const std::vector<std::string>& args, int* exit_code = nullptr,
+                               const std::string& stderr_path = "") {
     std::vector<char*> argv{const_cast<char*>(STREAMRT_BINARY)};
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
@@ -26,6 +29,7 @@ inline long child_peak_rss_kib(const std::vector<std::string>& args) {
     REQUIRE(pid >= 0);
     if (pid == 0) {
         if (::ptrace(PTRACE_TRACEME, 0, nullptr, nullptr) != 0) ::_exit(126);  // not allowed here
+        if (!stderr_path.empty() && !std::freopen(stderr_path.c_str(), "w", stderr)) ::_exit(125);
         ::execv(STREAMRT_BINARY, argv.data());
         ::_exit(127);
     }
@@ -50,7 +54,8 @@ inline long child_peak_rss_kib(const std::vector<std::string>& args) {
         }
     }
     REQUIRE(WIFEXITED(status));
-    REQUIRE(WEXITSTATUS(status) == 0);
+    if (exit_code) *exit_code = WEXITSTATUS(status);
+    else REQUIRE(WEXITSTATUS(status) == 0);
     REQUIRE(peak > 0);
     return peak;
 }
