@@ -65,13 +65,13 @@ int main(int argc, char** argv) {
                 d.positions.size() / 3, gen);
     std::printf("build (boxes, SAH BVH, leaf-order copy, normals): %.2f s; %zu wide nodes\n", build,
                 mesh->bvh.stats.wide_nodes);
-    const double tri = double(mesh->tri.size() * sizeof(float)), idx = double(mesh->index.size() * 4),
+    const double vertices_b = double(mesh->positions.size() * sizeof(float)), idx = double(mesh->index.size() * 4),
                  nrm = double(mesh->vertex_normals.size() * sizeof(float)),
                  nodes = double(mesh->bvh.memory_bytes()),
                  blocks = double(mesh->blocks.size() * sizeof(TriangleBlock) + mesh->block_of.size() * 4);
-    std::printf("memory: %.1f bytes/triangle (vertices in leaf order %.1f, vertex indices %.1f, vertex normals %.1f, "
+    std::printf("memory: %.1f bytes/triangle (vertex positions %.1f, vertex numbers %.1f, vertex normals %.1f, "
                 "BVH nodes %.1f, triangle blocks and their map %.1f)\n",
-                double(mesh->memory_bytes()) / n, tri / n, idx / n, nrm / n, nodes / n, blocks / n);
+                double(mesh->memory_bytes()) / n, vertices_b / n, idx / n, nrm / n, nodes / n, blocks / n);
 
     Object sphere;
     sphere.kind = ShapeKind::Sphere;

@@ -108,7 +108,8 @@ inline Streams make_streams(const Mesh& mesh, const KernelTable& kt, const Objec
         const Vec3f o{s.primary.ox[i], s.primary.oy[i], s.primary.oz[i]}, d{s.primary.dx[i], s.primary.dy[i],
                                                                                 s.primary.dz[i]};
         const Vec3f p = o + t[i] * d;
-        const float* q = &mesh.tri[9 * std::size_t(prim[i])];
+        const std::array<float, 9> hit = mesh.triangle(std::size_t(prim[i]));
+        const float* q = hit.data();
         Vec3f n = normalize(cross(Vec3f{q[3] - q[0], q[4] - q[1], q[5] - q[2]}, Vec3f{q[6] - q[0], q[7] - q[1], q[8] - q[2]}));
         if (dot(n, d) > 0) n = -n;
         const Vec3f out = p + 1e-4f * n, in = p - 1e-4f * n;

@@ -97,7 +97,8 @@ Stream reflect_inside(const Mesh& mesh, const Stream& in, const KernelTable& kt,
     for (std::size_t i = 0; i < in.count; ++i) {
         if (id[i] != 0) continue;
         const Vec3f o{in.ox[i], in.oy[i], in.oz[i]}, d{in.dx[i], in.dy[i], in.dz[i]};
-        const float* q = &mesh.tri[9 * std::size_t(prim[i])];
+        const std::array<float, 9> hit = mesh.triangle(std::size_t(prim[i]));
+        const float* q = hit.data();
         Vec3f n = normalize(cross(Vec3f{q[3] - q[0], q[4] - q[1], q[5] - q[2]}, Vec3f{q[6] - q[0], q[7] - q[1], q[8] - q[2]}));
         if (dot(n, d) > 0) n = -n;
         out.add(o + t[i] * d + 1e-4f * n, d - 2.f * dot(d, n) * n, 1e30f);

@@ -50,11 +50,13 @@ struct PacketLanes {
 /// Starts loading child j of node n, met by the lanes `bits` of a packet walk on a mesh larger
 /// than the caches (MeshView::prefetched): the first 4 lines at its address (an inner node's
 /// 256 bytes, or a leaf's first triangles, 36 bytes each, in leaf order), or for a child no lane
-/// met, `cached` (lines in the cache already). A select rather than a branch on the box test:
+/// met, `cached` (lines in the cache already). A leaf's first line is its triangles' vertex
+/// numbers (12 bytes each, leaf order; their positions follow from them, so cannot be fetched
+/// ahead here). A select rather than a branch on the box test:
 /// on a tree that does not fit the cache a mispredicted branch waits on the node's load.
 inline void prefetch_met_child(const MeshView& m, const accel::WideNode& n, int j, std::uint32_t bits,
                                const void* cached) {
-    const void* child = n.count[j] > 0 ? static_cast<const void*>(m.tri + 9 * std::size_t(n.child[j]))
+    const void* child = n.count[j] > 0 ? static_cast<const void*>(m.index + 3 * std::size_t(n.child[j]))
                                        : static_cast<const void*>(m.nodes + n.child[j]);
     simd::prefetch_lines(bits != 0 ? child : cached, sizeof(accel::WideNode));
 }
@@ -84,7 +86,7 @@ inline auto robust_box(const accel::WideNode& n, int j, const Vec3T<B>& o, const
 
 template <class B>
 inline Vec3T<B> vertex(const MeshView& m, std::uint32_t k, int j) {
-    const float* p = m.tri + 9 * std::size_t(k) + 3 * j;
+    const float* p = triangle_corner(m, k, j);
     return {B(p[0]), B(p[1]), B(p[2])};
 }
 
@@ -116,7 +118,7 @@ struct SharedAxesTriangles {
         o_perm = {oc[axes[0]], oc[axes[1]], oc[axes[2]]};
     }
     Vec3T<B> corner(const MeshView& m, std::uint32_t k, int j) const {
-        const float* p = m.tri + 9 * std::size_t(k) + 3 * j;
+        const float* p = triangle_corner(m, k, j);
         return {B(p[axis[0]]) - o_perm.x, B(p[axis[1]]) - o_perm.y, B(p[axis[2]]) - o_perm.z};
     }
     tri_detail::Sheared<B> sheared(const WatertightRay<B>& wr, const MeshView& m, std::uint32_t k) const {
@@ -164,7 +166,7 @@ struct LanePermutedTriangles<B> {
                                               idx));
     }
     Vec3T<B> corner(const MeshView& m, std::uint32_t k, int j) const {
-        const float* p = m.tri + 9 * std::size_t(k) + 3 * j;
+        const float* p = triangle_corner(m, k, j);
         return {permute(index[0], p) - o_perm.x, permute(index[1], p) - o_perm.y, permute(index[2], p) - o_perm.z};
     }
     tri_detail::Sheared<B> sheared(const WatertightRay<B>& wr, const MeshView& m, std::uint32_t k) const {

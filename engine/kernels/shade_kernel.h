@@ -82,9 +82,9 @@ inline Vec3T<B> mesh_normals(const ShadeJob& job, std::size_t i) {
         const std::size_t ray = std::size_t(job.order[i + l]);
         const std::size_t k = std::size_t(job.prim[ray]);
         if (ob.param == 0.f) {  // flat
-            const float* p = m.tri + 9 * k;
-            const float e1x = p[3] - p[0], e1y = p[4] - p[1], e1z = p[5] - p[2];
-            const float e2x = p[6] - p[0], e2y = p[7] - p[1], e2z = p[8] - p[2];
+            const float *p = triangle_corner(m, k, 0), *p1 = triangle_corner(m, k, 1), *p2 = triangle_corner(m, k, 2);
+            const float e1x = p1[0] - p[0], e1y = p1[1] - p[1], e1z = p1[2] - p[2];
+            const float e2x = p2[0] - p[0], e2y = p2[1] - p[1], e2z = p2[2] - p[2];
             nx[l] = e1y * e2z - e1z * e2y;
             ny[l] = e1z * e2x - e1x * e2z;
             nz[l] = e1x * e2y - e1y * e2x;
@@ -124,7 +124,7 @@ inline Vec3T<B> terminator_shifts(const ShadeJob& job, std::size_t i, const Rows
         const std::size_t ray = std::size_t(job.order[i + l]);
         const std::size_t k = std::size_t(job.prim[ray]);
         for (int j = 0; j < 3; ++j) {
-            const float* p = m.tri + 9 * k + 3 * std::size_t(j);
+            const float* p = triangle_corner(m, k, j);
             const float* n = m.vertex_normals + 3 * std::size_t(m.index[3 * k + std::size_t(j)]);
             for (int a = 0; a < 3; ++a) {
                 corner[0][j][a][l] = p[a];

@@ -23,54 +23,98 @@
 namespace streamrt {
 
 std::size_t Mesh::memory_bytes() const {
-    return tri.size() * sizeof(float) + blocks.size() * sizeof(TriangleBlock) +
+    return positions.size() * sizeof(float) + blocks.size() * sizeof(TriangleBlock) +
            block_of.size() * sizeof(std::uint32_t) + index.size() * sizeof(std::uint32_t) +
            vertex_normals.size() * sizeof(float) + corner_uv.size() * sizeof(float) +
            vertex_colors.size() * sizeof(float) + bvh.memory_bytes();
 }
 
 double Mesh::build_bytes(std::size_t vertices, std::size_t triangles, bool uv, bool colors) {
-    // Per vertex: its normal (and colour). Per triangle: the peak of Mesh::build, measured
+    // Per vertex: its normal, its renumbering (4) and the kept positions when they are copied
+    // (and its colour, copied too). Per triangle: the peak of Mesh::build above that, measured
     // (docs/performance.md, "Memory per vertex and triangle"): the kept vertex numbers (12),
     // the hierarchy builder's references (32) and nodes, then the finished arrays.
-    constexpr double kPerTriangle = 120, kPerTriangleUv = 4 + 24;
-    return double(vertices) * 3 * sizeof(float) * (colors ? 2 : 1) +
+    constexpr double kPerVertex = 2 * 3 * sizeof(float) + sizeof(std::uint32_t);
+    constexpr double kPerTriangle = 104, kPerTriangleUv = 4 + 24;
+    return double(vertices) * (kPerVertex + (colors ? 2 * 3 * sizeof(float) : 0.0)) +
            double(triangles) * (kPerTriangle + (uv ? kPerTriangleUv : 0.0));
 }
 
-std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<float>& positions,
-                                        const std::vector<std::uint32_t>& triangles,
-                                        const accel::BuildOptions& options,
-                                        const std::vector<float>& corner_uv,
-                                        const std::vector<float>& normals,
-                                        const std::vector<float>& colors) {
+std::shared_ptr<const Mesh> Mesh::build_from(std::string name, const std::vector<float>& positions,
+                                             std::vector<float>* own_positions,
+                                             const std::vector<std::uint32_t>& triangles,
+                                             std::vector<std::uint32_t>* own_triangles,
+                                             const accel::BuildOptions& options,
+                                             const std::vector<float>& corner_uv,
+                                             const std::vector<float>& normals,
+                                             const std::vector<float>& colors) {
     auto m = std::make_shared<Mesh>();
     m->name = std::move(name);
-    const std::size_t n_verts = positions.size() / 3;
-    const auto vertex = [&](std::uint32_t v) {
+    const std::size_t input_verts = positions.size() / 3;
+    const auto input_vertex = [&](std::uint32_t v) {
         return Vec3d{positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]};
     };
     // Keep the triangles with three distinct, valid vertices and a non-zero area (in double:
-    // the cross product of float differences is nearly exact).
+    // the cross product of float differences is nearly exact), written over the triangles' own
+    // array when the caller gave it up (a kept triangle never lands after where it was read).
+    const std::size_t input_tris = triangles.size() / 3;
     std::vector<std::uint32_t> kept;
+    if (own_triangles) kept = std::move(*own_triangles);  // `triangles` is empty from here on
+    else kept.assign(triangles.begin(), triangles.begin() + std::ptrdiff_t(3 * input_tris));
     std::vector<std::uint32_t> kept_from;  // the input triangle of each kept one (texture coordinates)
-    kept.reserve(triangles.size());
-    for (std::size_t k = 0; k + 2 < triangles.size(); k += 3) {
-        const std::uint32_t a = triangles[k], b = triangles[k + 1], c = triangles[k + 2];
-        bool ok = a < n_verts && b < n_verts && c < n_verts && a != b && b != c && a != c;
+    std::size_t n_kept = 0;
+    for (std::size_t k = 0; k < input_tris; ++k) {
+        const std::uint32_t a = kept[3 * k], b = kept[3 * k + 1], c = kept[3 * k + 2];
+        bool ok = a < input_verts && b < input_verts && c < input_verts && a != b && b != c && a != c;
         if (ok) {
-            const Vec3d n = cross(vertex(b) - vertex(a), vertex(c) - vertex(a));
+            const Vec3d n = cross(input_vertex(b) - input_vertex(a), input_vertex(c) - input_vertex(a));
             ok = dot(n, n) > 0.0 && std::isfinite(dot(n, n));
         }
         if (ok) {
-            kept.insert(kept.end(), {a, b, c});
-            if (!corner_uv.empty()) kept_from.push_back(std::uint32_t(k / 3));
+            kept[3 * n_kept] = a;
+            kept[3 * n_kept + 1] = b;
+            kept[3 * n_kept + 2] = c;
+            ++n_kept;
+            if (!corner_uv.empty()) kept_from.push_back(std::uint32_t(k));
         } else {
             ++m->dropped;
         }
     }
-    const std::size_t n_tris = kept.size() / 3;
-    if (colors.size() == 3 * n_verts) m->vertex_colors = colors;
+    kept.resize(3 * n_kept);
+    const std::size_t n_tris = n_kept;
+
+    // Keep the vertices the kept triangles use, renumbered in increasing order: a mesh read
+    // with vertices it never uses (an OBJ group of a larger model) does not hold them.
+    std::vector<float> given_normals;
+    {
+        constexpr std::uint32_t kUnused = ~std::uint32_t(0);
+        std::vector<std::uint32_t> renumber(input_verts, kUnused);
+        for (const std::uint32_t v : kept) renumber[v] = 0;
+        std::uint32_t used = 0;
+        for (std::uint32_t& r : renumber)
+            if (r != kUnused) r = used++;
+        const bool all_used = used == input_verts;
+        const auto compact = [&](const std::vector<float>& per_vertex) {
+            if (all_used) return per_vertex;
+            std::vector<float> out;
+            out.reserve(3 * std::size_t(used));
+            for (std::size_t v = 0; v < input_verts; ++v)
+                if (renumber[v] != kUnused) out.insert(out.end(), &per_vertex[3 * v], &per_vertex[3 * v + 3]);
+            return out;
+        };
+        if (all_used && own_positions) m->positions = std::move(*own_positions);
+        else m->positions = compact(positions);
+        if (colors.size() == 3 * input_verts) m->vertex_colors = compact(colors);
+        if (normals.size() == 3 * input_verts) given_normals = compact(normals);
+        if (!all_used)
+            for (std::uint32_t& v : kept) v = renumber[v];
+    }
+    // From here on, vertex numbers are the mesh's own.
+    const std::size_t n_verts = m->positions.size() / 3;
+    const std::vector<float>& kept_positions = m->positions;
+    const auto vertex = [&](std::uint32_t v) {
+        return Vec3d{kept_positions[3 * v], kept_positions[3 * v + 1], kept_positions[3 * v + 2]};
+    };
 
     // Area-weighted vertex normals (the cross product's length is twice the area), summed in
     // the normals' own floats: no array of double sums (24 bytes a vertex) beside them. Each
@@ -79,7 +123,7 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
     // Coordinates far from 1 (beyond 1e10 or below 1e-10) are scaled towards it first, so that
     // the products stay inside float's range: one factor for the whole mesh keeps the weights.
     double largest = 0.0;
-    for (const float p : positions) largest = std::max(largest, double(std::fabs(p)));
+    for (const float p : kept_positions) largest = std::max(largest, double(std::fabs(p)));
     const double scale = largest > 1e10 || (largest < 1e-10 && largest > 0.0) ? 1.0 / largest : 1.0;
     m->vertex_normals.assign(3 * n_verts, 0.f);
     for (std::size_t k = 0; k < n_tris; ++k) {
@@ -93,12 +137,12 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
         }
     }
     {
-        const bool given = normals.size() == 3 * n_verts;
+        const bool given = !given_normals.empty();
         for (std::size_t v = 0; v < n_verts; ++v) {
             float* out = &m->vertex_normals[3 * v];
             Vec3d n{out[0], out[1], out[2]};
             if (given) {
-                const Vec3d g{normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]};
+                const Vec3d g{given_normals[3 * v], given_normals[3 * v + 1], given_normals[3 * v + 2]};
                 if (const double g_len = length(g); g_len > 0.0 && std::isfinite(g_len)) n = g;
             }
             const double len = length(n);
@@ -108,6 +152,7 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
             out[2] = float(n.z);
         }
     }
+    std::vector<float>().swap(given_normals);
 
     // The hierarchy over the triangles' boxes (padded outwards, accel::conservative_box),
     // made as the builder reads them: no array of boxes (24 bytes a triangle) to fill and free.
@@ -116,9 +161,9 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
         [&](std::size_t k) {
             double lo[3], hi[3];
             for (int a = 0; a < 3; ++a) {
-                lo[a] = hi[a] = positions[3 * kept[3 * k] + a];
+                lo[a] = hi[a] = kept_positions[3 * kept[3 * k] + a];
                 for (int j = 1; j < 3; ++j) {
-                    const double p = positions[3 * kept[3 * k + j] + a];
+                    const double p = kept_positions[3 * kept[3 * k + j] + a];
                     lo[a] = std::min(lo[a], p);
                     hi[a] = std::max(hi[a], p);
                 }
@@ -127,16 +172,11 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
         },
         options);
 
-    // Store the triangles in leaf order, so leaves address them directly.
-    m->tri.resize(9 * n_tris);
+    // Store the triangles' vertex numbers in leaf order, so leaves address them directly.
     m->index.resize(3 * n_tris);
     parallel_for_index(n_tris, 16384, [&](std::size_t k) {
         const std::uint32_t src = m->bvh.prim_index[k];
-        for (int j = 0; j < 3; ++j) {
-            const std::uint32_t v = kept[3 * src + j];
-            m->index[3 * k + j] = v;
-            for (int a = 0; a < 3; ++a) m->tri[9 * k + 3 * j + a] = positions[3 * v + a];
-        }
+        for (int j = 0; j < 3; ++j) m->index[3 * k + j] = kept[3 * src + j];
     });
     std::vector<std::uint32_t>().swap(kept);  // in m->index now: freed before the blocks are made
     if (!corner_uv.empty()) {
@@ -160,11 +200,11 @@ std::shared_ptr<const Mesh> Mesh::build(std::string name, const std::vector<floa
         m->lo[a] = n_tris ? std::numeric_limits<double>::infinity() : 0.0;
         m->hi[a] = n_tris ? -std::numeric_limits<double>::infinity() : 0.0;
     }
-    for (std::size_t k = 0; k < 3 * n_tris; ++k)
-        for (int a = 0; a < 3; ++a) {
-            m->lo[a] = std::min(m->lo[a], double(m->tri[3 * k + a]));
-            m->hi[a] = std::max(m->hi[a], double(m->tri[3 * k + a]));
-        }
+    for (std::size_t k = 0; k < kept_positions.size(); ++k) {  // every kept vertex is a corner
+        const std::size_t a = k % 3;
+        m->lo[a] = std::min(m->lo[a], double(kept_positions[k]));
+        m->hi[a] = std::max(m->hi[a], double(kept_positions[k]));
+    }
     m->build_triangle_blocks();
     m->set_view(kDefaultSingleRayLanes);
     return m;
@@ -192,14 +232,14 @@ void append_corner_uv(const ObjData& d, std::size_t first, std::size_t count, st
     }
 }
 
-std::shared_ptr<const Mesh> build_checked(const std::string& path, const std::vector<float>& positions,
-                                          const std::vector<std::uint32_t>& tris, const std::vector<float>& corner_uv,
+std::shared_ptr<const Mesh> build_checked(const std::string& path, std::vector<float>&& positions,
+                                          std::vector<std::uint32_t>&& tris, const std::vector<float>& corner_uv,
                                           const std::vector<float>& colors, MemoryBudget& budget) {
     const std::size_t faces = tris.size() / 3;
     if (faces == 0) throw std::runtime_error("OBJ file has no faces");  // before anything is built
     budget.need(Mesh::build_bytes(positions.size() / 3, faces, !corner_uv.empty(), colors.size() == positions.size()),
                 "building its " + std::to_string(faces) + " triangles");
-    auto mesh = Mesh::build(path, positions, tris, {}, corner_uv, {}, colors);
+    auto mesh = Mesh::build(path, std::move(positions), std::move(tris), {}, corner_uv, {}, colors);
     if (mesh->triangle_count() == 0)
         throw std::runtime_error("OBJ file has no triangles of non-zero area (" + std::to_string(faces) + " degenerate)");
     return mesh;
@@ -229,7 +269,7 @@ std::shared_ptr<const Mesh> load_obj_mesh(const std::string& path, bool with_uv,
     // Every message that quotes the text is said: it is given back before the mesh is built.
     budget.release(double(file->text().size()));
     file.reset();
-    return build_checked(path, d.positions, d.triangles, corner_uv, d.colors, budget);
+    return build_checked(path, std::move(d.positions), std::move(d.triangles), corner_uv, d.colors, budget);
 }
 
 ObjModel load_obj_model(const std::string& path, bool with_uv) {

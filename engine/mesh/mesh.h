@@ -3,6 +3,7 @@
 // coordinates, which are the canonical space of every object that uses it (placed by Md like
 // the canonical shapes). Each mesh has its own BVH (accel::Bvh over the triangle boxes) and
 // is stored once however many objects use it: the scene hierarchy holds instances.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -25,8 +26,8 @@ inline constexpr std::uint32_t kDefaultSingleRayLanes = 0;
 
 struct Mesh {
     std::string name;                   ///< the file it came from, for messages
-    simd::AlignedVec<float> tri;        ///< 9 per triangle, leaf order
-    std::vector<std::uint32_t> index;   ///< 3 per triangle, leaf order
+    std::vector<float> positions;       ///< 3 per vertex the triangles use (MeshView::positions)
+    std::vector<std::uint32_t> index;   ///< 3 vertex numbers per triangle, leaf order
     std::vector<float> vertex_normals;  ///< 3 per vertex
     std::vector<float> corner_uv;       ///< 6 per triangle (MeshView::uv), leaf order; empty: none
     std::vector<float> vertex_colors;   ///< 3 per vertex (MeshView::vertex_colors); empty: none
@@ -39,8 +40,17 @@ struct Mesh {
     MeshView kernel_view{};             ///< pointers into the above, set once built (stable: the mesh is immutable)
 
     std::size_t triangle_count() const { return index.size() / 3; }
+    /// Corner j (0 - 2) of triangle k (leaf order): 3 floats.
+    const float* corner(std::size_t k, int j) const { return &positions[3 * std::size_t(index[3 * k + std::size_t(j)])]; }
+    /// Triangle k's corners p0, p1, p2 as 9 floats (tests and benchmarks).
+    std::array<float, 9> triangle(std::size_t k) const {
+        std::array<float, 9> t;
+        for (int j = 0; j < 3; ++j)
+            for (int a = 0; a < 3; ++a) t[std::size_t(3 * j + a)] = corner(k, j)[a];
+        return t;
+    }
     const MeshView& view() const { return kernel_view; }
-    /// Bytes held by the mesh (triangles, triangle blocks, indices, normals, BVH nodes).
+    /// Bytes held by the mesh (positions, vertex numbers, triangle blocks, normals, BVH nodes).
     std::size_t memory_bytes() const;
     /// A copy whose kernels switch a packet to single rays at `lanes` active lanes or fewer
     /// (MeshView::single_ray_lanes), for measuring the switch point (perf/mesh_bench.cpp).
@@ -49,7 +59,7 @@ struct Mesh {
     /// `triangles` (with texture coordinates, with colours): what a reader counts against its
     /// memory budget before it builds (core/memory_budget.h).
     static double build_bytes(std::size_t vertices, std::size_t triangles, bool uv, bool colors);
-    /// Fills blocks and block_of from tri and the BVH's leaves (mesh_blocks.cpp).
+    /// Fills blocks and block_of from the triangles and the BVH's leaves (mesh_blocks.cpp).
     void build_triangle_blocks();
     /// Points kernel_view at this mesh's arrays.
     void set_view(std::uint32_t single_ray_lanes);
@@ -62,12 +72,38 @@ struct Mesh {
     /// vertex (a PLY file's nx ny nz), gives the vertex normals (normalised; a zero or
     /// non-finite one is replaced by the computed one); otherwise they are area-weighted.
     /// `colors`, when it holds 3 floats per vertex, gives the vertex colours (linear RGB).
+    /// The mesh keeps only the vertices its triangles use, renumbered in their order. Given its
+    /// arrays by rvalue, it takes the positions over when it uses every vertex (no copy) and
+    /// sorts out the triangles in their own array (a build needs 12 bytes a triangle less).
     static std::shared_ptr<const Mesh> build(std::string name, const std::vector<float>& positions,
                                              const std::vector<std::uint32_t>& triangles,
                                              const accel::BuildOptions& options = {},
                                              const std::vector<float>& corner_uv = {},
                                              const std::vector<float>& normals = {},
-                                             const std::vector<float>& colors = {});
+                                             const std::vector<float>& colors = {}) {
+        return build_from(std::move(name), positions, nullptr, triangles, nullptr, options, corner_uv, normals, colors);
+    }
+    static std::shared_ptr<const Mesh> build(std::string name, std::vector<float>&& positions,
+                                             std::vector<std::uint32_t>&& triangles,
+                                             const accel::BuildOptions& options = {},
+                                             const std::vector<float>& corner_uv = {},
+                                             const std::vector<float>& normals = {},
+                                             const std::vector<float>& colors = {}) {
+        return build_from(std::move(name), positions, &positions, triangles, &triangles, options, corner_uv, normals,
+                          colors);
+    }
+
+private:
+    /// build's body; `own_positions` and `own_triangles`, when not null, are `positions` and
+    /// `triangles`, which it may then move from.
+    static std::shared_ptr<const Mesh> build_from(std::string name, const std::vector<float>& positions,
+                                                  std::vector<float>* own_positions,
+                                                  const std::vector<std::uint32_t>& triangles,
+                                                  std::vector<std::uint32_t>* own_triangles,
+                                                  const accel::BuildOptions& options,
+                                                  const std::vector<float>& corner_uv,
+                                                  const std::vector<float>& normals,
+                                                  const std::vector<float>& colors);
 };
 
 /// Reads a Wavefront OBJ file (mesh/obj_reader.h; polygons are triangulated, materials and

@@ -47,18 +47,19 @@ void Mesh::build_triangle_blocks() {
                 const bool real = k + std::uint32_t(lane) < count;
                 for (int c = 0; c < 3; ++c)
                     for (int a = 0; a < 3; ++a)
-                        b.corner[c][a][lane] = real ? tri[9 * std::size_t(t) + 3 * c + a]
-                                                    : std::numeric_limits<float>::quiet_NaN();
+                        b.corner[c][a][lane] = real ? corner(t, c)[a] : std::numeric_limits<float>::quiet_NaN();
             }
         }
     });
 }
 
 void Mesh::set_view(std::uint32_t single_ray_lanes) {
-    kernel_view = {bvh.nodes.empty() ? nullptr : bvh.nodes.data(), tri.data(), index.data(), vertex_normals.data(),
+    kernel_view = {bvh.nodes.empty() ? nullptr : bvh.nodes.data(), positions.data(), index.data(), vertex_normals.data(),
                    std::uint32_t(triangle_count()), corner_uv.empty() ? nullptr : corner_uv.data(), uv_density,
                    blocks.data(), block_of.data(), single_ray_lanes,
-                   tri.size() * sizeof(float) + bvh.nodes.size() * sizeof(accel::WideNode) > kPrefetchedMeshBytes,
+                   positions.size() * sizeof(float) + index.size() * sizeof(std::uint32_t) +
+                           bvh.nodes.size() * sizeof(accel::WideNode) >
+                       kPrefetchedMeshBytes,
                    vertex_colors.empty() ? nullptr : vertex_colors.data()};
 }
 

@@ -13,7 +13,7 @@ namespace streamrt {
 
 template <class T>
 inline Vec3T<T> mesh_vertex(const MeshView& m, std::uint32_t tri, int j) {
-    const float* p = m.tri + 9 * std::size_t(tri) + 3 * j;
+    const float* p = triangle_corner(m, tri, j);
     return {T(p[0]), T(p[1]), T(p[2])};
 }
 

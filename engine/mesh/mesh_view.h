@@ -25,8 +25,8 @@ static_assert(sizeof(TriangleBlock) == 144);
 /// the BVH's leaf order: a leaf (first, count) holds triangles first .. first + count - 1.
 struct MeshView {
     const accel::WideNode* nodes;    ///< the mesh BVH, nullptr when it has no triangles
-    const float* tri;                ///< 9 floats per triangle: p0, p1, p2
-    const std::uint32_t* index;      ///< 3 vertex numbers per triangle (into normals)
+    const float* positions;          ///< 3 floats per vertex (triangle_corner)
+    const std::uint32_t* index;      ///< 3 vertex numbers per triangle (into positions and normals)
     const float* vertex_normals;     ///< 3 floats per vertex, unit (area-weighted face normals)
     std::uint32_t n_tris;
     /// Texture coordinates (OBJ vt), 6 floats per triangle (u, v at its corners 0, 1, 2),
@@ -51,7 +51,15 @@ struct MeshView {
     const float* vertex_colors = nullptr;
 };
 
-/// Triangles plus BVH nodes above which a mesh is walked with prefetches (MeshView::prefetched):
+/// Corner j (0 - 2) of triangle k: its vertex's 3 coordinates. Triangles are held as vertex
+/// numbers into the shared positions, not as 9 floats each: 12 + 12 / 2 bytes a triangle on a
+/// closed mesh instead of 36, and the walks read the same floats (docs/performance.md,
+/// "Memory per vertex and triangle").
+inline const float* triangle_corner(const MeshView& m, std::size_t k, int j) {
+    return m.positions + 3 * std::size_t(m.index[3 * k + std::size_t(j)]);
+}
+
+/// Positions, vertex numbers and BVH nodes above which a mesh is walked with prefetches (MeshView::prefetched):
 /// half of this machine class's 4 MiB L2 per core, the rest for the rays and other meshes.
 /// Measured (docs/performance.md, "Shadow packets load ahead"): on shadow rays the prefetch
 /// gains 5 - 14 % on the 235k-triangle and larger meshes and costs the 3.7k-triangle bunny's.

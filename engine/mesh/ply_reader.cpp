@@ -533,7 +533,7 @@ std::shared_ptr<const Mesh> load_ply_mesh(const std::string& path, bool with_uv,
             "green blue)");
     budget.need(Mesh::build_bytes(data.positions.size() / 3, faces, !corner_uv.empty(), !data.colors.empty()),
                 "building its " + std::to_string(faces) + " triangles");
-    auto mesh = Mesh::build(path, data.positions, data.triangles, {}, corner_uv, data.normals, data.colors);
+    auto mesh = Mesh::build(path, std::move(data.positions), std::move(data.triangles), {}, corner_uv, data.normals, data.colors);
     if (mesh->triangle_count() == 0)
         throw std::runtime_error("PLY file has no triangles of non-zero area (" + std::to_string(faces) + " degenerate)");
     return mesh;

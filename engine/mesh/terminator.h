@@ -34,7 +34,7 @@ template <class T>
 inline SmoothCorners<T> smooth_corners(const MeshView& m, std::uint32_t tri) {
     SmoothCorners<T> c;
     for (int j = 0; j < 3; ++j) {
-        const float* p = m.tri + 9 * std::size_t(tri) + 3 * std::size_t(j);
+        const float* p = triangle_corner(m, tri, j);
         const float* n = m.vertex_normals + 3 * std::size_t(m.index[3 * std::size_t(tri) + std::size_t(j)]);
         c.p[j] = {T(p[0]), T(p[1]), T(p[2])};
         c.n[j] = {T(n[0]), T(n[1]), T(n[2])};

@@ -81,7 +81,7 @@ RTCScene embree_scene(RTCDevice dev, const Mesh& mesh, RTCBuildQuality quality) 
         for (int j = 0; j < 3; ++j) {
             const std::uint32_t v = mesh.index[3 * t + j];
             ib[3 * t + j] = v;
-            std::memcpy(vb + 3 * std::size_t(v), &mesh.tri[9 * t + 3 * j], 3 * sizeof(float));
+            std::memcpy(vb + 3 * std::size_t(v), mesh.corner(t, j), 3 * sizeof(float));
         }
     rtcCommitGeometry(g);
     rtcAttachGeometry(scene, g);

@@ -37,7 +37,8 @@ OracleHit oracle(const Mesh& m, const Vec3f& of, const Vec3f& df, double t_max) 
     OracleHit best;
     const double o[3] = {of.x, of.y, of.z}, d[3] = {df.x, df.y, df.z};
     for (std::size_t k = 0; k < m.triangle_count(); ++k) {
-        const float* p = &m.tri[9 * k];
+        const std::array<float, 9> tri_k = m.triangle(k);
+        const float* p = tri_k.data();
         double e1[3], e2[3], s[3];
         for (int a = 0; a < 3; ++a) {
             e1[a] = double(p[3 + a]) - p[a];
@@ -250,7 +251,8 @@ TEST_CASE("mesh walks: random rays through a triangle soup agree with a brute-fo
             c.o.push_back(o);
             // Half aimed at a triangle's interior, half anywhere.
             if (i % 2 && mesh->triangle_count() > 0) {
-                const float* p = &mesh->tri[9 * (std::size_t(rng()) % mesh->triangle_count())];
+                const std::array<float, 9> picked = mesh->triangle(std::size_t(rng()) % mesh->triangle_count());
+                const float* p = picked.data();
                 std::uniform_real_distribution<float> w(0.05f, 0.9f);
                 const float a = w(rng), b = (1.f - a) * w(rng);
                 const Vec3f q{p[0] + a * (p[3] - p[0]) + b * (p[6] - p[0]), p[1] + a * (p[4] - p[1]) + b * (p[7] - p[1]),
@@ -299,7 +301,8 @@ TEST_CASE("mesh walks: packets of one direction octant that reach different leav
     std::vector<std::vector<std::pair<Vec3f, Vec3f>>> by_octant(8);
     while (true) {
         const Vec3f o{u(rng), u(rng), u(rng)};
-        const float* p = &mesh->tri[9 * (std::size_t(rng()) % mesh->triangle_count())];
+        const std::array<float, 9> picked = mesh->triangle(std::size_t(rng()) % mesh->triangle_count());
+                const float* p = picked.data();
         const float a = w(rng), b = (1.f - a) * w(rng);
         const Vec3f q{p[0] + a * (p[3] - p[0]) + b * (p[6] - p[0]), p[1] + a * (p[4] - p[1]) + b * (p[7] - p[1]),
                       p[2] + a * (p[5] - p[2]) + b * (p[8] - p[2])};
@@ -336,7 +339,8 @@ TEST_CASE("mesh walks: packets whose lanes share the triangle test's axes give t
     Case shared;
     while (shared.o.size() < 1024) {
         const Vec3f o{u(rng), u(rng), -2.5f};
-        const float* p = &mesh->tri[9 * (std::size_t(rng()) % mesh->triangle_count())];
+        const std::array<float, 9> picked = mesh->triangle(std::size_t(rng()) % mesh->triangle_count());
+                const float* p = picked.data();
         const float a = w(rng), b = (1.f - a) * w(rng);
         const Vec3f q{p[0] + a * (p[3] - p[0]) + b * (p[6] - p[0]), p[1] + a * (p[4] - p[1]) + b * (p[7] - p[1]),
                       p[2] + a * (p[5] - p[2]) + b * (p[8] - p[2])};
@@ -520,7 +524,8 @@ TEST_CASE("mesh walks: a ray through a shared edge takes the lower-numbered tria
     const auto sharing = [&](float px, float py, float qx, float qy) {
         std::vector<int> found;
         for (std::size_t k = 0; k < mesh->triangle_count(); ++k) {
-            const float* t = &mesh->tri[9 * k];
+            const std::array<float, 9> tri_k = mesh->triangle(k);
+            const float* t = tri_k.data();
             int corners = 0;
             for (int c = 0; c < 3; ++c)
                 corners += (t[3 * c] == px && t[3 * c + 1] == py) || (t[3 * c] == qx && t[3 * c + 1] == qy);

@@ -107,7 +107,7 @@ std::vector<std::uint32_t> oracle_uv_indices(const std::string& obj) {
 void check_same_mesh(const Mesh& a, const Mesh& b) {
     CHECK(a.triangle_count() == b.triangle_count());
     CHECK(a.dropped == b.dropped);
-    CHECK(std::equal(a.tri.begin(), a.tri.end(), b.tri.begin(), b.tri.end()));
+    CHECK(std::equal(a.positions.begin(), a.positions.end(), b.positions.begin(), b.positions.end()));
     CHECK(a.index == b.index);
     CHECK(a.vertex_normals == b.vertex_normals);
     CHECK(a.corner_uv == b.corner_uv);

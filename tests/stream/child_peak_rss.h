@@ -53,6 +53,7 @@ inline long child_peak_rss_kib(const std::vector<std::string>& args, int* exit_c
             signal = WSTOPSIG(status);  // not ours: deliver it
         }
     }
+    INFO("the child ended by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0));
     REQUIRE(WIFEXITED(status));
     if (exit_code) *exit_code = WEXITSTATUS(status);
     else REQUIRE(WEXITSTATUS(status) == 0);
