@@ -14,7 +14,11 @@ Scenes (perf/scenes/peer/ and scenes/):
             which needs npm; without it the scene is skipped)
   million   perf/scenes/peer/million.cfg: a lumpy icosphere of 1 310 720 triangles (generated
             here into perf/assets/lumpy_icosphere.obj), a mirror sphere, the floor, depth 8
+  bunny235k perf/scenes/peer/bunny235k_glass.cfg: the bunny scene with the bunny split three
+            times, 235 136 triangles (scripts/fetch_bunny.py --split 3)
   whitted   scenes/whitted.cfg, the handout's scene (at --size, 1 spp like the others)
+  random_spheres  scenes/random_spheres.cfg: 50 spheres (clay, mirror, glass) on a checker
+            floor, two point lights, depth 4 (not in the default set)
 All at 1280x720 (--size), 1 spp.
 
 Each scene is translated into a POV-Ray scene (BUILD/peer/NAME.pov, meshes as mesh2 in
@@ -69,6 +73,7 @@ SCENES = {
     "bunny235k": os.path.join(PEER_DIR, "bunny235k_glass.cfg"),
     "million": os.path.join(PEER_DIR, "million.cfg"),
     "whitted": os.path.join(pc.ROOT, "scenes", "whitted.cfg"),
+    "random_spheres": os.path.join(pc.ROOT, "scenes", "random_spheres.cfg"),
 }
 MODES = {
     # name: (POV-Ray adc_bailout or None for its default, streamrt --cutoff or None for its default)
@@ -708,9 +713,9 @@ def append_log(path, entries):
 
 
 BENCH_ORDER = {"povray": 0, "engines": 1, "embree": 2}
-BENCH_TITLE = {"povray": "POV-Ray 3.7 wall / streamrt wall, whole process, +WT2 / -j2",
-               "engines": "streamrt recursive / stream, -j2",
-               "embree": "streamrt / Embree 3 rtcIntersect16 (rtcOccluded16 for shadow), one thread, Mrays/s"}
+BENCH_TITLE = {"povray": "POV-Ray 3.7 wall time / streamrt wall time, whole process, +WT2 / -j2",
+               "engines": "streamrt's recursive engine / its stream engine, whole process and render phase, -j2",
+               "embree": "streamrt's packet kernel / Embree 3's rtcIntersect16 (rtcOccluded16: shadow), Mrays/s, one thread"}
 
 
 def read_log(path):
@@ -726,28 +731,58 @@ def read_log(path):
     return entries
 
 
+METRIC_ORDER = ["ratio default", "ratio nopruning", "ratio matched", "render ratio default", "render ratio nopruning",
+                "render ratio matched", "whole ratio", "render ratio", "primary ratio", "shadow ratio", "mirror ratio",
+                "glass ratio", "diffuse ratio"]
+SCENE_ORDER = ["bunny", "bunny235k", "million", "whitted", "random_spheres", "sphere1m", "lumpy"]
+
+
+def _order(xs, order):
+    return sorted(xs, key=lambda x: (order.index(x) if x in order else len(order), x))
+
+
 def table(entries, metric_filter=None):
-    """The Markdown table of the log: per benchmark, scene and ratio, lowest (the headline) and
-    highest over the runs, the number of runs and of days, the loads and ISAs they ran under."""
-    groups = {}
+    """The Markdown tables of the log, one per benchmark: a row per scene with the runs logged,
+    their days, loads and ISAs, and per ratio the lowest value (the headline, bold) with the
+    range over the runs (its spread) in brackets; "n=K" where only K of the row's runs have it."""
+    by_bench = {}
     for e in entries:
+        row = by_bench.setdefault(e["bench"], {}).setdefault(e["scene"], {"entries": [], "metrics": {}})
+        row["entries"].append(e)
         for k, v in e["metrics"].items():
             if "ratio" not in k.split() or not isinstance(v, (int, float)) or v != v:
                 continue
-            if metric_filter and not any(f in k for f in metric_filter):
+            if metric_filter and k not in metric_filter:
                 continue
-            groups.setdefault((e["bench"], e["scene"], k), []).append((v, e))
-    lines = ["| benchmark | scene | ratio | headline (lowest) | range | spread | runs | days | load (1 min) | ISA |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
-    for (bench, scene, k), vs in sorted(groups.items(), key=lambda kv: (BENCH_ORDER.get(kv[0][0], 9),) + kv[0]):
-        vals = [v for v, _ in vs]
-        lo, hi = min(vals), max(vals)
-        days = sorted({e["date"][:10] for _, e in vs})
-        loads = [e["load"][0] for _, e in vs if e.get("load")]
-        isas = sorted({e.get("isa", "?") for _, e in vs})
-        lines.append("| %s | %s | %s | **%.2fx** | %.2f - %.2fx | %.0f %% | %d | %d (%s) | %s | %s |" % (
-            bench, scene, k, lo, lo, hi, 100.0 * (hi - lo) / lo if lo else 0.0, len(vals), len(days),
-            ", ".join(days), ("%.1f - %.1f" % (min(loads), max(loads))) if loads else "-", ", ".join(isas)))
+            row["metrics"].setdefault(k, []).append(v)
+    lines = []
+    for bench in _order(by_bench, list(BENCH_ORDER)):
+        rows = by_bench[bench]
+        metrics = _order({k for r in rows.values() for k in r["metrics"]}, METRIC_ORDER)
+        if not metrics:
+            continue
+        if lines:
+            lines.append("")
+        lines += ["%s:" % BENCH_TITLE.get(bench, bench), "",
+                  "| scene | runs | days | load (1 min) | ISA | " + " | ".join(metrics) + " |",
+                  "|---|---|---|---|---|" + "---|" * len(metrics)]
+        for scene in _order(rows, SCENE_ORDER):
+            r = rows[scene]
+            es = r["entries"]
+            days = sorted({e["date"][:10] for e in es})
+            loads = [e["load"][0] for e in es if e.get("load")]
+            cells = []
+            for k in metrics:
+                vs = r["metrics"].get(k)
+                if not vs:
+                    cells.append("-")
+                    continue
+                lo, hi = min(vs), max(vs)
+                cells.append("**%.2fx** (%.2f - %.2f%s)" % (lo, lo, hi, "" if len(vs) == len(es) else ", n=%d" % len(vs)))
+            lines.append("| %s | %d | %d (%s) | %s | %s | %s |" % (
+                scene, len(es), len(days), ", ".join(days),
+                ("%.1f - %.1f" % (min(loads), max(loads))) if loads else "-",
+                ", ".join(sorted({e.get("isa", "?") for e in es})), " | ".join(cells)))
     return "\n".join(lines)
 
 
@@ -773,8 +808,8 @@ def main(argv=None):
     ap.add_argument("--no-log", action="store_true", help="append nothing to the log")
     ap.add_argument("--table", action="store_true", help="print the Markdown table of the log's runs "
                     "(lowest, range, runs, days per scene and ratio) and stop")
-    ap.add_argument("--metrics", help="with --table: only the ratios whose name contains one of these "
-                    "comma-separated words (e.g. default,primary)")
+    ap.add_argument("--metrics", help="with --table: only these ratios, comma-separated names as in the "
+                    "table's third column (e.g. 'ratio default,primary ratio')")
     ap.add_argument("--dry-run", action="store_true", help="check tools, write the .pov files, render nothing")
     ap.add_argument("--out", help="output folder (default BUILD/peer)")
     ap.add_argument("--picture", metavar="PNG", help="only write the first scene (nopruning) at --size by streamrt "
@@ -787,7 +822,7 @@ def main(argv=None):
             return 1
         entries = read_log(args.log)
         print(table(entries, [m for m in args.metrics.split(",") if m] if args.metrics else None))
-        print("\n%d entries from %s; headline = the lowest ratio; spread = (highest - lowest) / lowest" % (
+        print("\n%d entries from %s; bold: the lowest over the runs (the headline), in brackets the range" % (
             len(entries), os.path.relpath(os.path.abspath(args.log), pc.ROOT)))
         return 0
     for m in args.embree_meshes.split(","):
