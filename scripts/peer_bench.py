@@ -44,8 +44,10 @@ runs it). Writes BUILD/peer/results.{json,md}.
 Every real run also appends to the log (--log, default perf/results/peer_runs.jsonl, committed;
 --no-log: not) one JSON object per scene and benchmark: "bench" (povray, engines or embree),
 "scene", "date" (UTC), "host", "cpu", "isa", "load" (the 1, 5 and 15-minute load averages
-before the scene's runs), "load_after", "commit", "command" and "metrics" (ratios and seconds,
-each the median of the run's --runs repetitions). --table reads the log and prints the
+before the scene's runs), "load_after", "commit" (of the source the build folder was made from,
+"-dirty" when its engine/ or perf/ differ from it), "build", "binaries" (sha256 of streamrt and
+embree_rays; "binaries_changed" when a digest moved during the run), "scripts_commit",
+"command" and "metrics" (ratios and seconds, each the median of the run's --runs repetitions). --table reads the log and prints the
 Markdown table docs/performance.md quotes: per benchmark, scene and ratio, the lowest and the
 highest over the runs logged, how many runs on how many days, the loads they ran under, and
 the headline, which is the lowest.
@@ -693,10 +695,46 @@ def load_now():
     return [round(x, 2) for x in os.getloadavg()]
 
 
+def build_provenance(build_dir):
+    """The source tree the build folder was configured from (CMakeCache.txt), its commit, and
+    "-dirty" when its engine/ or perf/ sources differ from that commit: what the binaries were
+    built from, as far as the tree says (the binaries' digests pin them down)."""
+    source = None
+    try:
+        with open(os.path.join(build_dir, "CMakeCache.txt")) as f:
+            source = next((ln.split("=", 1)[1].strip() for ln in f if ln.startswith("CMAKE_HOME_DIRECTORY:")), None)
+    except OSError:
+        pass
+    commit = "unknown"
+    if source:
+        try:
+            commit = subprocess.run(["git", "-C", source, "rev-parse", "--short", "HEAD"], capture_output=True,
+                                    text=True, check=True).stdout.strip()
+            dirty = subprocess.run(["git", "-C", source, "status", "--porcelain", "--untracked-files=no", "--",
+                                    "engine", "perf"], capture_output=True, text=True, check=True).stdout.strip()
+            commit += "-dirty" if dirty else ""
+        except (OSError, subprocess.CalledProcessError):
+            pass
+    return {"build": os.path.abspath(build_dir), "source": source, "commit": commit}
+
+
+def binary_digests(paths):
+    """sha256 (first 12 hex digits) of each program that runs, by name: a build that changes
+    under a run shows as a different digest at its end."""
+    import hashlib
+    out = {}
+    for p in paths:
+        if p and os.path.exists(p):
+            with open(p, "rb") as f:
+                out[os.path.basename(p)] = hashlib.sha256(f.read()).hexdigest()[:12]
+    return out
+
+
 def log_entry(meta, bench, scene, metrics, load_before, **extra):
     e = {"bench": bench, "scene": scene, "date": meta["utc"], "host": meta["host"], "cpu": meta["cpu"],
          "cores": meta["cores"], "isa": meta["isa"], "load": load_before, "load_after": load_now(),
-         "commit": meta["revision"], "command": meta["command"], "size": meta["size"], "runs": meta["runs"]}
+         "commit": meta["build_commit"], "build": meta["build"], "binaries": meta["binaries"],
+         "scripts_commit": meta["revision"], "command": meta["command"], "size": meta["size"], "runs": meta["runs"]}
     e.update(extra)
     e["metrics"] = {k: (round(v, 4) if isinstance(v, float) else v) for k, v in metrics.items()}
     return e
@@ -893,6 +931,11 @@ def main(argv=None):
     meta.update(runs=args.runs, size=args.size, command=" ".join(["scripts/peer_bench.py"] + (argv or sys.argv[1:])),
                 load_before=os.getloadavg()[0], utc=time.strftime("%Y-%m-%dT%H:%MZ", time.gmtime()),
                 host=platform.node(), isa=cpu_isa())
+    prov = build_provenance(args.build)
+    meta.update(build_commit=prov["commit"], build=prov["build"], binaries=binary_digests([exe, embree_rays]))
+    if prov["commit"].endswith("-dirty") or prov["commit"] == "unknown":
+        print("warning: the build's source tree %s is at %s: the figures are of uncommitted code" % (
+            prov["source"], prov["commit"]))
     log = []
     if povray:
         v = subprocess.run([povray, "--version"], capture_output=True, text=True)
@@ -1015,6 +1058,10 @@ def main(argv=None):
     print()
     print(text)
     print("wrote %s/results.{json,md}" % os.path.relpath(out_dir, pc.ROOT))
+    if binary_digests([exe, embree_rays]) != meta["binaries"]:
+        print("warning: %s changed during the run (rebuilt?): its entries are marked binaries_changed" % args.build)
+        for e in log:
+            e["binaries_changed"] = True
     if not args.no_log:
         append_log(args.log, log)
     return 0
