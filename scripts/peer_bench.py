@@ -4,7 +4,9 @@ POV-Ray and Embree").
 
 usage: /usr/bin/python3 scripts/peer_bench.py [--build DIR] [--runs N] [--scenes NAME,...]
                                               [--modes MODE,...] [--size WxH] [--no-engines]
-                                              [--no-embree] [--povray PATH] [--dry-run]
+                                              [--no-embree] [--embree-meshes NAME,...]
+                                              [--povray PATH] [--dry-run] [--log FILE | --no-log]
+       /usr/bin/python3 scripts/peer_bench.py --table [--log FILE]
 
 Scenes (perf/scenes/peer/ and scenes/):
   bunny     perf/scenes/peer/bunny_glass.cfg: the Stanford bunny in glass and in clay, a mirror
@@ -12,7 +14,11 @@ Scenes (perf/scenes/peer/ and scenes/):
             which needs npm; without it the scene is skipped)
   million   perf/scenes/peer/million.cfg: a lumpy icosphere of 1 310 720 triangles (generated
             here into perf/assets/lumpy_icosphere.obj), a mirror sphere, the floor, depth 8
+  bunny235k perf/scenes/peer/bunny235k_glass.cfg: the bunny scene with the bunny split three
+            times, 235 136 triangles (scripts/fetch_bunny.py --split 3)
   whitted   scenes/whitted.cfg, the handout's scene (at --size, 1 spp like the others)
+  random_spheres  scenes/random_spheres.cfg: 50 spheres (clay, mirror, glass) on a checker
+            floor, two point lights, depth 4 (not in the default set)
 All at 1280x720 (--size), 1 spp.
 
 Each scene is translated into a POV-Ray scene (BUILD/peer/NAME.pov, meshes as mesh2 in
@@ -34,11 +40,23 @@ Without POV-Ray (`povray` not on PATH, or --povray naming no program) the POV-Ra
 skipped with a message; without embree_rays the Embree table is. --dry-run checks the tools,
 writes the .pov files of the scenes whose meshes are there, and renders nothing (the test suite
 runs it). Writes BUILD/peer/results.{json,md}.
+
+Every real run also appends to the log (--log, default perf/results/peer_runs.jsonl, committed;
+--no-log: not) one JSON object per scene and benchmark: "bench" (povray, engines or embree),
+"scene", "date" (UTC), "host", "cpu", "isa", "load" (the 1, 5 and 15-minute load averages
+before the scene's runs), "load_after", "commit" (of the source the build folder was made from,
+"-dirty" when its engine/ or perf/ differ from it), "build", "binaries" (sha256 of streamrt and
+embree_rays; "binaries_changed" when a digest moved during the run), "scripts_commit",
+"command" and "metrics" (ratios and seconds, each the median of the run's --runs repetitions). --table reads the log and prints the
+Markdown table docs/performance.md quotes: per benchmark, scene and ratio, the lowest and the
+highest over the runs logged, how many runs on how many days, the loads they ran under, and
+the headline, which is the lowest.
 """
 import argparse
 import json
 import math
 import os
+import platform
 import re
 import shutil
 import struct
@@ -57,6 +75,7 @@ SCENES = {
     "bunny235k": os.path.join(PEER_DIR, "bunny235k_glass.cfg"),
     "million": os.path.join(PEER_DIR, "million.cfg"),
     "whitted": os.path.join(pc.ROOT, "scenes", "whitted.cfg"),
+    "random_spheres": os.path.join(pc.ROOT, "scenes", "random_spheres.cfg"),
 }
 MODES = {
     # name: (POV-Ray adc_bailout or None for its default, streamrt --cutoff or None for its default)
@@ -65,6 +84,13 @@ MODES = {
     "matched": (None, 1.0 / 255.0),
 }
 LUMPY_LEVEL = 8  # 20 * 4^8 = 1 310 720 triangles
+LOG = os.path.join(pc.ROOT, "perf", "results", "peer_runs.jsonl")
+EMBREE_MESHES = {  # --embree-meshes name: file under perf/assets
+    "bunny": "bunny.ply",
+    "bunny235k": "bunny_split3.ply",
+    "sphere1m": "uv_sphere_1m.obj",
+    "lumpy": "lumpy_icosphere.obj",
+}
 
 
 # ---- generated meshes -------------------------------------------------------------------------
@@ -125,22 +151,21 @@ def uv_sphere(path, rings=501, segments=1000):
     return pc.write_lines(path, lines)
 
 
-def embree_meshes(dry_run):
+def embree_meshes(dry_run, names=tuple(EMBREE_MESHES)):
     """The meshes of the Embree table (docs/performance.md, "Ray traversal, Embree against
-    streamrt"), made when missing: the bunny, the bunny split three times (235k triangles: the
-    issue's ~200k-triangle scanned mesh), the 1M-triangle UV sphere and the 1.3M lumpy
-    icosphere (its 1M-triangle meshes)."""
-    bunny = os.path.join(ASSETS, "bunny.ply")
-    split3 = os.path.join(ASSETS, "bunny_split3.ply")
-    sphere = os.path.join(ASSETS, "uv_sphere_1m.obj")
-    lumpy = os.path.join(ASSETS, "lumpy_icosphere.obj")
+    streamrt") among `names`, made when missing: the bunny, the bunny split three times (235k
+    triangles: the issue's ~200k-triangle scanned mesh), the 1M-triangle UV sphere and the 1.3M
+    lumpy icosphere (its 1M-triangle meshes)."""
+    bunny, split3, sphere, lumpy = (os.path.join(ASSETS, EMBREE_MESHES[n]) for n in EMBREE_MESHES)
     if not dry_run:
-        if os.path.exists(bunny) and not os.path.exists(split3):
+        if "bunny235k" in names and os.path.exists(bunny) and not os.path.exists(split3):
             import fetch_bunny
             fetch_bunny.main(["--split", "3"])
-        uv_sphere(sphere)
-        lumpy_icosphere(lumpy)
-    return [p for p in (bunny, split3, sphere, lumpy) if os.path.exists(p)]
+        if "sphere1m" in names:
+            uv_sphere(sphere)
+        if "lumpy" in names:
+            lumpy_icosphere(lumpy)
+    return [os.path.join(ASSETS, EMBREE_MESHES[n]) for n in names if os.path.exists(os.path.join(ASSETS, EMBREE_MESHES[n]))]
 
 
 def ensure_assets(names, dry_run):
@@ -625,6 +650,180 @@ def side_by_side_png(left_ppm, right_ppm, png, gap=4):
                 chunk(b"IDAT", zlib.compress(b"".join(rows), 9)) + chunk(b"IEND", b""))
 
 
+
+# ---- the log of runs and the table the report quotes ------------------------------------------
+
+EMBREE_ROW_RE = re.compile(r"^(primary|shadow|mirror|glass|diffuse)\s+(\d+)\s+([0-9.]+)\s+([0-9.]+)\s+([0-9.]+)\s+"
+                           r"([0-9.]+)x\s+([0-9.]+)")
+EMBREE_MESH_RE = re.compile(r"^(\S+): (\d+) triangles;")
+EMBREE_ISA_RE = re.compile(r"streamrt kernels (\w+)")
+
+
+def parse_embree(text):
+    """embree_rays' output as (isa, {mesh file name: {metric: value}}): per ray kind the ratio
+    streamrt / Embree16 ("KIND ratio") and the three programs' Mrays/s."""
+    isa, meshes, cur = None, {}, None
+    for line in text.splitlines():
+        m = EMBREE_ISA_RE.search(line)
+        if m and isa is None:
+            isa = m.group(1)
+        m = EMBREE_MESH_RE.match(line)
+        if m:
+            cur = meshes.setdefault(os.path.basename(m.group(1)), {"triangles": int(m.group(2))})
+            continue
+        m = EMBREE_ROW_RE.match(line)
+        if m and cur is not None:
+            k = m.group(1)
+            cur.update({k + " ratio": float(m.group(6)), k + " Embree16 Mrays/s": float(m.group(3)),
+                        k + " Embree1 Mrays/s": float(m.group(4)), k + " streamrt Mrays/s": float(m.group(5))})
+    return isa, meshes
+
+
+def cpu_isa():
+    """The widest vector extension the CPU reports (what streamrt's dispatch picks)."""
+    try:
+        flags = next((ln.split(":", 1)[1].split() for ln in open("/proc/cpuinfo") if ln.startswith("flags")), [])
+    except OSError:
+        flags = []
+    for isa, flag in (("avx512", "avx512f"), ("avx2", "avx2"), ("sse4.2", "sse4_2")):
+        if flag in flags:
+            return isa
+    return "sse2"
+
+
+def load_now():
+    return [round(x, 2) for x in os.getloadavg()]
+
+
+def build_provenance(build_dir):
+    """The source tree the build folder was configured from (CMakeCache.txt), its commit, and
+    "-dirty" when its engine/ or perf/ sources differ from that commit: what the binaries were
+    built from, as far as the tree says (the binaries' digests pin them down)."""
+    source = None
+    try:
+        with open(os.path.join(build_dir, "CMakeCache.txt")) as f:
+            source = next((ln.split("=", 1)[1].strip() for ln in f if ln.startswith("CMAKE_HOME_DIRECTORY:")), None)
+    except OSError:
+        pass
+    commit = "unknown"
+    if source:
+        try:
+            commit = subprocess.run(["git", "-C", source, "rev-parse", "--short", "HEAD"], capture_output=True,
+                                    text=True, check=True).stdout.strip()
+            dirty = subprocess.run(["git", "-C", source, "status", "--porcelain", "--untracked-files=no", "--",
+                                    "engine", "perf"], capture_output=True, text=True, check=True).stdout.strip()
+            commit += "-dirty" if dirty else ""
+        except (OSError, subprocess.CalledProcessError):
+            pass
+    return {"build": os.path.abspath(build_dir), "source": source, "commit": commit}
+
+
+def binary_digests(paths):
+    """sha256 (first 12 hex digits) of each program that runs, by name: a build that changes
+    under a run shows as a different digest at its end."""
+    import hashlib
+    out = {}
+    for p in paths:
+        if p and os.path.exists(p):
+            with open(p, "rb") as f:
+                out[os.path.basename(p)] = hashlib.sha256(f.read()).hexdigest()[:12]
+    return out
+
+
+def log_entry(meta, bench, scene, metrics, load_before, **extra):
+    e = {"bench": bench, "scene": scene, "date": meta["utc"], "host": meta["host"], "cpu": meta["cpu"],
+         "cores": meta["cores"], "isa": meta["isa"], "load": load_before, "load_after": load_now(),
+         "commit": meta["build_commit"], "build": meta["build"], "binaries": meta["binaries"],
+         "scripts_commit": meta["revision"], "command": meta["command"], "size": meta["size"], "runs": meta["runs"]}
+    e.update(extra)
+    e["metrics"] = {k: (round(v, 4) if isinstance(v, float) else v) for k, v in metrics.items()}
+    return e
+
+
+def append_log(path, entries):
+    if not entries:
+        return
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "a") as f:
+        for e in entries:
+            f.write(json.dumps(e, sort_keys=True) + "\n")
+    print("appended %d entries to %s" % (len(entries), os.path.relpath(path, pc.ROOT)))
+
+
+BENCH_ORDER = {"povray": 0, "engines": 1, "embree": 2}
+BENCH_TITLE = {"povray": "POV-Ray 3.7 wall time / streamrt wall time, whole process, +WT2 / -j2",
+               "engines": "streamrt's recursive engine / its stream engine, whole process and render phase, -j2",
+               "embree": "streamrt's packet kernel / Embree 3's rtcIntersect16 (rtcOccluded16: shadow), Mrays/s, one thread"}
+
+
+def read_log(path):
+    entries = []
+    with open(path) as f:
+        for n, line in enumerate(f, 1):
+            line = line.strip()
+            if line:
+                try:
+                    entries.append(json.loads(line))
+                except ValueError as e:
+                    raise SystemExit("%s:%d: not JSON (%s)" % (path, n, e))
+    return entries
+
+
+METRIC_ORDER = ["ratio default", "ratio nopruning", "ratio matched", "render ratio default", "render ratio nopruning",
+                "render ratio matched", "whole ratio", "render ratio", "primary ratio", "shadow ratio", "mirror ratio",
+                "glass ratio", "diffuse ratio"]
+SCENE_ORDER = ["bunny", "bunny235k", "million", "whitted", "random_spheres", "sphere1m", "lumpy"]
+
+
+def _order(xs, order):
+    return sorted(xs, key=lambda x: (order.index(x) if x in order else len(order), x))
+
+
+def table(entries, metric_filter=None):
+    """The Markdown tables of the log, one per benchmark: a row per scene with the runs logged,
+    their days, loads and ISAs, and per ratio the lowest value (the headline, bold) with the
+    range over the runs (its spread) in brackets; "n=K" where only K of the row's runs have it."""
+    by_bench = {}
+    for e in entries:
+        row = by_bench.setdefault(e["bench"], {}).setdefault(e["scene"], {"entries": [], "metrics": {}})
+        row["entries"].append(e)
+        for k, v in e["metrics"].items():
+            if "ratio" not in k.split() or not isinstance(v, (int, float)) or v != v:
+                continue
+            if metric_filter and k not in metric_filter:
+                continue
+            row["metrics"].setdefault(k, []).append(v)
+    lines = []
+    for bench in _order(by_bench, list(BENCH_ORDER)):
+        rows = by_bench[bench]
+        metrics = _order({k for r in rows.values() for k in r["metrics"]}, METRIC_ORDER)
+        if not metrics:
+            continue
+        if lines:
+            lines.append("")
+        lines += ["%s:" % BENCH_TITLE.get(bench, bench), "",
+                  "| scene | runs | days | load (1 min) | ISA | " + " | ".join(metrics) + " |",
+                  "|---|---|---|---|---|" + "---|" * len(metrics)]
+        for scene in _order(rows, SCENE_ORDER):
+            r = rows[scene]
+            es = r["entries"]
+            days = sorted({e["date"][:10] for e in es})
+            loads = [e["load"][0] for e in es if e.get("load")]
+            cells = []
+            for k in metrics:
+                vs = r["metrics"].get(k)
+                if not vs:
+                    cells.append("-")
+                    continue
+                lo, hi = min(vs), max(vs)
+                cells.append("**%.2fx** (%.2f - %.2f%s)" % (lo, lo, hi, "" if len(vs) == len(es) else ", n=%d" % len(vs)))
+            lines.append("| %s | %d | %d (%s) | %s | %s | %s |" % (
+                scene, len(es), len(days), ", ".join(days),
+                ("%.1f - %.1f" % (min(loads), max(loads))) if loads else "-",
+                ", ".join(sorted({e.get("isa", "?") for e in es})), " | ".join(cells)))
+    return "\n".join(lines)
+
+
 def fmt(v, nd=3):
     return "-" if v is None else "%.*f" % (nd, v)
 
@@ -640,12 +839,33 @@ def main(argv=None):
     ap.add_argument("--no-engines", action="store_true", help="leave out streamrt's recursive-vs-stream table")
     ap.add_argument("--no-embree", action="store_true", help="leave out the Embree table")
     ap.add_argument("--embree-reps", type=int, default=5, help="embree_rays --reps (default 5)")
+    ap.add_argument("--embree-meshes", default=",".join(EMBREE_MESHES),
+                    help="meshes of the Embree table (default %s)" % ",".join(EMBREE_MESHES))
+    ap.add_argument("--log", default=LOG, help="the log of runs to append to and --table from "
+                    "(default perf/results/peer_runs.jsonl)")
+    ap.add_argument("--no-log", action="store_true", help="append nothing to the log")
+    ap.add_argument("--table", action="store_true", help="print the Markdown table of the log's runs "
+                    "(lowest, range, runs, days per scene and ratio) and stop")
+    ap.add_argument("--metrics", help="with --table: only these ratios, comma-separated names as in the "
+                    "table's third column (e.g. 'ratio default,primary ratio')")
     ap.add_argument("--dry-run", action="store_true", help="check tools, write the .pov files, render nothing")
     ap.add_argument("--out", help="output folder (default BUILD/peer)")
     ap.add_argument("--picture", metavar="PNG", help="only write the first scene (nopruning) at --size by streamrt "
                     "(left) and POV-Ray (right) side by side into PNG, and stop (docs/img/peer_bunny.png: "
                     "--scenes bunny --size 400x225)")
     args = ap.parse_args(argv)
+    if args.table:
+        if not os.path.exists(args.log):
+            print("no log at %s: run the benchmark first" % args.log)
+            return 1
+        entries = read_log(args.log)
+        print(table(entries, [m for m in args.metrics.split(",") if m] if args.metrics else None))
+        print("\n%d entries from %s; bold: the lowest over the runs (the headline), in brackets the range" % (
+            len(entries), os.path.relpath(os.path.abspath(args.log), pc.ROOT)))
+        return 0
+    for m in args.embree_meshes.split(","):
+        if m and m not in EMBREE_MESHES:
+            ap.error("unknown Embree mesh %r (one of %s)" % (m, ", ".join(EMBREE_MESHES)))
     width, height = (int(x) for x in args.size.split("x"))
     names = [s for s in args.scenes.split(",") if s]
     modes = [m for m in args.modes.split(",") if m]
@@ -709,7 +929,14 @@ def main(argv=None):
 
     meta = pc.machine_info()
     meta.update(runs=args.runs, size=args.size, command=" ".join(["scripts/peer_bench.py"] + (argv or sys.argv[1:])),
-                load_before=os.getloadavg()[0])
+                load_before=os.getloadavg()[0], utc=time.strftime("%Y-%m-%dT%H:%MZ", time.gmtime()),
+                host=platform.node(), isa=cpu_isa())
+    prov = build_provenance(args.build)
+    meta.update(build_commit=prov["commit"], build=prov["build"], binaries=binary_digests([exe, embree_rays]))
+    if prov["commit"].endswith("-dirty") or prov["commit"] == "unknown":
+        print("warning: the build's source tree %s is at %s: the figures are of uncommitted code" % (
+            prov["source"], prov["commit"]))
+    log = []
     if povray:
         v = subprocess.run([povray, "--version"], capture_output=True, text=True)
         meta["povray"] = next((ln.strip() for ln in (v.stdout + v.stderr).splitlines() if ln.startswith("POV-Ray")),
@@ -718,6 +945,7 @@ def main(argv=None):
     t_start = time.time()
     for s in names:
         cfg = SCENES[s]
+        scene_load, pov_metrics = load_now(), {}
         for m in modes:
             adc, cutoff = MODES[m]
             pov_path = os.path.join(out_dir, "%s_%s.pov" % (s, m))
@@ -743,11 +971,19 @@ def main(argv=None):
                 row["render_ratio"] = row["povray_trace"] / row["streamrt_render"]
                 row["psnr"], row["close"] = ppm_psnr(pov_img, srt_img)
             rows.append(row)
+            pov_metrics.update({"streamrt s " + m: row["streamrt"], "streamrt render s " + m: row["streamrt_render"]})
+            if povray:
+                pov_metrics.update({"ratio " + m: row["ratio"], "render ratio " + m: row["render_ratio"],
+                                    "povray s " + m: row["povray"], "povray trace s " + m: row["povray_trace"],
+                                    "psnr dB " + m: row["psnr"]})
             print("[%4.0fs] %-8s %-10s POV-Ray %s s (parse %s, trace %s)  streamrt %.3f s (render %.3f)  ratio %s"
                   "  PSNR %s dB" % (time.time() - t_start, s, m, fmt(row.get("povray")), fmt(row.get("povray_parse")),
                                      fmt(row.get("povray_trace")), row["streamrt"], row["streamrt_render"],
                                      fmt(row.get("ratio"), 2), fmt(row.get("psnr"), 1)), flush=True)
+        if povray and pov_metrics:
+            log.append(log_entry(meta, "povray", s, pov_metrics, scene_load, povray=meta.get("povray")))
         if not args.no_engines:
+            scene_load = load_now()
             img = os.path.join(out_dir, "%s_engine.ppm" % s)
             times = {"stream": [], "recursive": []}
             for e in times:
@@ -759,19 +995,31 @@ def main(argv=None):
                       **{e + "_render": pc.median([r["seconds"] for r in rs]) for e, rs in times.items()})
             er["ratio"] = er["recursive"] / er["stream"]
             engine_rows.append(er)
+            log.append(log_entry(meta, "engines", s, {
+                "whole ratio": er["ratio"], "render ratio": er["recursive_render"] / er["stream_render"],
+                "stream s": er["stream"], "recursive s": er["recursive"]}, scene_load))
             print("[%4.0fs] %-8s engines: recursive %.3f s (render %.3f), stream %.3f s (render %.3f), %.2fx" % (
                 time.time() - t_start, s, er["recursive"], er["recursive_render"], er["stream"], er["stream_render"],
                 er["ratio"]), flush=True)
 
     embree_text = None
     if embree_rays:
-        meshes = embree_meshes(False)
-        if meshes:
-            p = subprocess.run([embree_rays, "--reps", str(args.embree_reps)] + meshes, capture_output=True,
-                               text=True)
-            embree_text = p.stdout.strip()
+        meshes = embree_meshes(False, [m for m in args.embree_meshes.split(",") if m])
+        for mesh in meshes:  # one mesh a process: each its own load average in the log
+            scene_load = load_now()
+            p = subprocess.run([embree_rays, "--reps", str(args.embree_reps), mesh], capture_output=True, text=True)
+            text = p.stdout.strip()
             if p.returncode != 0:
-                embree_text += "\n(embree_rays failed: %s)" % p.stderr.strip()
+                text += "\n(embree_rays failed: %s)" % p.stderr.strip()
+            embree_text = text if embree_text is None else embree_text + "\n\n" + text.split("\n\n", 1)[-1]
+            isa, parsed = parse_embree(text)
+            for name, metrics in parsed.items():
+                scene = next((k for k, f in EMBREE_MESHES.items() if f == name), name)
+                log.append(log_entry(meta, "embree", scene, metrics, scene_load, kernels=isa,
+                                     reps=args.embree_reps))
+            print("[%4.0fs] embree_rays %s: %s" % (time.time() - t_start, os.path.basename(mesh), ", ".join(
+                "%s %.2fx" % (k.split()[0], v) for m in parsed.values() for k, v in m.items() if k.endswith("ratio"))),
+                flush=True)
 
     meta["load_after"] = os.getloadavg()[0]
     meta["seconds"] = time.time() - t_start
@@ -810,6 +1058,12 @@ def main(argv=None):
     print()
     print(text)
     print("wrote %s/results.{json,md}" % os.path.relpath(out_dir, pc.ROOT))
+    if binary_digests([exe, embree_rays]) != meta["binaries"]:
+        print("warning: %s changed during the run (rebuilt?): its entries are marked binaries_changed" % args.build)
+        for e in log:
+            e["binaries_changed"] = True
+    if not args.no_log:
+        append_log(args.log, log)
     return 0
 
 
