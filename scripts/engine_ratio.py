@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Stream engine against the recursive baseline, whole process, runs alternated
-(docs/performance.md, "Two rays per single-ray walk" and the issue's 5x target).
+(docs/performance.md, "The closest walk on large meshes" and the issue's 5x target).
 
 usage: /usr/bin/python3 scripts/engine_ratio.py [--streamrt build/engine/streamrt] [--runs 9]
                                                 [--jobs 2] [--size 1280x720] [SCENE]

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The streamrt performance suite (docs/performance.md, "Perf suite").
+"""The streamrt performance suite (docs/performance.md, "How to reproduce").
 
 usage: scripts/perf_suite.py [--quick] [--build DIR] [--runs N] [--groups G,...]
 

@@ -253,7 +253,7 @@ inline void mesh_closest_packet_walk(const MeshView& m, const Vec3T<B>& o, const
         bv.store_aligned(v_l);
         bprim.store_aligned(p_l);
         // The lanes to finish, walked in pairs (mesh_closest_single_pair), the odd one alone.
-        // Measured (docs/performance.md, "Two rays per single-ray walk"): pairs made the
+        // Measured (docs/performance.md, "The closest walk on large meshes"): pairs made the
         // single-ray walk 1.15 - 1.44x faster on closest hits; groups of 4 gained nothing.
         int go[W], n = 0;
         Vec3f og[W], dg[W];
@@ -444,7 +444,7 @@ inline M mesh_any_packet_walk(const MeshView& m, const Vec3T<B>& o, const Vec3T<
         for (int j = 0; j < accel::kNodeWidth && n.child[j] >= 0; ++j) {
             B tn;
             const std::uint32_t bits = movemask_bits(robust_box(n, j, o, inv, t_max, tn) && open);
-            // docs/performance.md, "Shadow packets load ahead"
+            // docs/performance.md, "The closest walk on large meshes"
             if (m.prefetched) prefetch_met_child(m, n, j, bits, stack);
             stack[sp] = {n.child[j], n.count[j], 0.f, bits};
             sp += int(bits != 0);

@@ -61,7 +61,7 @@ inline const float* triangle_corner(const MeshView& m, std::size_t k, int j) {
 
 /// Positions, vertex numbers and BVH nodes above which a mesh is walked with prefetches (MeshView::prefetched):
 /// half of this machine class's 4 MiB L2 per core, the rest for the rays and other meshes.
-/// Measured (docs/performance.md, "Shadow packets load ahead"): on shadow rays the prefetch
+/// Measured (docs/performance.md, "The closest walk on large meshes"): on shadow rays the prefetch
 /// gains 5 - 14 % on the 235k-triangle and larger meshes and costs the 3.7k-triangle bunny's.
 inline constexpr std::size_t kPrefetchedMeshBytes = std::size_t(2) << 20;
 
