@@ -60,6 +60,8 @@ class CMakeBuild(build_ext):
         target = pathlib.Path(self.get_ext_fullpath(ext.name))
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(native, target)
+        for stale in target.parent.glob("libstreamrt_*.so"):  # an earlier build's, kept by setuptools
+            stale.unlink()
         for module in sorted((BUILD / "lib" / "streamrt").glob("libstreamrt_*.so")):
             shutil.copyfile(module, target.parent / module.name)
 
