@@ -11,11 +11,11 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
-#include <csignal>
-#include <cstdio>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <memory>
