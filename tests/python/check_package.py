@@ -16,6 +16,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCENE = str(ROOT / "scenes/whitted.cfg")
@@ -94,13 +95,16 @@ def main():
     args = ap.parse_args()
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "STREAMRT_MODULE_DIR")}
     env["STREAMRT_BUILD_DIR"] = os.path.abspath(args.build_dir)
+    start = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="streamrt-package-") as tmp:
         tmp = pathlib.Path(tmp)
         venv = tmp / "venv"
         run([sys.executable, "-m", "venv", "--system-site-packages", venv])
         python = venv / "bin/python"
         # --isolated: no pip configuration of this machine's; --no-index: no network.
+        made = time.monotonic()
         run([python, "-m", "pip", "--isolated", "install", "--no-index", "--no-build-isolation", ROOT], env=env)
+        installed = time.monotonic()
 
         # The package's files, the type stubs and the modules it loads included.
         site = pathlib.Path(run([python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
@@ -130,7 +134,8 @@ def main():
         out = run([python, "-c", IN_VENV, venv, tmp / "m.pfm", tmp / "api.exr"], cwd=tmp, env=env).stdout
         assert out == "api ok\n", out
         assert exr_data_window(tmp / "api.exr") == (0, 0, 79, 59)
-    print("python_package: pip install, python -m streamrt and the API in a fresh venv: ok")
+    print("python_package: pip install, python -m streamrt and the API in a fresh venv: ok (venv %.1f s, pip "
+          "install %.1f s, checks %.1f s)" % (made - start, installed - made, time.monotonic() - installed))
 
 
 if __name__ == "__main__":
