@@ -1,6 +1,6 @@
 #pragma once
 // The streamrt command (docs/scene-format.md; README "Using it"), one concept a file:
-// main.cpp (options, dispatch, exit status), job.cpp (the render job from the options and the
+// command.cpp (options, dispatch, exit status; main.cpp is the program's main), job.cpp (the render job from the options and the
 // checks before rendering), progress.h (the progress bar), picture.cpp (one picture, both
 // engines, frames), tiled.cpp (shards, checkpoints, tile costs, MPI, merge).
 #include <CLI/CLI.hpp>
@@ -165,5 +165,11 @@ int render_tiled(const Options& opt, Job& job, Parallelism& par, const SceneBund
                  std::unique_ptr<PreparedRender>& prepared);
 int run_mpi(const Options& opt, int argc, char** argv);
 int run_merge(int argc, char** argv);
+
+// ---- command.cpp ----
+/// The whole command: `argv` as the program gets it (argv[0] its name); an error is reported
+/// here (one line on stderr) and becomes the exit status. The program's main, and
+/// `python -m streamrt` through the Python module.
+int run_command(int argc, char** argv);
 
 }  // namespace streamrt::cli

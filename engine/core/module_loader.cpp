@@ -31,11 +31,14 @@ std::vector<std::string> module_folders() {
         char* resolved = realpath(info.dli_fname, nullptr);
         if (!resolved) resolved = realpath("/proc/self/exe", nullptr);
         if (resolved) {
+            // Its own folder first: the Python package installed by pip holds the modules
+            // beside its extension (site-packages/streamrt/). Then lib/streamrt/ above it:
             // PREFIX/bin/streamrt and build/<folder>/<program> are one level down from the
-            // root whose lib/streamrt/ holds the modules; an installed Python module
-            // (PREFIX/lib/python3.X/dist-packages/) three.
+            // root that holds it, the Python module in build/python/streamrt/ two, and one
+            // installed by cmake --install (PREFIX/lib/python3.X/dist-packages/streamrt/) four.
             std::string root = parent_folder(resolved);
-            for (int up = 0; up < 3 && root.size() > 1; ++up) {
+            folders.push_back(root);
+            for (int up = 0; up < 4 && root.size() > 1; ++up) {
                 root = parent_folder(root);
                 folders.push_back((root == "/" ? std::string() : root) + "/lib/streamrt");
             }

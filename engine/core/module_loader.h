@@ -6,11 +6,13 @@
 
 namespace streamrt {
 
-/// Where a module is looked for, in order: $STREAMRT_MODULE_DIR; lib/streamrt/ in the
-/// folders one, two and three levels above the program or library that holds this engine
-/// (build/engine/streamrt and build/tests/... find build/lib/streamrt/, an installed
-/// PREFIX/bin/streamrt and PREFIX/lib/python3.X/dist-packages/streamrt*.so find
-/// PREFIX/lib/streamrt/); the install folder chosen at configure time.
+/// Where a module is looked for, in order: $STREAMRT_MODULE_DIR; the folder of the program
+/// or library that holds this engine (the Python package pip installs keeps the modules
+/// beside its extension); lib/streamrt/ in the folders one to four levels above it
+/// (build/engine/streamrt, build/tests/... and build/python/streamrt/_native*.so find
+/// build/lib/streamrt/, an installed PREFIX/bin/streamrt and
+/// PREFIX/lib/python3.X/dist-packages/streamrt/_native*.so find PREFIX/lib/streamrt/); the
+/// install folder chosen at configure time.
 std::string module_search_path();
 
 /// The address of `symbol` in module `file` (e.g. "libstreamrt_exr.so"), loaded once and

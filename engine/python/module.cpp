@@ -3,7 +3,9 @@
 // render job the command line builds, so a picture from Python is the CLI's picture, bit for
 // bit. Rendering runs on a worker thread with the GIL released; the calling thread waits,
 // looking at Python's signals (Ctrl-C becomes KeyboardInterrupt, the render is cancelled
-// within a chunk) and calling the progress callback.
+// within a chunk) and calling the progress callback. Built as streamrt._native, the
+// extension of the streamrt package (python/streamrt/): `python -m streamrt` runs the
+// command line itself (cli/command.cpp) through run_command.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -12,6 +14,8 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <memory>
@@ -20,6 +24,7 @@
 #include <thread>
 #include <utility>
 
+#include "cli/cli.h"
 #include "core/error.h"
 #include "core/memory_budget.h"
 #include "driver/limits.h"
@@ -324,9 +329,32 @@ void save(py::array_t<float, py::array::c_style | py::array::forcecast> image, c
     write_image(path, fb, d);
 }
 
+/// python -m streamrt ARGS: the command line in this process, its exit status returned. The
+/// command sets its own SIGINT and SIGTERM handlers (Ctrl-C stops the render, status 130);
+/// Python's are put back afterwards.
+int run_command(const std::vector<std::string>& args) {
+    std::vector<std::string> words{"streamrt"};
+    words.insert(words.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    struct sigaction python_int {}, python_term {};
+    sigaction(SIGINT, nullptr, &python_int);
+    sigaction(SIGTERM, nullptr, &python_term);
+    int status;
+    {
+        py::gil_scoped_release release;
+        status = cli::run_command(int(words.size()), argv.data());
+        std::fflush(stdout);  // before anything Python prints next
+    }
+    sigaction(SIGINT, &python_int, nullptr);
+    sigaction(SIGTERM, &python_term, nullptr);
+    return status;
+}
+
 }  // namespace
 
-PYBIND11_MODULE(streamrt, m) {
+PYBIND11_MODULE(_native, m) {
     m.doc() = "streamrt: a SIMD ray-stream ray tracer and its recursive baseline (docs/python.md).";
 
     static py::exception<SceneError> scene_error(m, "SceneError", PyExc_ValueError);
@@ -426,4 +454,6 @@ PYBIND11_MODULE(streamrt, m) {
           py::arg("tonemap") = "clamp", py::arg("exposure") = 1.0,
           "save(image, path, colorspace='srgb', tonemap='clamp', exposure=1.0): writes a linear\n"
           "height x width x 3 image in the format of the path's extension (.png, .ppm, .pfm, .exr, .hdr).");
+    m.def("run_command", &run_command, py::arg("args"),
+          "run_command(args) -> int: the streamrt command line with these arguments (python -m streamrt).");
 }

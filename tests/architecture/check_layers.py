@@ -22,7 +22,8 @@ LAYERS = [
     ["stream", "baseline"],
     ["driver"],
     ["distributed"],
-    ["cli", "python", "modules"],
+    ["cli", "modules"],
+    ["python"],  # python -m streamrt runs the command (cli/command.cpp)
 ]
 LEVEL = {folder: i for i, peers in enumerate(LAYERS) for folder in peers}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([a-z_0-9]+)/[^"]+"')
