@@ -303,3 +303,34 @@ def test_a_mesh_from_arrays_takes_vertex_colours():
     bare.mesh(v, t, vertex_colors=True)
     with pytest.raises(streamrt.SceneError, match="in-memory mesh 'memory:0' was made without them"):
         streamrt.render(bare)
+
+
+def test_memory_limit_refuses_a_mesh_before_reading_it_and_is_undone_after(tmp_path):
+    # A 64 x 64 grid of quads (8,192 triangles) as OBJ text, named by the scene's line 3.
+    n = 64
+    lines = ["v %d %d 0" % (i, j) for j in range(n + 1) for i in range(n + 1)]
+    for j in range(n):
+        for i in range(n):
+            a = j * (n + 1) + i + 1
+            lines += ["f %d %d %d" % (a, a + 1, a + n + 2), "f %d %d %d" % (a, a + n + 2, a + n + 1)]
+    (tmp_path / "grid.obj").write_text("\n".join(lines) + "\n")
+    scene = tmp_path / "s.cfg"
+    scene.write_text("image width=16 height=16 degree=0\ncamera eye=32,32,80 look=32,32,0 fov=60\n"
+                     "mesh file=grid.obj color=1,0,0\n")
+    # This process holds far more than 1 MiB already: the budget has no room, and the mesh's
+    # text is the first thing counted.
+    with pytest.raises(MemoryError) as e:
+        streamrt.render(str(scene), memory_limit="1M")
+    # (The mesh's path is shortened in the middle when long, as in every message.)
+    assert str(e.value).startswith("%s:3:11: '" % scene)
+    assert str(e.value).endswith("': its text would need about %.1f KiB, past the memory budget of 0 bytes "
+                                 "(--memory-limit 1.0 MiB less what the process held before); --memory-limit raises it"
+                                 % ((tmp_path / "grid.obj").stat().st_size / 1024))
+    # The limit was for that call alone: the next one renders (the grid fills the view: red).
+    img = streamrt.render(str(scene)).image
+    np.testing.assert_array_equal(img[8, 8], [1, 0, 0])
+    assert streamrt.render(str(scene), memory_limit=64 << 30).image[8, 8].tolist() == [1, 0, 0]
+    with pytest.raises(ValueError, match="memory_limit: 'lots' is not a size"):
+        streamrt.render(str(scene), memory_limit="lots")
+    with pytest.raises(ValueError, match="memory_limit: expected a positive size"):
+        streamrt.render(str(scene), memory_limit=0)
