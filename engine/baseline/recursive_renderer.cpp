@@ -5,7 +5,6 @@
 #include <utility>
 
 #include "mesh/terminator.h"
-#include "render/csg_spans.h"
 #include "render/sampling.h"
 #include "render/texture.h"
 #include "shapes/shapes.h"
@@ -56,6 +55,7 @@ RecursiveRenderer::RecursiveRenderer(const Scene& scene, const RenderSettings& s
         const Object& o = object_at(i);
         objects_[i] = {affine_inverse(o.md), o.param, o.kind, scene.mesh_of(o)};
     });
+    for (const CsgObject& o : scene.csg_objects) csg_boxes_.push_back(csg_node_box(scene, o.root));
     for (const Material& m : scene.materials) {
         materials_.push_back(MaterialT<double>::from(m));
         if (m.texture >= 0) materials_.back().texture = scene.textures[std::size_t(m.texture)]->view();
@@ -91,6 +91,7 @@ bool RecursiveRenderer::test_object(std::size_t i, const RayD& ray, double t_min
 
 int RecursiveRenderer::test_csg(std::size_t k, const RayD& ray, double t_min, double& t_max, Candidate& c,
                                 bool& flip) const {
+    if (!ray_may_meet(csg_boxes_[k], ray.origin, ray.dir, t_min, t_max)) return -1;
     const auto canonical_ray = [&](std::uint32_t shape) {
         const PreparedObject& ob = objects_[csg_base_ + shape];
         return std::pair{apply_point(RowsOf{ob.mi}, ray.origin), apply_vector(RowsOf{ob.mi}, ray.dir)};

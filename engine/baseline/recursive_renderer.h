@@ -11,6 +11,7 @@
 #include "image/framebuffer.h"
 #include "parallel/parallelism.h"
 #include "render/camera_rays.h"
+#include "render/csg_spans.h"
 #include "render/render_stats.h"
 #include "render/sampling.h"
 #include "render/shading.h"
@@ -109,6 +110,7 @@ class RecursiveRenderer {
     CameraRays<double> camera_;
     std::vector<PreparedObject> objects_;  ///< the scene's objects, then its CSG shapes
     std::size_t csg_base_ = 0;             ///< the first CSG shape's index in objects_
+    std::vector<CsgBox> csg_boxes_;        ///< per CSG object: its result's box (csg_node_box)
     std::vector<MaterialT<double>> materials_;  ///< per scene material
     std::vector<LightT<double>> lights_;
 };

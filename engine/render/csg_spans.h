@@ -2,10 +2,14 @@
 // Constructive solid geometry along one line (docs/architecture.md, "CSG"): each solid's span
 // (shapes/solid_span.h) combined node by node into the spans of the result. Scalar code for
 // both engines, in fixed arrays (kMaxCsgShapes): nothing is allocated per ray.
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "scene/scene.h"
+#include "scene/scene_bvh.h"
 #include "shapes/shapes.h"
 
 namespace streamrt {
@@ -125,6 +129,64 @@ SpanT<V> csg_shape_span(ShapeKind kind, const Vec3T<V>& o, const Vec3T<V>& d, V 
         if constexpr (Solid<decltype(shape)>) return solid_span<decltype(shape)>(o, d, param);
         else return {V(1), V(0)};
     });
+}
+
+/// A world box of a CSG result: lo > hi on an axis when it is empty, infinite ends where it
+/// is unbounded.
+struct CsgBox {
+    double lo[3], hi[3];
+
+    bool empty() const { return !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]); }
+    bool bounded() const {
+        return std::isfinite(lo[0] + lo[1] + lo[2]) && std::isfinite(hi[0] + hi[1] + hi[2]);
+    }
+};
+
+/// The world box of node `node`'s result: a union's (and a merge's) holds its children's
+/// boxes, an intersection's is their overlap, a difference's is its first child's (what is
+/// removed adds nothing). A shape without bounds (the plane's half-space) is unbounded.
+inline CsgBox csg_node_box(const Scene& scene, std::uint32_t node) {
+    const CsgNode& n = scene.csg_nodes[node];
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    CsgBox box{};
+    for (std::size_t i = 0; i < n.children.size(); ++i) {
+        const CsgNode::Child& c = n.children[i];
+        CsgBox child{{-kInf, -kInf, -kInf}, {kInf, kInf, kInf}};
+        if (c.is_node) child = csg_node_box(scene, c.index);
+        else accel::object_world_bounds(scene.csg_shapes[c.index], nullptr, child.lo, child.hi);
+        if (i == 0) {
+            box = child;
+            if (n.op == CsgOp::Difference) break;
+            continue;
+        }
+        const bool overlap = n.op == CsgOp::Intersection;
+        for (int a = 0; a < 3; ++a) {
+            box.lo[a] = overlap ? std::max(box.lo[a], child.lo[a]) : std::min(box.lo[a], child.lo[a]);
+            box.hi[a] = overlap ? std::min(box.hi[a], child.hi[a]) : std::max(box.hi[a], child.hi[a]);
+        }
+    }
+    return box;
+}
+
+/// False when the ray o + t d surely stays out of `box` for t in (t_min, t_max), so the
+/// object inside needs no spans. The box is taken as an image of the canonical cube and met
+/// through the cube's own span, widened by a millionth so that rounding never culls a shape
+/// that touches its box; an unbounded or flat box culls nothing.
+template <class V>
+bool ray_may_meet(const CsgBox& box, const Vec3T<V>& o, const Vec3T<V>& d, V t_min, V t_max) {
+    if (box.empty()) return false;
+    if (!box.bounded()) return true;
+    V oc[3], dc[3];
+    const V os[3] = {o.x, o.y, o.z}, ds[3] = {d.x, d.y, d.z};
+    for (int a = 0; a < 3; ++a) {
+        const double centre = 0.5 * (box.lo[a] + box.hi[a]);
+        const double half = 0.5 * (box.hi[a] - box.lo[a]) + 1e-6 * (box.hi[a] - box.lo[a] + std::abs(centre));
+        if (!(half > 0)) return true;
+        oc[a] = (os[a] - V(centre)) / V(half);
+        dc[a] = ds[a] / V(half);
+    }
+    const SpanT<V> s = solid_span<CubeMath>(Vec3T<V>{oc[0], oc[1], oc[2]}, Vec3T<V>{dc[0], dc[1], dc[2]}, V(0));
+    return s.enter <= s.exit && s.enter < t_max && s.exit > t_min;
 }
 
 }  // namespace streamrt

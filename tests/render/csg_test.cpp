@@ -230,3 +230,53 @@ TEST_CASE("csg: combining span lists by hand") {
     combine_spans(CsgOp::Intersection, spans({0, 2}), spans({2, 3}), out);
     CHECK(out.size == 0);
 }
+
+namespace {
+
+void check_box(const CsgBox& b, glm::dvec3 lo, glm::dvec3 hi) {
+    for (int a = 0; a < 3; ++a) {
+        CHECK(b.lo[a] == doctest::Approx(lo[a]).epsilon(1e-12));
+        CHECK(b.hi[a] == doctest::Approx(hi[a]).epsilon(1e-12));
+    }
+}
+
+CsgBox box_of(const std::string& text) {
+    const Scene s = parse(text);
+    return csg_node_box(s, s.csg_objects[0].root);
+}
+
+}  // namespace
+
+TEST_CASE("csg: a node is bounded by its result") {
+    // Intersection: the overlap of the spheres' boxes, |z| <= 0.5.
+    check_box(box_of(kLens), {-2, -2, -0.5}, {2, 2, 0.5});
+    // Difference: the first child's box.
+    check_box(box_of(kPipe), {-1, -2, -1}, {1, 2, 1});
+    // Union: the box of both.
+    check_box(box_of("csg union\n sphere translate=-3,0,0\n sphere translate=3,0,1\nend\n"), {-4, -1, -1}, {4, 1, 2});
+    // Nested: the union's box cut by a cube of half-size 2 at the origin.
+    check_box(box_of("csg intersection\n cube scale=2\n csg union\n  sphere translate=-3,0,0\n  sphere translate=3,0,1\n"
+                     " end\nend\n"),
+              {-2, -1, -1}, {2, 1, 2});
+    // The plane's half-space has no box: cutting keeps the other's, joining loses it.
+    const CsgBox cut = box_of("csg intersection\n plane\n cube\nend\n");
+    check_box(cut, {-1, -1, -1}, {1, 1, 1});
+    CHECK(!box_of("csg union\n plane\n cube\nend\n").bounded());
+    // Children that cannot overlap leave an empty box.
+    CHECK(box_of("csg intersection\n sphere translate=-3,0,0\n sphere translate=3,0,0\nend\n").empty());
+}
+
+TEST_CASE("csg: a ray is culled by its object's box only where it surely stays out") {
+    const CsgBox lens = box_of(kLens);  // z in [-0.5, 0.5]: from z = 10 down, t in [9.5, 10.5]
+    const Vec3d from{0, 0, 10}, down{0, 0, -1};
+    CHECK(!ray_may_meet(lens, from, down, 0.0, 9.4));
+    CHECK(ray_may_meet(lens, from, down, 0.0, 9.6));
+    CHECK(ray_may_meet(lens, from, down, 10.4, kInf));
+    CHECK(!ray_may_meet(lens, from, down, 10.6, kInf));
+    CHECK(!ray_may_meet(lens, Vec3d{2.1, 0, 10}, down, 0.0, kInf));
+    // A ray grazing the box's face is kept: the box is widened, never narrowed.
+    CHECK(ray_may_meet(lens, Vec3d{2, 0, 10}, down, 0.0, kInf));
+    const CsgBox nothing = box_of("csg intersection\n sphere translate=-3,0,0\n sphere translate=3,0,0\nend\n");
+    CHECK(!ray_may_meet(nothing, from, down, 0.0, kInf));
+    CHECK(ray_may_meet(box_of("csg union\n plane\n cube\nend\n"), Vec3d{50, 0, 10}, down, 0.0, kInf));
+}
