@@ -133,7 +133,7 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
         for (std::size_t i = 0; i < csg_base_; ++i)
             if (test_object(i, ray, t_min, best_t, cand)) best = int(i);
     }
-    // CSG objects, outside the hierarchy (a later slice bounds them by their result).
+    // CSG objects, after the hierarchy (each culled by its result's box; not in the hierarchy yet).
     bool flip = false;
     for (std::size_t k = 0; k < scene_->csg_objects.size(); ++k) {
         bool flip_k = false;
