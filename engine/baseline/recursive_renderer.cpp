@@ -1,6 +1,8 @@
 #include "baseline/recursive_renderer.h"
 
 #include <limits>
+#include <tuple>
+#include <utility>
 
 #include "mesh/terminator.h"
 #include "render/sampling.h"
@@ -47,11 +49,13 @@ RecursiveRenderer::RecursiveRenderer(const Scene& scene, const RenderSettings& s
       accel_config_(accel),
       bvh_(accel::SceneBvh::build_for(scene, accel_config_)),
       camera_(CameraRays<double>::from(scene.camera, settings_)) {
-    objects_.resize(scene.objects.size());
-    parallel_for_index(scene.objects.size(), 4096, [&](std::size_t i) {
-        const Object& o = scene.objects[i];
+    csg_base_ = scene.objects.size();
+    objects_.resize(csg_base_ + scene.csg_shapes.size());
+    parallel_for_index(objects_.size(), 4096, [&](std::size_t i) {
+        const Object& o = object_at(i);
         objects_[i] = {affine_inverse(o.md), o.param, o.kind, scene.mesh_of(o)};
     });
+    for (const CsgObject& o : scene.csg_objects) csg_boxes_.push_back(csg_node_box(scene, o.root));
     for (const Material& m : scene.materials) {
         materials_.push_back(MaterialT<double>::from(m));
         if (m.texture >= 0) materials_.back().texture = scene.textures[std::size_t(m.texture)]->view();
@@ -85,6 +89,29 @@ bool RecursiveRenderer::test_object(std::size_t i, const RayD& ray, double t_min
     return true;
 }
 
+int RecursiveRenderer::test_csg(std::size_t k, const RayD& ray, double t_min, double& t_max, Candidate& c,
+                                bool& flip) const {
+    if (!ray_may_meet(csg_boxes_[k], ray.origin, ray.dir, t_min, t_max)) return -1;
+    const auto canonical_ray = [&](std::uint32_t shape) {
+        const PreparedObject& ob = objects_[csg_base_ + shape];
+        return std::pair{apply_point(RowsOf{ob.mi}, ray.origin), apply_vector(RowsOf{ob.mi}, ray.dir)};
+    };
+    CsgSpans<double> spans;
+    csg_node_spans(*scene_, scene_->csg_objects[k].root,
+                   [&](std::uint32_t shape) {
+                       const auto [o, d] = canonical_ray(shape);
+                       const PreparedObject& ob = objects_[csg_base_ + shape];
+                       return csg_shape_span(ob.kind, o, d, ob.param);
+                   },
+                   spans);
+    const CsgBoundary<double>* at = first_boundary(spans, t_min, t_max);
+    if (!at) return -1;
+    t_max = at->t;
+    std::tie(c.o, c.d) = canonical_ray(at->shape);
+    flip = at->flip;
+    return int(csg_base_ + at->shape);
+}
+
 bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max, HitD& hit) const {
     // The handout: intersect in each object's canonical space, [Mi A, Mi u). The direction is
     // not renormalised there, so t means the same distance along the world ray for every
@@ -103,8 +130,17 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
                                                     best = int(h.prim_index[k]);
                                         });
     } else {
-        for (std::size_t i = 0; i < objects_.size(); ++i)
+        for (std::size_t i = 0; i < csg_base_; ++i)
             if (test_object(i, ray, t_min, best_t, cand)) best = int(i);
+    }
+    // CSG objects, after the hierarchy (each culled by its result's box; not in the hierarchy yet).
+    bool flip = false;
+    for (std::size_t k = 0; k < scene_->csg_objects.size(); ++k) {
+        bool flip_k = false;
+        if (const int i = test_csg(k, ray, t_min, best_t, cand, flip_k); i >= 0) {
+            best = i;
+            flip = flip_k;
+        }
     }
     if (best < 0) return false;
     const PreparedObject& ob = objects_[std::size_t(best)];
@@ -114,8 +150,8 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
                          : visit_shape(ob.kind, [&](auto shape) { return shape.template normal<double>(pc, ob.param); });
     hit.object = best;
     hit.t = best_t;
-    hit.point = apply_point(RowsOf{scene_->objects[std::size_t(best)].md}, pc);
-    hit.normal = apply_normal(RowsOf{ob.mi}, nc);
+    hit.point = apply_point(RowsOf{object_at(std::size_t(best)).md}, pc);
+    hit.normal = apply_normal(RowsOf{ob.mi}, flip ? -nc : nc);
     hit.canonical = pc;
     hit.tri = cand.tri;
     hit.bu = cand.u;
@@ -133,6 +169,11 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
         return mesh_any(ob.mesh->view(), ob.mesh->bvh, apply_point(RowsOf{ob.mi}, ray.origin),
                         apply_vector(RowsOf{ob.mi}, ray.dir), 0.0, tm);
     };
+    for (std::size_t k = 0; k < scene_->csg_objects.size(); ++k) {
+        double tm = t_max;
+        bool flip = false;
+        if (test_csg(k, ray, 0.0, tm, o, flip) >= 0) return true;
+    }
     if (bvh_) {
         for (std::uint32_t i : bvh_->unbounded) {
             if (blocks(i, t_max)) return true;
@@ -145,7 +186,7 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
                                                return false;
                                            });
     }
-    for (std::size_t i = 0; i < objects_.size(); ++i)
+    for (std::size_t i = 0; i < csg_base_; ++i)
         if (blocks(i, t_max)) return true;
     return false;
 }
@@ -173,7 +214,7 @@ ColorT<double> RecursiveRenderer::trace(const RayD& ray, int depth, RayCounts& c
     HitD hit;
     if (!closest_hit(ray, 0.0, kInf, hit)) return {s.background.x, s.background.y, s.background.z};
 
-    const Object& object = scene_->objects[std::size_t(hit.object)];
+    const Object& object = object_at(std::size_t(hit.object));
     const ShadeRules<double> rules{
         .degree = s.degree,
         .ambient = s.ambient,

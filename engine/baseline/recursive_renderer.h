@@ -11,6 +11,7 @@
 #include "image/framebuffer.h"
 #include "parallel/parallelism.h"
 #include "render/camera_rays.h"
+#include "render/csg_spans.h"
 #include "render/render_stats.h"
 #include "render/sampling.h"
 #include "render/shading.h"
@@ -94,12 +95,22 @@ class RecursiveRenderer {
     };
     /// Tests object i in its canonical space; shrinks t_max and records it on a closer hit.
     bool test_object(std::size_t i, const RayD& ray, double t_min, double& t_max, Candidate& c) const;
+    /// Tests CSG object k (render/csg_spans.h): the result's first surface in (t_min, t_max)
+    /// shrinks t_max; its shape's number in objects_ is returned (-1: none closer), and
+    /// `flip` says whether the shape's normal is to be turned round there.
+    int test_csg(std::size_t k, const RayD& ray, double t_min, double& t_max, Candidate& c, bool& flip) const;
+    /// Object i: one of the scene's objects, or from csg_base_ on one of its CSG shapes.
+    const Object& object_at(std::size_t i) const {
+        return i < csg_base_ ? scene_->objects[i] : scene_->csg_shapes[i - csg_base_];
+    }
     const Scene* scene_;
     RenderSettings settings_;
     accel::AccelConfig accel_config_;
     std::unique_ptr<accel::SceneBvh> bvh_;  ///< null: the handout's loop over all objects
     CameraRays<double> camera_;
-    std::vector<PreparedObject> objects_;
+    std::vector<PreparedObject> objects_;  ///< the scene's objects, then its CSG shapes
+    std::size_t csg_base_ = 0;             ///< the first CSG shape's index in objects_
+    std::vector<CsgBox> csg_boxes_;        ///< per CSG object: its result's box (csg_node_box)
     std::vector<MaterialT<double>> materials_;  ///< per scene material
     std::vector<LightT<double>> lights_;
 };

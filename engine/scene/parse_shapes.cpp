@@ -46,10 +46,11 @@ std::uint32_t Parser::file_index(const std::string& file) {
 }
 
 std::optional<Arg> Parser::shape(Statement& st, const std::vector<Token>& toks, ShapeKind kind, std::uint32_t file,
-                         MaterialList& materials, Object& out, ObjectLoc& loc) {
+                         MaterialList& materials, Object& out, ObjectLoc& loc, const CsgBlock* within) {
     st.read_args(toks, 1, shape_keys(kind));
     ShapeFields f;
     f.kind = kind;
+    if (within) f.look = within->look;
     const ShapeParam param = shape_param(kind);
     f.param = param.default_value;
     if (const Arg* base = st.find("material")) f.look = lookup_material(st, *base);
@@ -110,6 +111,7 @@ std::optional<Arg> Parser::shape(Statement& st, const std::vector<Token>& toks, 
     }
     if (file_arg) f.mesh = mesh_file(st, *file_arg, f.look.m.texture >= 0, f.look.m.vertex_colors);
     if (kind == ShapeKind::Mesh && !f.mesh) st.fail_here("mesh needs 'file=PATH' (a Wavefront OBJ or PLY file)");
+    if (within) f.md = within->md * f.md;
     if (singular(f.md))
         st.fail_here(std::string(st.word()) +
                      ": the composed transform is singular (or not finite)");

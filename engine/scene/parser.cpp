@@ -146,7 +146,7 @@ void Parser::survey(std::string_view text, Chunk& c) {
         const std::string_view line = line_at(text, pos);
         const std::string_view w = first_word(line);
         if (is_plain_shape(w)) ++c.shapes;
-        else if (w == "include" || w == "mesh" || w == "key") c.sequential_only = true;
+        else if (w == "include" || w == "mesh" || w == "key" || w == "csg") c.sequential_only = true;
         else if (!w.empty()) c.others.emplace_back(pos, c.lines);
         pos += line.size() + 1;
         ++c.lines;
@@ -183,7 +183,15 @@ void Parser::statement(std::string_view line, const std::string& file, int line_
     if (toks.empty()) return;
     Statement st(file, line_no, toks[0], scratch.args);
     const auto w = toks[0].text;
-    if (w == "image") image(st, toks);
+    const bool in_csg_block = csg_blocks_.size() > file_csg_base_;
+    if (w == "csg") csg(st, toks);
+    else if (w == "end") csg_end(st, toks);
+    else if (const auto kind = w == "mesh" ? ShapeKind::Mesh : shape_from_word(w)) {
+        if (in_csg_block) csg_child(st, toks, *kind);
+        else one_pass_shape(st, toks, *kind);
+    } else if (in_csg_block && std::find(kStatementWords.begin(), kStatementWords.end(), w) != kStatementWords.end())
+        st.fail_here("'" + std::string(w) + "' cannot be inside a csg block (it holds shapes and csg blocks, then 'end')");
+    else if (w == "image") image(st, toks);
     else if (w == "ambient") ambient(st, toks);
     else if (w == "background") background(st, toks);
     else if (w == "camera") camera(st, toks);
@@ -191,8 +199,7 @@ void Parser::statement(std::string_view line, const std::string& file, int line_
     else if (w == "material") material(st, toks);
     else if (w == "include") include(st, toks, depth);
     else if (w == "key") key(st, toks);
-    else if (w == "mesh") one_pass_shape(st, toks, ShapeKind::Mesh);
-    else if (auto kind = shape_from_word(w)) one_pass_shape(st, toks, *kind);
+
     else {
         const auto near = nearest_name(w, kStatementWords);
         st.fail_here("unknown statement " + quote(w) + (near ? ": did you mean '" + *near + "'?" : std::string()) +

@@ -100,6 +100,8 @@ class Parser {
                    int depth) {
         ++files_;
         open_.push_back(id);
+        const std::size_t outer_csg_base = file_csg_base_;
+        file_csg_base_ = csg_blocks_.size();
         if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 BOM
         int line_no = 0;
         std::size_t pos = 0;
@@ -110,6 +112,8 @@ class Parser {
             statement(text.substr(pos, nl - pos), display, line_no, depth, scratch_);
             pos = nl + 1;
         }
+        check_csg_closed();
+        file_csg_base_ = outer_csg_base;
         open_.pop_back();
     }
 
@@ -186,6 +190,29 @@ class Parser {
         std::optional<std::uint32_t> mesh;  // index in scene.meshes
     };
 
+    /// A `csg` block being read (docs/scene-format.md, "CSG"): its node so far, what its
+    /// children inherit (its appearance; its transform, applied after theirs) and where its
+    /// `csg` word is.
+    struct CsgBlock {
+        CsgNode node;
+        Appearance look;
+        glm::dmat4 md{1.0};
+        SourceLoc at;
+        std::uint32_t file = 0;
+        int shapes = 0;  // the outermost block's: all its object's shapes (kMaxCsgShapes)
+    };
+    std::vector<CsgBlock> csg_blocks_;  // innermost last
+    std::size_t file_csg_base_ = 0;     // blocks opened before the file being read: not its to end
+
+    /// csg OP keys...: opens a block.
+    void csg(Statement& st, const std::vector<Token>& toks);
+    /// end: closes the innermost block, checked, into its parent or the scene.
+    void csg_end(Statement& st, const std::vector<Token>& toks);
+    /// A shape statement inside a block: one of its children.
+    void csg_child(Statement& st, const std::vector<Token>& toks, ShapeKind kind);
+    /// After a file: a block it opened and did not end is an error at that block's `csg`.
+    void check_csg_closed() const;
+
     /// The one place an Object is built from a checked shape statement, in place: `obj` and
     /// `loc` are its slots in scene.objects and scene.object_locs.
     static void make_object(const Statement& st, const ShapeFields& f, std::uint32_t file, MaterialList& materials,
@@ -200,8 +227,10 @@ class Parser {
     std::uint32_t last_file_ = 0;
 
     /// Reads a shape statement into `out` and `loc`; its `name=` argument, if any.
+    /// Inside a csg block (`within`), the shape starts from the block's appearance and the
+    /// block's transform applies after its own.
     std::optional<Arg> shape(Statement& st, const std::vector<Token>& toks, ShapeKind kind, std::uint32_t file,
-                             MaterialList& materials, Object& out, ObjectLoc& loc);
+                             MaterialList& materials, Object& out, ObjectLoc& loc, const CsgBlock* within = nullptr);
 
     /// The file `a` names, relative to the statement's file.
     static fs::path target_of(const Statement& st, const Arg& a);

@@ -58,6 +58,31 @@ struct ObjectLoc {
     std::int32_t line = 0, column = 0;
 };
 
+/// Constructive solid geometry (docs/scene-format.md, "CSG"): how a node combines the solids
+/// of its children. Merge is a union that keeps only the result's outer surface (for glass).
+enum class CsgOp : std::uint8_t { Union, Intersection, Difference, Merge };
+inline constexpr EnumName<CsgOp> kCsgOpNames[] = {
+    {CsgOp::Union, "union"}, {CsgOp::Intersection, "intersection"}, {CsgOp::Difference, "difference"},
+    {CsgOp::Merge, "merge"}};
+
+/// One `csg` block: its operation over its children, in written order (a difference is the
+/// first child minus the others). A child is a shape (Scene::csg_shapes) or another node.
+struct CsgNode {
+    struct Child {
+        bool is_node = false;
+        std::uint32_t index = 0;  ///< into Scene::csg_nodes or Scene::csg_shapes
+    };
+    CsgOp op = CsgOp::Union;
+    std::vector<Child> children;
+};
+
+/// A top-level `csg` block: the object a renderer traces (its root node and the block's
+/// statement, for messages).
+struct CsgObject {
+    std::uint32_t root = 0;  ///< into Scene::csg_nodes
+    ObjectLoc loc;
+};
+
 /// The handout's canonical camera (eye (0,0,1), screen [-1,1]^2 in z=0) placed by Md.
 /// Two forms: Md given directly (homothety rx, ry, df then the listed transforms), or
 /// look-at (eye, look, up, vertical fov), converted to Md once the image aspect is known.
@@ -160,6 +185,12 @@ struct Scene {
     std::vector<Material> materials;  ///< deduplicated; Object::material indexes it
     std::vector<std::shared_ptr<const Mesh>> meshes;  ///< one per OBJ file; Object::mesh indexes it
     std::vector<std::shared_ptr<const Texture>> textures;  ///< one per image file; Material::texture indexes it
+    // CSG (docs/scene-format.md, "CSG"): the objects made of `csg` blocks, their nodes and
+    // their shapes (in world space, with their own material; apart from `objects`, which a
+    // renderer traces one by one). Empty in a scene without CSG.
+    std::vector<CsgObject> csg_objects;
+    std::vector<CsgNode> csg_nodes;
+    std::vector<Object> csg_shapes;
     /// Cold data, for messages only: the statement of each object (same indexing as objects).
     std::vector<ObjectLoc> object_locs;
     std::vector<std::string> files;  ///< the files objects came from (ObjectLoc::file)
@@ -182,6 +213,11 @@ struct Scene {
     /// The statement that made object i.
     SourceLoc where(std::size_t i) const {
         const ObjectLoc& l = object_locs[i];
+        return SourceLoc{files[l.file], l.line, l.column};
+    }
+    /// The `csg` statement of CSG object i.
+    SourceLoc csg_where(std::size_t i) const {
+        const ObjectLoc& l = csg_objects[i].loc;
         return SourceLoc{files[l.file], l.line, l.column};
     }
     /// Throws SceneError at the statement of the first object beyond `limit` (kMaxSceneObjects

@@ -46,6 +46,8 @@ inline std::vector<std::string_view> join(std::initializer_list<std::vector<std:
 inline const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExplicitCameraKeys, kLensKeys, {"name"}});
 inline const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
 inline const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys, {"name"}});
+/// A csg block's keys: what its children inherit (docs/scene-format.md, "CSG").
+inline const std::vector<std::string_view> kCsgKeys = join({{"material"}, kMaterialKeys, kTransformKeys});
 inline const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth", "materials"}});
 // The `key` statement's keys, by what the name names (animation, scene/animation.h).
 inline const std::vector<std::string_view> kObjectKeyKeys = {"frame", "translate", "rotate", "scale"};
@@ -143,6 +145,7 @@ inline const std::vector<std::string> kStatementWords = [] {
     CanonicalShapes::for_each([&](auto s) { words.emplace_back(s.name); });
     words.emplace_back("mesh");
     words.emplace_back("include");
+    words.emplace_back("csg");
     return words;
 }();
 inline const std::string kStatementList = [] {

@@ -3,6 +3,7 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "shapes/solid_span.h"
 #include "simd/isa_namespace.h"
 
 namespace streamrt {
@@ -41,6 +42,8 @@ struct ConeMath {
         best = keep_cap(best, o, d, V(-1), t_min);  // the base
         return miss_if_unchanged(best, t_max);
     }
+    /// A convex closed solid: its inside along a line lies between hit_t's two ends (solid_span.h).
+    static constexpr bool kConvexSolid = true;
     /// Gradient of the side, (x, k^2 (1 - y), z); the base cap below; +y at the apex itself.
     template <class V>
     static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) {

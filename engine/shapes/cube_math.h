@@ -3,6 +3,7 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "shapes/solid_span.h"
 #include "simd/isa_namespace.h"
 
 namespace streamrt {
@@ -39,6 +40,8 @@ struct CubeMath {
         best = keep_closest(best, t_far, spans, t_min);  // from inside, t_near < t_min
         return miss_if_unchanged(best, t_max);
     }
+    /// A convex closed solid: its inside along a line lies between hit_t's two ends (solid_span.h).
+    static constexpr bool kConvexSolid = true;
     /// The face a point is on: the axis with the largest |coordinate| (x, then y, on ties).
     template <class V>
     struct Face {

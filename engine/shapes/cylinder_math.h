@@ -3,6 +3,7 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "shapes/solid_span.h"
 #include "simd/isa_namespace.h"
 
 namespace streamrt {
@@ -35,6 +36,8 @@ struct CylinderMath {
         best = keep_cap(best, o, d, V(1), t_min);
         return miss_if_unchanged(best, t_max);
     }
+    /// A convex closed solid: its inside along a line lies between hit_t's two ends (solid_span.h).
+    static constexpr bool kConvexSolid = true;
     /// Cap or side, whichever the point is closer to being outside of.
     template <class V>
     static Vec3T<V> normal(const Vec3T<V>& p, V /*param*/) {

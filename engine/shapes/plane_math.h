@@ -3,6 +3,7 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "shapes/solid_span.h"
 #include "simd/isa_namespace.h"
 
 namespace streamrt {
@@ -26,6 +27,18 @@ struct PlaneMath {
         // poisoned ray misses instead of producing a NaN hit point.
         const V rest = o.x + o.z + d.x + d.z;
         return miss_if_unchanged(keep_closest(t_max, t, rest - rest == V(0), t_min), t_max);
+    }
+    /// As a solid, the half-space y <= 0 below the plane (its normal points out of it, as in
+    /// POV-Ray). A line rising through the plane is inside before the crossing, a falling one
+    /// after it; a line parallel to it is inside everywhere (y <= 0) or nowhere.
+    template <class V>
+    static SpanT<V> inside_span(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/) {
+        using namespace simd;
+        const V inf = infinity_v<V>();
+        const V t = -o.y / d.y;
+        const auto rising = d.y > V(0), falling = d.y < V(0), below = o.y <= V(0);
+        const V all = select(below, -inf, inf), none = select(below, inf, -inf);
+        return {select(rising, -inf, select(falling, t, all)), select(rising, t, select(falling, inf, none))};
     }
     template <class V>
     static Vec3T<V> normal(const Vec3T<V>& /*p*/, V /*param*/) { return {V(0), V(1), V(0)}; }

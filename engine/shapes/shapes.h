@@ -165,6 +165,15 @@ constexpr CanonicalBounds canonical_bounds(ShapeKind k, double param) {
     return b;
 }
 
+/// Whether the kind is a solid a csg block may hold (shapes/solid_span.h; not Mesh, yet).
+constexpr bool shape_is_solid(ShapeKind k) {
+    bool solid = false;
+    CanonicalShapes::for_each([&](auto s) {
+        if (s.kind == k) solid = Solid<decltype(s)>;
+    });
+    return solid;
+}
+
 /// Whether the kernels solve this kind in double lanes (half as many per register).
 constexpr bool shape_computes_in_double(ShapeKind k) {
     bool dbl = false;

@@ -3,6 +3,7 @@
 #include "core/vec3.h"
 #include "shapes/quadratic.h"
 #include "shapes/shape_traits.h"
+#include "shapes/solid_span.h"
 #include "simd/isa_namespace.h"
 
 namespace streamrt {
@@ -33,6 +34,8 @@ struct SphereMath {
         best = keep_closest(best, r.t1, r.valid, t_min);
         return miss_if_unchanged(best, t_max);
     }
+    /// A convex closed solid: its inside along a line lies between hit_t's two ends (solid_span.h).
+    static constexpr bool kConvexSolid = true;
     /// False only where the ray's line surely misses the unit sphere; a packet kernel skips
     /// hit_t (a division, a square root and two more divisions) when no lane may hit, and where
     /// any lane may, hit_t decides every lane as before, so the answers keep their bits.

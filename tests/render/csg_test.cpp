@@ -1,0 +1,282 @@
+// Constructive solid geometry traced by the recursive engine (render/csg_spans.h): hits at
+// points worked out by hand, normals facing out of the result, shadow rays, and set identities
+// that must hold pixel for pixel.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include "baseline/recursive_renderer.h"
+#include "driver/render.h"
+#include "render/csg_spans.h"
+#include "scene/parser.h"
+
+using namespace streamrt;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+Scene parse(const std::string& text) { return parse_scene(text, "t.cfg"); }
+
+/// The closest hit of the ray from `from` along unit `dir`, past t_min; false on a miss.
+bool hit_of(const Scene& scene, Vec3d from, Vec3d dir, HitD& hit, double t_min = 0.0) {
+    const RecursiveRenderer r(scene);
+    return r.closest_hit(RayD{from, dir}, t_min, kInf, hit);
+}
+
+void check_vec(const Vec3d& v, double x, double y, double z) {
+    CHECK(v.x == doctest::Approx(x).epsilon(1e-9));
+    CHECK(v.y == doctest::Approx(y).epsilon(1e-9));
+    CHECK(v.z == doctest::Approx(z).epsilon(1e-9));
+}
+
+// A biconvex lens: spheres of radius 2 centred at z = -1.5 and z = +1.5, intersected. Along the
+// axis it spans z in [-0.5, 0.5]; at x = 1 it spans |z| <= sqrt(3) - 1.5.
+const char* const kLens =
+    "csg intersection\n"
+    "  sphere scale=2,2,2 translate=0,0,-1.5\n"
+    "  sphere scale=2,2,2 translate=0,0,1.5\n"
+    "end\n";
+
+// A pipe: a cylinder of radius 1 and height 4 minus a longer one of radius 0.8.
+const char* const kPipe =
+    "csg difference\n"
+    "  cylinder scale=1,2,1\n"
+    "  cylinder scale=0.8,2.1,0.8\n"
+    "end\n";
+
+// A die with one dimple: the cube [-1,1]^3 minus a sphere of radius 0.5 at z = 1.2, which cuts
+// a cap of depth 0.3 into the face z = 1.
+const char* const kDie =
+    "csg difference\n"
+    "  cube\n"
+    "  sphere scale=0.5,0.5,0.5 translate=0,0,1.2\n"
+    "end\n";
+
+}  // namespace
+
+TEST_CASE("csg: a ray along a lens's axis meets the two caps at their vertices") {
+    const Scene s = parse(kLens);
+    HitD in, out;
+    REQUIRE(hit_of(s, {0, 0, 10}, {0, 0, -1}, in));
+    CHECK(in.t == doctest::Approx(9.5).epsilon(1e-12));
+    check_vec(in.point, 0, 0, 0.5);
+    check_vec(in.normal, 0, 0, 1);  // the cap of the sphere centred at z = -1.5
+    REQUIRE(hit_of(s, {0, 0, 10}, {0, 0, -1}, out, in.t + 1e-9));
+    CHECK(out.t == doctest::Approx(10.5).epsilon(1e-12));
+    check_vec(out.normal, 0, 0, -1);  // leaving: the outward normal points along the ray
+    CHECK(!hit_of(s, {0, 0, 10}, {0, 0, -1}, out, out.t + 1e-9));
+}
+
+TEST_CASE("csg: a ray parallel to a lens's axis meets the caps where the spheres say") {
+    const Scene s = parse(kLens);
+    const double z = std::sqrt(3.0) - 1.5;
+    HitD in, out;
+    REQUIRE(hit_of(s, {1, 0, 10}, {0, 0, -1}, in));
+    CHECK(in.t == doctest::Approx(10 - z).epsilon(1e-12));
+    check_vec(in.point, 1, 0, z);
+    check_vec(in.normal, 0.5, 0, std::sqrt(3.0) / 2);  // from the centre (0, 0, -1.5), radius 2
+    REQUIRE(hit_of(s, {1, 0, 10}, {0, 0, -1}, out, in.t + 1e-9));
+    check_vec(out.point, 1, 0, -z);
+    check_vec(out.normal, 0.5, 0, -std::sqrt(3.0) / 2);
+    // Beyond the rim (|x| > sqrt(4 - 1.5^2) = 1.3229) the spheres do not overlap.
+    CHECK(!hit_of(s, {1.33, 0, 10}, {0, 0, -1}, in));
+}
+
+TEST_CASE("csg: a ray through a pipe's hole hits nothing, and its walls face out of the pipe") {
+    const Scene s = parse(kPipe);
+    HitD hit;
+    CHECK(!hit_of(s, {0, 10, 0}, {0, -1, 0}, hit));
+    CHECK(!hit_of(s, {0.3, 10, 0.3}, {0, -1, 0}, hit));
+    // Down onto the rim's annulus at x = 0.9: the outer cylinder's top cap at y = 2.
+    REQUIRE(hit_of(s, {0.9, 10, 0}, {0, -1, 0}, hit));
+    CHECK(hit.t == doctest::Approx(8.0).epsilon(1e-12));
+    check_vec(hit.normal, 0, 1, 0);
+    // Across the pipe: into the outer wall at x = -1, out of the material at the inner wall
+    // x = -0.8, whose normal (the removed cylinder's, turned round) points into the hole.
+    REQUIRE(hit_of(s, {-5, 0, 0}, {1, 0, 0}, hit));
+    CHECK(hit.t == doctest::Approx(4.0).epsilon(1e-12));
+    check_vec(hit.normal, -1, 0, 0);
+    REQUIRE(hit_of(s, {-5, 0, 0}, {1, 0, 0}, hit, hit.t + 1e-9));
+    CHECK(hit.t == doctest::Approx(4.2).epsilon(1e-12));
+    check_vec(hit.normal, 1, 0, 0);
+    REQUIRE(hit_of(s, {-5, 0, 0}, {1, 0, 0}, hit, hit.t + 1e-9));
+    CHECK(hit.t == doctest::Approx(5.8).epsilon(1e-12));  // into the far wall at x = 0.8
+    check_vec(hit.normal, -1, 0, 0);
+}
+
+TEST_CASE("csg: a ray into a die's dimple hits the sphere's surface, normal out of the die") {
+    const Scene s = parse(kDie);
+    HitD hit;
+    // Down the axis: the dimple's bottom at z = 1.2 - 0.5 = 0.7.
+    REQUIRE(hit_of(s, {0, 0, 5}, {0, 0, -1}, hit));
+    CHECK(hit.t == doctest::Approx(4.3).epsilon(1e-12));
+    check_vec(hit.normal, 0, 0, 1);
+    // At x = 0.3: the sphere at z = 1.2 - 0.4 = 0.8, where its own normal is (0.6, 0, -0.8);
+    // the die's surface there faces the other way, up and toward the axis.
+    REQUIRE(hit_of(s, {0.3, 0, 5}, {0, 0, -1}, hit));
+    CHECK(hit.t == doctest::Approx(4.2).epsilon(1e-12));
+    check_vec(hit.point, 0.3, 0, 0.8);
+    check_vec(hit.normal, -0.6, 0, 0.8);
+    CHECK(s.csg_shapes[std::size_t(hit.object) - s.objects.size()].kind == ShapeKind::Sphere);
+    // Outside the dimple (x = 0.6 > 0.4, the dimple's radius at z = 1) the cube's face.
+    REQUIRE(hit_of(s, {0.6, 0, 5}, {0, 0, -1}, hit));
+    CHECK(hit.t == doctest::Approx(4.0).epsilon(1e-12));
+    check_vec(hit.normal, 0, 0, 1);
+}
+
+TEST_CASE("csg: shadow rays are blocked by the result, not by what was removed") {
+    const Scene s = parse(kPipe);
+    const RecursiveRenderer r(s);
+    CHECK(!r.occluded(RayD{{0, 10, 0}, {0, -1, 0}}, 20.0));  // down the hole
+    CHECK(r.occluded(RayD{{-5, 0, 0}, {1, 0, 0}}, 20.0));    // through the wall
+    CHECK(!r.occluded(RayD{{-5, 0, 0}, {1, 0, 0}}, 3.9));    // stops short of the wall
+    // From inside the hole, sideways within the removed cylinder: the wall is 0.8 away.
+    CHECK(!r.occluded(RayD{{0, 0, 0}, {1, 0, 0}}, 0.7));
+    CHECK(r.occluded(RayD{{0, 0, 0}, {1, 0, 0}}, 0.9));
+}
+
+namespace {
+
+// A lit scene around a CSG object or plain shapes, small enough to compare every pixel.
+std::string lit_scene(const std::string& objects) {
+    return "image width=48 height=32 degree=5\n"
+           "camera eye=0,1,6 look=0,0,0 fov=40\n"
+           "light point pos=4,5,6 color=1,1,1\n"
+           "plane translate=0,-1.5,0 color=0.5,0.5,0.5\n" +
+           objects;
+}
+
+Framebuffer recursive_image(const std::string& text) {
+    Parallelism par(1);
+    return render_scene(parse(text), EngineKind::Recursive, par).image;
+}
+
+/// The number of pixels whose colour differs at all.
+int differing_pixels(const Framebuffer& a, const Framebuffer& b) {
+    REQUIRE(a.width == b.width);
+    REQUIRE(a.height == b.height);
+    int n = 0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x)
+            for (int c = 0; c < 3; ++c)
+                if (a.pixel(x, y)[c] != b.pixel(x, y)[c]) {
+                    ++n;
+                    break;
+                }
+    return n;
+}
+
+}  // namespace
+
+TEST_CASE("csg: A union B and B union A give the same picture") {
+    const std::string a = "  sphere translate=-0.5,0,0 color=1,0,0\n";
+    const std::string b = "  cube scale=0.7,0.7,0.7 translate=0.4,0.2,0 color=0,0,1 refl=0.3\n";
+    const Framebuffer ab = recursive_image(lit_scene("csg union\n" + a + b + "end\n"));
+    const Framebuffer ba = recursive_image(lit_scene("csg union\n" + b + a + "end\n"));
+    CHECK(differing_pixels(ab, ba) == 0);
+    // Not a picture of nothing: the object covers pixels the floor alone does not.
+    CHECK(differing_pixels(ab, recursive_image(lit_scene(""))) > 100);
+}
+
+TEST_CASE("csg: a difference with a disjoint child is its first child alone") {
+    const std::string first = "sphere color=1,0.5,0 spec=0.5 shininess=20";
+    const Framebuffer plain = recursive_image(lit_scene(first + "\n"));
+    const Framebuffer csg =
+        recursive_image(lit_scene("csg difference\n  " + first + "\n  cylinder translate=10,0,0\nend\n"));
+    CHECK(differing_pixels(plain, csg) == 0);
+    CHECK(differing_pixels(plain, recursive_image(lit_scene(""))) > 100);
+}
+
+TEST_CASE("csg: the stream engine refuses csg objects at their block for now") {
+    const Scene s = parse("sphere\n\n  csg union\n  sphere\n  end\n");
+    Parallelism par(1);
+    try {
+        render_scene(s, EngineKind::Stream, par);
+        FAIL("expected a SceneError");
+    } catch (const SceneError& e) {
+        CHECK(e.where().line == 3);
+        CHECK(e.where().column == 3);
+        CHECK(std::string(e.what()).find("--engine recursive") != std::string::npos);
+    }
+}
+
+TEST_CASE("csg: combining span lists by hand") {
+    const auto spans = [](std::initializer_list<double> ts) {
+        CsgSpans<double> s;
+        std::uint32_t shape = 0;
+        for (const double t : ts) s.b[std::size_t(s.size++)] = {t, shape++, false};
+        return s;
+    };
+    const CsgSpans<double> a = spans({0, 4, 6, 8});  // shapes 0 .. 3
+    const CsgSpans<double> b = spans({2, 7});        // shapes 0, 1 of b
+    CsgSpans<double> out;
+    const auto ts = [&] {
+        std::string s;
+        for (int i = 0; i < out.size; ++i)
+            s += std::to_string(int(out.b[std::size_t(i)].t)) + (out.b[std::size_t(i)].flip ? "f " : " ");
+        return s;
+    };
+    combine_spans(CsgOp::Union, a, b, out);
+    CHECK(ts() == "0 8 ");
+    combine_spans(CsgOp::Intersection, a, b, out);
+    CHECK(ts() == "2 4 6 7 ");
+    combine_spans(CsgOp::Difference, a, b, out);
+    CHECK(ts() == "0 2f 7f 8 ");  // b's surfaces bound the result from its far side
+    combine_spans(CsgOp::Difference, b, a, out);
+    CHECK(ts() == "4f 6f ");
+    // Spans that touch leave nothing of zero length behind.
+    combine_spans(CsgOp::Intersection, spans({0, 2}), spans({2, 3}), out);
+    CHECK(out.size == 0);
+}
+
+namespace {
+
+void check_box(const CsgBox& b, glm::dvec3 lo, glm::dvec3 hi) {
+    for (int a = 0; a < 3; ++a) {
+        CHECK(b.lo[a] == doctest::Approx(lo[a]).epsilon(1e-12));
+        CHECK(b.hi[a] == doctest::Approx(hi[a]).epsilon(1e-12));
+    }
+}
+
+CsgBox box_of(const std::string& text) {
+    const Scene s = parse(text);
+    return csg_node_box(s, s.csg_objects[0].root);
+}
+
+}  // namespace
+
+TEST_CASE("csg: a node is bounded by its result") {
+    // Intersection: the overlap of the spheres' boxes, |z| <= 0.5.
+    check_box(box_of(kLens), {-2, -2, -0.5}, {2, 2, 0.5});
+    // Difference: the first child's box.
+    check_box(box_of(kPipe), {-1, -2, -1}, {1, 2, 1});
+    // Union: the box of both.
+    check_box(box_of("csg union\n sphere translate=-3,0,0\n sphere translate=3,0,1\nend\n"), {-4, -1, -1}, {4, 1, 2});
+    // Nested: the union's box cut by a cube of half-size 2 at the origin.
+    check_box(box_of("csg intersection\n cube scale=2\n csg union\n  sphere translate=-3,0,0\n  sphere translate=3,0,1\n"
+                     " end\nend\n"),
+              {-2, -1, -1}, {2, 1, 2});
+    // The plane's half-space has no box: cutting keeps the other's, joining loses it.
+    const CsgBox cut = box_of("csg intersection\n plane\n cube\nend\n");
+    check_box(cut, {-1, -1, -1}, {1, 1, 1});
+    CHECK(!box_of("csg union\n plane\n cube\nend\n").bounded());
+    // Children that cannot overlap leave an empty box.
+    CHECK(box_of("csg intersection\n sphere translate=-3,0,0\n sphere translate=3,0,0\nend\n").empty());
+}
+
+TEST_CASE("csg: a ray is culled by its object's box only where it surely stays out") {
+    const CsgBox lens = box_of(kLens);  // z in [-0.5, 0.5]: from z = 10 down, t in [9.5, 10.5]
+    const Vec3d from{0, 0, 10}, down{0, 0, -1};
+    CHECK(!ray_may_meet(lens, from, down, 0.0, 9.4));
+    CHECK(ray_may_meet(lens, from, down, 0.0, 9.6));
+    CHECK(ray_may_meet(lens, from, down, 10.4, kInf));
+    CHECK(!ray_may_meet(lens, from, down, 10.6, kInf));
+    CHECK(!ray_may_meet(lens, Vec3d{2.1, 0, 10}, down, 0.0, kInf));
+    // A ray grazing the box's face is kept: the box is widened, never narrowed.
+    CHECK(ray_may_meet(lens, Vec3d{2, 0, 10}, down, 0.0, kInf));
+    const CsgBox nothing = box_of("csg intersection\n sphere translate=-3,0,0\n sphere translate=3,0,0\nend\n");
+    CHECK(!ray_may_meet(nothing, from, down, 0.0, kInf));
+    CHECK(ray_may_meet(box_of("csg union\n plane\n cube\nend\n"), Vec3d{50, 0, 10}, down, 0.0, kInf));
+}
