@@ -47,7 +47,7 @@ inline std::string check_error(const SceneError& e) {
 inline std::string check_scene(const Scene& sc) {
     const RenderSettings& s = sc.settings;
     if (s.width < 1 || s.width > 32768 || s.height < 1 || s.height > 32768) return "image size out of range";
-    if (s.spp < 1 || s.spp > 65536 || s.depth < 0 || s.depth > 256 || s.degree < 0 || s.degree > 5)
+    if (s.spp < 1 || s.spp > 65536 || s.depth < 0 || s.depth > 256 || s.degree < 0 || s.degree > 6)
         return "spp, depth or degree out of range";
     if (!(s.ambient >= 0 && s.ambient <= 1) || !finite(s.background) || s.output.empty())
         return "ambient, background or output invalid";
