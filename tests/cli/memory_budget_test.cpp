@@ -14,6 +14,7 @@
 
 #include "cli/cli_support.h"
 #include "core/memory_budget.h"
+#include "error_of.h"
 #include "meshes/gzip_member.h"
 #include "mesh/mesh.h"
 #include "mesh/mesh_bytes.h"
@@ -22,18 +23,11 @@
 using namespace streamrt;
 using namespace cli_support;
 
+using streamrt::test::error_of;
+
 namespace {
 
 constexpr double kMiB = 1024.0 * 1024.0;
-
-std::string error_of(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "no error";
-}
 
 
 /// A binary (little-endian) or ASCII PLY file of positions and triangles.

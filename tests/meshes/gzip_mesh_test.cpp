@@ -12,6 +12,7 @@
 #include <string>
 
 #include "driver/render.h"
+#include "error_of.h"
 #include "meshes/gzip_member.h"
 #include "mesh/mesh.h"
 #include "mesh/mesh_bytes.h"
@@ -22,6 +23,8 @@
 using namespace streamrt;
 namespace fs = std::filesystem;
 
+using streamrt::test::error_of;
+
 namespace {
 
 std::string gzip(const std::string& data) { return test::gzip_member(data); }
@@ -31,15 +34,6 @@ std::string slurp(const fs::path& p) {
     std::ostringstream s;
     s << in.rdbuf();
     return s.str();
-}
-
-std::string error_of(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "no error";
 }
 
 struct Dir {
