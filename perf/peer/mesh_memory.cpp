@@ -139,10 +139,11 @@ int main(int argc, char** argv) {
     const double resident = (status_kib("VmRSS:") - start_kib) * 1024.0;
     const double peak = (status_kib("VmHWM:") - start_kib) * 1024.0;
     const double n = double(triangles);
+    char build_text[32] = "-";  // Embree's monitor only
+    if (build > 0) std::snprintf(build_text, sizeof build_text, "%.1f", build / n);
     std::printf("%s%s: %zu triangles, %zu vertices; bytes a triangle: held %.1f, build %s, resident %.1f, peak %.1f\n",
                 engine.c_str(), engine == "embree" ? (quality == RTC_BUILD_QUALITY_HIGH ? " (high)" : " (medium)") : "",
-                triangles, vertices, held / n, build > 0 ? std::to_string(build / n).substr(0, 5).c_str() : "-",
-                resident / n, peak / n);
+                triangles, vertices, held / n, build_text, resident / n, peak / n);
     if (scene) rtcReleaseScene(scene);
     if (dev) rtcReleaseDevice(dev);
     return 0;
