@@ -76,7 +76,15 @@ SCENES = {
     "million": os.path.join(PEER_DIR, "million.cfg"),
     "whitted": os.path.join(pc.ROOT, "scenes", "whitted.cfg"),
     "random_spheres": os.path.join(pc.ROOT, "scenes", "random_spheres.cfg"),
+    # CSG (docs/scene-format.md, "CSG"); the lens's Fresnel glass is not translated, so it is
+    # in the degree-0 check (--flat) only
+    "csg_lens": os.path.join(pc.ROOT, "scenes", "csg", "lens.cfg"),
+    "csg_pipe": os.path.join(pc.ROOT, "scenes", "csg", "pipe.cfg"),
+    "csg_die": os.path.join(pc.ROOT, "scenes", "csg", "die.cfg"),
+    "csg_hollow": os.path.join(pc.ROOT, "scenes", "csg", "hollow.cfg"),
+    "csg_tree": os.path.join(pc.ROOT, "scenes", "csg", "tree.cfg"),
 }
+CSG_SCENES = [k for k in SCENES if k.startswith("csg_")]
 MODES = {
     # name: (POV-Ray adc_bailout or None for its default, streamrt --cutoff or None for its default)
     "default": (None, None),
@@ -245,14 +253,21 @@ MATERIAL_KEYS = set(DEFAULT_MATERIAL) | {"fresnel", "texture", "uvscale"}
 TRANSFORM_KEYS = {"scale", "rotate_x", "rotate_y", "rotate_z", "translate"}
 
 
-def read_cfg(path):
+SHAPES = ("sphere", "plane", "cube", "cylinder", "cone")  # canonical shapes POV-Ray has as primitives
+CSG_OPS = ("union", "intersection", "difference", "merge")
+
+
+def read_cfg(path, flat=False):
     """The scene as a dict (image, ambient, background, camera, lights, objects) for the
-    statements the peer scenes use; anything else raises Unsupported (file:line)."""
+    statements the peer scenes use; anything else raises Unsupported (file:line). `csg` blocks
+    become objects of kind "csg" (op, children, md) whose leaves carry their resolved material;
+    flat: a degree-0 picture is wanted, so material keys other than the colours are ignored."""
     scene = dict(image=dict(width=640, height=480, spp=1, depth=5, degree=5, cutoff=0.001), ambient=0.1,
                  background=[0.0, 0.0, 0.0], camera=dict(eye=[0.0, 0.0, 5.0], look=[0.0, 0.0, 0.0],
                                                           up=[0.0, 1.0, 0.0], fov=45.0),
                  lights=[], objects=[])
     materials = {}
+    blocks = []  # the open csg blocks, outermost first
     base = os.path.dirname(os.path.abspath(path))
     with open(path) as f:
         for n, raw in enumerate(f, 1):
@@ -267,9 +282,16 @@ def read_cfg(path):
             if stmt == "background":
                 scene["background"] = vec(rest[0])
                 continue
-            if stmt == "material":
+            if stmt == "end":
+                if not blocks:
+                    raise Unsupported("%s: end with no csg block" % where)
+                node = blocks.pop()
+                (blocks[-1]["children"] if blocks else scene["objects"]).append(node)
+                continue
+            name = None
+            if stmt in ("material", "csg"):
                 if not rest:
-                    raise Unsupported("%s: material without a name" % where)
+                    raise Unsupported("%s: %s without a name" % (where, stmt))
                 name, rest = rest[0], rest[1:]
             kv = []
             for w in rest:
@@ -301,14 +323,18 @@ def read_cfg(path):
                 if d.get("kind") != "point" or set(d) - {"kind", "pos", "color", "name"}:
                     raise Unsupported("%s: only point lights without falloff are translated" % where)
                 scene["lights"].append(dict(pos=vec(d["pos"]), color=vec(d.get("color", "1,1,1"))))
-            elif stmt in ("material", "sphere", "plane", "mesh"):
+            elif stmt in ("material", "mesh", "csg") + SHAPES:
                 d = dict(kv)
-                mat = dict(materials[d["material"]] if "material" in d else DEFAULT_MATERIAL)
+                # a shape in a block starts from the block's appearance (docs/scene-format.md, "CSG")
+                inherited = blocks[-1]["material"] if blocks else DEFAULT_MATERIAL
+                mat = dict(materials[d["material"]] if "material" in d else inherited)
                 md = IDENTITY
                 obj = dict(kind=stmt, smooth=False)
                 for k, v in kv:
                     if k in TRANSFORM_KEYS:
                         md = mat_mul(transform_of(k, v), md)
+                    elif flat and k not in ("color", "checker", "cell", "material"):
+                        continue
                     elif k in ("fresnel", "texture", "uvscale"):
                         if k != "fresnel" or v != "false":
                             raise Unsupported("%s: %s= is not translated" % (where, k))
@@ -326,10 +352,20 @@ def read_cfg(path):
                     materials[name] = mat
                     continue
                 obj.update(material=mat, md=md)
-                scene["objects"].append(obj)
+                if stmt == "csg":
+                    if name not in CSG_OPS:
+                        raise Unsupported("%s: csg %s is not an operation" % (where, name))
+                    obj.update(op=name, children=[])
+                    blocks.append(obj)
+                elif blocks:
+                    blocks[-1]["children"].append(obj)
+                else:
+                    scene["objects"].append(obj)
             else:
                 raise Unsupported("%s: statement %r is not translated" % (where, stmt))
-    if scene["image"]["degree"] != 5:
+    if blocks:
+        raise Unsupported("%s: a csg block has no end" % path)
+    if scene["image"]["degree"] != 5 and not flat:
         raise Unsupported("%s: only degree 5 is translated" % path)
     return scene
 
@@ -477,9 +513,9 @@ def pov_matrix(md):
     return "matrix <%s>" % ",".join("%.9g" % v for v in vals)
 
 
-def pov_texture(m, ambient):
+def pov_texture(m, ambient, flat=False):
     c = m["color"]
-    t = m["trans"]
+    t = 0.0 if flat else m["trans"]
     if m["checker"] is None:
         pig = "rgbt <%.6g,%.6g,%.6g,%.6g>" % (c[0], c[1], c[2], t) if t > 0 else "rgb <%.6g,%.6g,%.6g>" % tuple(c)
         pigment = "pigment { %s }" % pig
@@ -494,6 +530,8 @@ def pov_texture(m, ambient):
     # POV-Ray scales a surface's ambient and diffuse terms by its opacity, 1 - transmit
     # (measured: a sphere of transmit 0.9 shows a tenth of its diffuse term; its phong and
     # reflection are not scaled), streamrt does not: divide them back.
+    if flat:
+        return "texture { %s finish { ambient 1 diffuse 0 } }" % pigment
     opacity = 1.0 - t if 0 < t < 1 else 1.0
     fin = ["ambient %.6g" % (ambient * m["ambi"] / opacity), "diffuse %.6g" % (m["diff"] / opacity)]
     if m["spec"] > 0:
@@ -506,9 +544,22 @@ def pov_texture(m, ambient):
     return s
 
 
-def write_pov(scene, pov_path, width, height, adc_bailout, mesh_cache):
+# The canonical shapes (docs/scene-format.md, "Canonical shapes") as POV-Ray primitives, less
+# their closing brace; POV-Ray's cylinder and cone are closed solids, as streamrt's, and its
+# plane's inside is below it, as streamrt's half-space.
+POV_PRIMITIVES = {
+    "sphere": "sphere { <0,0,0>, 1",
+    "plane": "plane { y, 0",
+    "cube": "box { <-1,-1,-1>, <1,1,1>",
+    "cylinder": "cylinder { <0,-1,0>, <0,1,0>, 1",
+    "cone": "cone { <0,-1,0>, 1, <0,1,0>, 0",
+}
+
+
+def write_pov(scene, pov_path, width, height, adc_bailout, mesh_cache, flat=False):
     """Writes the POV-Ray scene; mesh_cache maps (file, smooth) to (include name, declared name),
-    filled as meshes are written (one include per scene, reused by every mode)."""
+    filled as meshes are written (one include per scene, reused by every mode). flat: degree 0,
+    each surface its pigment alone (`finish { ambient 1 diffuse 0 }`, full ambient light)."""
     img, cam = scene["image"], scene["camera"]
     depth = img["depth"]
     hfov = 2 * math.degrees(math.atan(math.tan(math.radians(cam["fov"] / 2)) * width / height))
@@ -524,18 +575,20 @@ def write_pov(scene, pov_path, width, height, adc_bailout, mesh_cache):
     for li in scene["lights"]:
         lines.append("light_source { %s color rgb %s }" % (f3(li["pos"]), f3(li["color"], False)))
     includes = []
-    for o in scene["objects"]:
-        tex = pov_texture(o["material"], scene["ambient"])
-        if o["kind"] == "sphere":
-            lines.append("sphere { <0,0,0>, 1 %s %s }" % (pov_matrix(o["md"]), tex))
-        elif o["kind"] == "plane":
-            lines.append("plane { y, 0 %s %s }" % (pov_matrix(o["md"]), tex))
-        else:
-            key = (o["file"], o["smooth"])
-            inc, name = mesh_cache[key]
-            if inc not in includes:
-                includes.append(inc)
-            lines.append("object { %s %s %s }" % (name, pov_matrix(o["md"]), tex))
+
+    def pov_object(o):
+        if o["kind"] == "csg":
+            # the leaves carry their own textures; the block's matrix applies after its children's
+            return "%s { %s %s }" % (o["op"], " ".join(pov_object(c) for c in o["children"]), pov_matrix(o["md"]))
+        tex = pov_texture(o["material"], scene["ambient"], flat)
+        if o["kind"] in POV_PRIMITIVES:
+            return "%s %s %s }" % (POV_PRIMITIVES[o["kind"]], pov_matrix(o["md"]), tex)
+        inc, name = mesh_cache[(o["file"], o["smooth"])]
+        if inc not in includes:
+            includes.append(inc)
+        return "object { %s %s %s }" % (name, pov_matrix(o["md"]), tex)
+
+    lines += [pov_object(o) for o in scene["objects"]]
     lines[3:3] = ['#include "%s"' % os.path.basename(i) for i in includes]
     with open(pov_path, "w") as f:
         f.write("\n".join(lines) + "\n")
@@ -828,6 +881,64 @@ def fmt(v, nd=3):
     return "-" if v is None else "%.*f" % (nd, v)
 
 
+def edge_mask(w, h, *pictures):
+    """Pixels with a 4-neighbour of another colour in any of the pictures: silhouettes and
+    colour edges (checker cells), where a sample a hair's breadth away can change the colour."""
+    mask = bytearray(w * h)
+    for px in pictures:
+        for y in range(h):
+            row = 3 * w * y
+            for x in range(w):
+                i = row + 3 * x
+                c = px[i:i + 3]
+                if (x + 1 < w and px[i + 3:i + 6] != c) or (y + 1 < h and px[i + 3 * w:i + 3 * w + 3] != c):
+                    mask[y * w + x] = 1
+                    mask[y * w + x + (1 if x + 1 < w else 0)] = 1
+                    if y + 1 < h:
+                        mask[(y + 1) * w + x] = 1
+    return mask
+
+
+def flat_check(exe, povray, names, out_dir, width, height, engines):
+    """Degree-0 pictures (each surface's own colour) of each scene by streamrt's engines and by
+    POV-Ray (`finish { ambient 1 diffuse 0 }`), one sample at each pixel's centre: the count of
+    pixels that differ (any channel by more than one step of 255), all of them and those off
+    the edges (edge_mask). Returns the rows printed."""
+    rows = []
+    for s in names:
+        # streamrt filters the checker over each sample's footprint (docs/scene-format.md,
+        # "Checker") and POV-Ray does not: the check compares the scene without its checkers,
+        # a copy whose mesh files are named by absolute paths
+        base = os.path.dirname(os.path.abspath(SCENES[s]))
+        with open(SCENES[s]) as f:
+            text = f.read()
+        text = re.sub(r"(?<=\s)checker=\S+", "", text)
+        text = re.sub(r"(?<=\s)file=(\S+)", lambda m: "file=" + os.path.join(base, m.group(1)), text)
+        cfg = os.path.join(out_dir, "%s_flat.cfg" % s)
+        with open(cfg, "w") as f:
+            f.write(text)
+        sc = read_cfg(cfg, flat=True)
+        sc["path"] = SCENES[s]
+        pov_path = os.path.join(out_dir, "%s_flat.pov" % s)
+        write_pov(sc, pov_path, width, height, None, prepare_meshes(sc, out_dir, s), flat=True)
+        pov_img = os.path.join(out_dir, "%s_flat_povray.ppm" % s)
+        run_povray(povray, pov_path, pov_img, width, height)
+        _, _, pov_px = read_ppm(pov_img)
+        for e in engines:
+            img = os.path.join(out_dir, "%s_flat_%s.ppm" % (s, e))
+            pc.run_streamrt(exe, cfg, img, engine=e, jobs=2, spp=1, width=width, height=height,
+                            sampler="grid", extra=["--degree", "0"])
+            _, _, px = read_ppm(img)
+            edges = edge_mask(width, height, px, pov_px)
+            differ = [max(abs(px[3 * i + c] - pov_px[3 * i + c]) for c in range(3)) > 1 for i in range(width * height)]
+            row = dict(scene=s, engine=e, pixels=width * height, differ=sum(differ),
+                       differ_off_edges=sum(d and not m for d, m in zip(differ, edges)), edge_pixels=sum(edges))
+            rows.append(row)
+            print("%-10s %-9s %7d pixels: %6d differ, %5d of them off the edges (%d edge pixels)" % (
+                s, e, row["pixels"], row["differ"], row["differ_off_edges"], row["edge_pixels"]), flush=True)
+    return rows
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"), help="build folder (default build/)")
@@ -850,6 +961,10 @@ def main(argv=None):
                     "table's third column (e.g. 'ratio default,primary ratio')")
     ap.add_argument("--dry-run", action="store_true", help="check tools, write the .pov files, render nothing")
     ap.add_argument("--out", help="output folder (default BUILD/peer)")
+    ap.add_argument("--flat", action="store_true", help="only the degree-0 check: each scene's flat colours by "
+                    "both engines against POV-Ray's, the count of differing pixels on and off the edges "
+                    "(docs/csg.md: --flat --scenes %s --size 320x240)" % ",".join(CSG_SCENES))
+    ap.add_argument("--engines", default="stream,recursive", help="with --flat: streamrt's engines checked")
     ap.add_argument("--picture", metavar="PNG", help="only write the first scene (nopruning) at --size by streamrt "
                     "(left) and POV-Ray (right) side by side into PNG, and stop (docs/img/peer_bunny.png: "
                     "--scenes bunny --size 400x225)")
@@ -898,9 +1013,25 @@ def main(argv=None):
         print("skipping scene %s: %s" % (s, why))
     names = [s for s in names if s not in skip]
 
+    if args.flat:
+        if not povray:
+            print("no degree-0 check: it needs POV-Ray (apt-get install povray)")
+            return 77  # ctest's skip (tests/CMakeLists.txt, csg_against_povray)
+        if args.dry_run:
+            print("dry run: nothing rendered")
+            return 0
+        rows = flat_check(exe, povray, names, out_dir, width, height, [e for e in args.engines.split(",") if e])
+        with open(os.path.join(out_dir, "flat.json"), "w") as f:
+            json.dump(rows, f, indent=1)
+        return 1 if any(r["differ_off_edges"] for r in rows) else 0
     scenes = {}
-    for s in names:
-        sc = read_cfg(SCENES[s])
+    for s in list(names):
+        try:
+            sc = read_cfg(SCENES[s])
+        except Unsupported as e:
+            print("skipping scene %s: %s" % (s, e))
+            names.remove(s)
+            continue
         sc["path"] = SCENES[s]
         scenes[s] = sc
         if povray or args.dry_run:
