@@ -57,6 +57,13 @@ struct PyScene {
     }
 };
 
+/// `with scene.csg(op, **keys):` — the block's `csg` line on entering, its `end` on leaving
+/// (also when the body raised, so the scene's text stays balanced).
+struct PyCsgBlock {
+    PyScene* scene;
+    std::string line;
+};
+
 /// A keyword value in the scene format: tuples and lists as "a,b,c", booleans true/false.
 std::string format_value(const py::handle& v) {
     if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
@@ -439,7 +446,23 @@ PYBIND11_MODULE(_native, m) {
             "Appends a mesh object from arrays (vertices (n, 3), triangles (m, 3), counter-clockwise seen\n"
             "from outside) with the mesh statement's other keys: mesh(v, t, smooth=True, color=(1, 0, 0)).\n"
             "colors: (n, 3) linear RGB per vertex, shown with vertex_colors=True.")
+        .def("csg", [](PyScene& s, const std::string& op, const py::kwargs& kw) {
+                return PyCsgBlock{&s, statement("csg " + op, kw)};
+            }, py::arg("op"), py::keep_alive<0, 1>(),
+            "A csg block (docs/scene-format.md, \"CSG\") as a context: the statements added in its\n"
+            "body are its children. with scene.csg('difference', material='steel', rotate_x=90):\n"
+            "    scene.statement('cylinder', scale=(1, 2, 1)); scene.statement('cylinder', scale=(0.8, 2.1, 0.8))")
         .def_property_readonly("text", &PyScene::text, "The statements as .cfg text (meshes as file=memory:K).");
+
+    py::class_<PyCsgBlock>(m, "CsgBlock", "A csg block being written: use it in a with statement (Scene.csg).")
+        .def("__enter__", [](PyCsgBlock& b) {
+                b.scene->lines.push_back(b.line);
+                return b.scene;
+            }, py::return_value_policy::reference)
+        .def("__exit__", [](PyCsgBlock& b, const py::args&) {
+                b.scene->lines.push_back("end");
+                return false;
+            });
 
     m.def("render", &render, py::arg("scene"),
           "render(scene, **overrides) -> Result\n\n"

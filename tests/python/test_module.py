@@ -156,6 +156,34 @@ def test_scene_text_and_flat_colours():
     np.testing.assert_array_equal(img[0, 0], [0, 0, 1])
 
 
+def test_a_csg_block_from_python_cuts_a_hole():
+    # A pipe seen down its axis at degree 0: a cylinder of radius 1 minus one of radius 0.5
+    # (the inner one longer, so it opens both ends). The camera at z = 5 looks down the
+    # axis (fov 30: the half-width at the pipe's near end, 4 away, is 4 tan 15 = 1.07):
+    # the centre pixel sees the background through the hole, a pixel at x = 0.75 the pipe.
+    scene = streamrt.Scene()
+    scene.add("image width=15 height=15 degree=0\nbackground 0,0,1\ncamera eye=0,0,5 look=0,0,0 fov=30")
+    with scene.csg("difference", color=(1, 0, 0), rotate_x=90) as block:
+        assert block is scene
+        scene.statement("cylinder")
+        scene.statement("cylinder", scale=(0.5, 1.5, 0.5), color=(0, 1, 0))
+    assert scene.text.splitlines()[-4:] == [
+        "csg difference color=1,0,0 rotate_x=90", "cylinder", "cylinder scale=0.5,1.5,0.5 color=0,1,0", "end"]
+    img = streamrt.render(scene, engine="recursive").image
+    np.testing.assert_array_equal(img[7, 7], [0, 0, 1])  # down the hole
+    np.testing.assert_array_equal(img[7, 12], [1, 0, 0])  # the pipe's end face, x = 0.75 at z = 1
+    # A block whose body raised is still closed, and the scene reader refuses a bad operation
+    # at its line and column.
+    bad = streamrt.Scene()
+    with pytest.raises(RuntimeError):
+        with bad.csg("unoin"):
+            raise RuntimeError("stop")
+    assert bad.text == "csg unoin\nend\n"
+    with pytest.raises(streamrt.SceneError) as e:
+        streamrt.render(bad)
+    assert (e.value.line, e.value.column) == (1, 5)
+
+
 def test_scene_errors_carry_file_line_and_column():
     with pytest.raises(streamrt.SceneError) as e:
         streamrt.render("image width=9\nsphere colour=1,0,0\n")

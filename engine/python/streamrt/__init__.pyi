@@ -21,9 +21,17 @@ class Scene:
     def mesh(self, vertices: npt.ArrayLike, triangles: npt.ArrayLike, *, colors: Optional[npt.ArrayLike] = None,
              **keys: Any) -> None:
         """Appends a mesh object: vertices (n, 3), triangles (m, 3), and the mesh statement's keys."""
+    def csg(self, op: str, **keys: Any) -> CsgBlock:
+        """A csg block: `with scene.csg('difference', rotate_x=90):` writes `csg difference
+        rotate_x=90`, the statements added in the body as its children, then `end`."""
     @property
     def text(self) -> str:
         """The statements as .cfg text (meshes named file=memory:K)."""
+
+class CsgBlock:
+    """A csg block being written (Scene.csg), used in a with statement."""
+    def __enter__(self) -> Scene: ...
+    def __exit__(self, *exc: Any) -> bool: ...
 
 class Result:
     """One render."""
