@@ -83,6 +83,7 @@ SCENES = {
     "csg_die": os.path.join(pc.ROOT, "scenes", "csg", "die.cfg"),
     "csg_hollow": os.path.join(pc.ROOT, "scenes", "csg", "hollow.cfg"),
     "csg_tree": os.path.join(pc.ROOT, "scenes", "csg", "tree.cfg"),
+    "csg_mesh_cut": os.path.join(pc.ROOT, "scenes", "csg", "mesh_cut.cfg"),
 }
 CSG_SCENES = [k for k in SCENES if k.startswith("csg_")]
 MODES = {
@@ -333,7 +334,7 @@ def read_cfg(path, flat=False):
                 for k, v in kv:
                     if k in TRANSFORM_KEYS:
                         md = mat_mul(transform_of(k, v), md)
-                    elif flat and k not in ("color", "checker", "cell", "material"):
+                    elif flat and k not in ("color", "checker", "cell", "material", "file", "smooth"):
                         continue
                     elif k in ("fresnel", "texture", "uvscale"):
                         if k != "fresnel" or v != "false":
@@ -493,7 +494,8 @@ def write_mesh2(name, path, out, smooth):
         parts.append("\n  }\n")
     parts.append("  face_indices { %d,\n" % len(keep))
     parts.append(",\n".join("<%d,%d,%d>" % t for t in keep))
-    parts.append("\n  }\n}\n")
+    # inside_vector: POV-Ray's meshes have an inside (for CSG) only with it
+    parts.append("\n  }\n  inside_vector <0, 0, 1>\n}\n")
     out.write("".join(parts))
     return len(keep)
 
@@ -597,7 +599,13 @@ def write_pov(scene, pov_path, width, height, adc_bailout, mesh_cache, flat=Fals
 def prepare_meshes(scene, out_dir, tag):
     """Writes the include file of the scene's meshes (once); returns the mesh cache."""
     cache, todo = {}, []
-    for o in scene["objects"]:
+
+    def objects(objs):  # csg blocks' children too
+        for o in objs:
+            yield o
+            yield from objects(o.get("children", []))
+
+    for o in objects(scene["objects"]):
         if o["kind"] == "mesh" and (o["file"], o["smooth"]) not in cache:
             name = "M_%s_%d" % (tag, len(cache))
             cache[(o["file"], o["smooth"])] = (os.path.join(out_dir, "%s_meshes.inc" % tag), name)

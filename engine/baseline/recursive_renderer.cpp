@@ -98,10 +98,11 @@ int RecursiveRenderer::test_csg(std::size_t k, const RayD& ray, double t_min, do
     };
     CsgSpans<double> spans;
     csg_node_spans(*scene_, scene_->csg_objects[k].root,
-                   [&](std::uint32_t shape) {
+                   [&](std::uint32_t shape, CsgSpans<double>& into) {
                        const auto [o, d] = canonical_ray(shape);
                        const PreparedObject& ob = objects_[csg_base_ + shape];
-                       return csg_shape_span(ob.kind, o, d, ob.param);
+                       if (ob.kind == ShapeKind::Mesh) add_mesh_spans(into, *ob.mesh, o, d, shape);
+                       else add_solid_span(into, csg_shape_span(ob.kind, o, d, ob.param), shape);
                    },
                    spans);
     const CsgBoundary<double>* at = first_boundary(spans, t_min, t_max);
@@ -109,6 +110,18 @@ int RecursiveRenderer::test_csg(std::size_t k, const RayD& ray, double t_min, do
     t_max = at->t;
     std::tie(c.o, c.d) = canonical_ray(at->shape);
     flip = at->flip;
+    if (objects_[csg_base_ + at->shape].kind == ShapeKind::Mesh) {
+        // The crossing's barycentric coordinates, for the normal and the texture: its triangle
+        // met again, over every t.
+        const MeshView& m = objects_[csg_base_ + at->shape].mesh->view();
+        const double inf = std::numeric_limits<double>::infinity();
+        const TriangleHit<double> h = triangle_hit(watertight_ray(c.o, c.d), mesh_vertex<double>(m, at->tri, 0),
+                                                   mesh_vertex<double>(m, at->tri, 1), mesh_vertex<double>(m, at->tri, 2),
+                                                   -inf, inf);
+        c.tri = at->tri;
+        c.u = h.t < inf ? h.u : 1.0 / 3.0;
+        c.v = h.t < inf ? h.v : 1.0 / 3.0;
+    }
     return int(csg_base_ + at->shape);
 }
 

@@ -2,7 +2,9 @@
 // Scalar mesh queries (the baseline's, in double; tests also run them in float): the mesh's
 // hierarchy walked with accel::traverse_closest / traverse_any, leaves tested with the
 // watertight triangle test of shapes/triangle_math.h, and the normal at a hit.
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 
 #include "accel/bvh.h"
 #include "core/vec3.h"
@@ -39,6 +41,62 @@ inline bool mesh_closest(const MeshView& m, const accel::Bvh& bvh, const Vec3T<T
         }
     });
     return hit;
+}
+
+/// One crossing of a line with a mesh's surface: where, on which triangle, and whether the
+/// line enters the volume there (against the outward normal of a counter-clockwise triangle).
+template <class T>
+struct MeshCrossing {
+    T t;
+    std::uint32_t tri;
+    bool enters;
+};
+
+/// The crossings of the whole line o + t d (every t) with the mesh, sorted by t: at most
+/// `capacity`, the nearest to where the line enters the mesh's box. The hierarchy is walked
+/// from that entry point (its walk covers t >= 0 only), every triangle of a visited leaf tested
+/// over all t: the watertight test counts a line through an edge or a corner of a closed mesh
+/// once. Returns the count.
+template <class T>
+inline int mesh_crossings(const MeshView& m, const accel::Bvh& bvh, const Vec3T<T>& o, const Vec3T<T>& d,
+                          MeshCrossing<T>* out, int capacity) {
+    if (m.n_tris == 0 || bvh.empty()) return 0;
+    // The line's stretch through the mesh's box, over every t.
+    T t0 = -std::numeric_limits<T>::infinity(), t1 = std::numeric_limits<T>::infinity();
+    const T os[3] = {o.x, o.y, o.z}, ds[3] = {d.x, d.y, d.z};
+    for (int a = 0; a < 3; ++a) {
+        const T lo = T(bvh.bounds.lo[a]), hi = T(bvh.bounds.hi[a]);
+        if (ds[a] == T(0)) {
+            if (os[a] < lo || os[a] > hi) return 0;
+            continue;
+        }
+        const T ta = (lo - os[a]) / ds[a], tb = (hi - os[a]) / ds[a];
+        t0 = std::max(t0, std::min(ta, tb));
+        t1 = std::min(t1, std::max(ta, tb));
+    }
+    if (!(t0 <= t1)) return 0;
+    const Vec3T<T> start = o + d * t0;
+    const WatertightRay<T> r = watertight_ray(start, d);
+    const T inf = std::numeric_limits<T>::infinity();
+    int n = 0;
+    // The walk's boxes are padded; its t_max reaches past the exit by a margin for rounding.
+    accel::traverse_any<T>(bvh, start, d, (t1 - t0) * T(1.0001) + T(1e-6), [&](std::uint32_t first, std::uint32_t count, T) {
+        for (std::uint32_t k = first; k < first + count; ++k) {
+            const Vec3T<T> p0 = mesh_vertex<T>(m, k, 0), p1 = mesh_vertex<T>(m, k, 1), p2 = mesh_vertex<T>(m, k, 2);
+            const TriangleHit<T> h = triangle_hit(r, p0, p1, p2, -inf, inf);
+            if (!(h.t < inf)) continue;
+            const MeshCrossing<T> c{t0 + h.t, k, dot(d, triangle_normal(p0, p1, p2)) < T(0)};
+            // Insertion into the sorted list; past capacity the farthest is let go.
+            int i = n < capacity ? n++ : capacity;
+            while (i > 0 && c.t < out[i - 1].t) {
+                if (i < capacity) out[i] = out[i - 1];
+                --i;
+            }
+            if (i < capacity) out[i] = c;
+        }
+        return false;  // every leaf the line passes
+    });
+    return n;
 }
 
 /// True if some triangle is hit for t in (t_min, t_max).

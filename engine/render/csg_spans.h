@@ -7,8 +7,11 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include "scene/scene.h"
+#include "mesh/mesh_solid.h"
+#include "mesh/mesh_trace.h"
 #include "scene/scene_bvh.h"
 #include "shapes/shapes.h"
 
@@ -22,6 +25,7 @@ struct CsgBoundary {
     V t;
     std::uint32_t shape;
     bool flip;
+    std::uint32_t tri = 0;  ///< a mesh's triangle there (leaf order); 0 for other shapes
 };
 
 /// A node's spans along the line, sorted and disjoint: [b[0], b[1]], [b[2], b[3]], ... each
@@ -80,8 +84,42 @@ void combine_spans(CsgOp op, const CsgSpans<V>& a, const CsgSpans<V>& b, CsgSpan
     }
 }
 
-/// The spans of node `node` of the scene's CSG trees along a line; leaf(k) gives the SpanT of
-/// Scene::csg_shapes[k] along the same line (in the same units of t).
+/// A convex solid's (or a half-space's) span as a span list: none for a miss (NaN included)
+/// or a span of length 0 (a tangent line).
+template <class V>
+void add_solid_span(CsgSpans<V>& into, const SpanT<V>& s, std::uint32_t shape) {
+    if (s.enter < s.exit) {
+        into.open({s.enter, shape, false});
+        into.close({s.exit, shape, false});
+    }
+}
+
+/// A closed mesh's spans along the line o + t d (its canonical space): where the crossings,
+/// counted +1 going in and -1 going out, add up to other than 0 (a mesh turned inside out is
+/// a solid too, its normals turned round to face out of it: flip). At most kMeshCsgSpans, the
+/// first along the line; a count left open at the last crossing (a line that rounding let
+/// through an edge) closes nothing.
+template <class V>
+void add_mesh_spans(CsgSpans<V>& into, const Mesh& mesh, const Vec3T<V>& o, const Vec3T<V>& d, std::uint32_t shape) {
+    MeshCrossing<V> c[kMeshCsgCrossings];
+    const int n = mesh_crossings(mesh.view(), mesh.bvh, o, d, c, kMeshCsgCrossings);
+    int winding = 0, spans = 0;
+    for (int i = 0; i < n && spans < kMeshCsgSpans; ++i) {
+        const int before = winding;
+        winding += c[i].enters ? 1 : -1;
+        // Going in, the surface must face against the line: a triangle facing along it is turned round.
+        if (before == 0 && winding != 0) into.open({c[i].t, shape, !c[i].enters, c[i].tri});
+        else if (before != 0 && winding == 0) {
+            into.close({c[i].t, shape, c[i].enters, c[i].tri});
+            spans = into.size / 2;
+        }
+    }
+    if (into.size % 2 != 0) --into.size;  // an open span at the end: dropped
+}
+
+/// The spans of node `node` of the scene's CSG trees along a line. leaf(k, into) writes the
+/// span list of Scene::csg_shapes[k] along the same line (in the same units of t) into
+/// `into`, which it finds empty; a leaf(k) that returns the shape's SpanT does as well.
 template <class V, class Leaf>
 void csg_node_spans(const Scene& scene, std::uint32_t node, const Leaf& leaf, CsgSpans<V>& out) {
     const CsgNode& n = scene.csg_nodes[node];
@@ -93,11 +131,8 @@ void csg_node_spans(const Scene& scene, std::uint32_t node, const Leaf& leaf, Cs
             csg_node_spans(scene, c.index, leaf, into);
         } else {
             into.size = 0;
-            const SpanT<V> s = leaf(c.index);
-            if (s.enter < s.exit) {  // false for a miss, NaN included
-                into.open({s.enter, c.index, false});
-                into.close({s.exit, c.index, false});
-            }
+            if constexpr (std::is_invocable_v<const Leaf&, std::uint32_t, CsgSpans<V>&>) leaf(c.index, into);
+            else add_solid_span(into, leaf(c.index), c.index);
         }
         if (first) {
             first = false;
@@ -153,7 +188,7 @@ inline CsgBox csg_node_box(const Scene& scene, std::uint32_t node) {
         const CsgNode::Child& c = n.children[i];
         CsgBox child{{-kInf, -kInf, -kInf}, {kInf, kInf, kInf}};
         if (c.is_node) child = csg_node_box(scene, c.index);
-        else accel::object_world_bounds(scene.csg_shapes[c.index], nullptr, child.lo, child.hi);
+        else accel::object_world_bounds(scene.csg_shapes[c.index], scene.mesh_of(scene.csg_shapes[c.index]), child.lo, child.hi);
         if (i == 0) {
             box = child;
             if (n.op == CsgOp::Difference) break;

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "core/format_number.h"
+#include "mesh/mesh_solid.h"
 #include "scene/parser_state.h"
 
 namespace streamrt::scene_reader {
@@ -54,22 +56,51 @@ void Parser::csg_end(Statement& st, const std::vector<Token>& toks) {
 }
 
 void Parser::csg_child(Statement& st, const std::vector<Token>& toks, ShapeKind kind) {
-    if (kind == ShapeKind::Mesh)
-        st.fail_here("CSG children are canonical shapes for now: a mesh cannot be part of a csg block yet");
     if (kind == ShapeKind::Disk)
         st.fail_here("a disk has no inside, so it cannot be part of a csg block (a thin cylinder has one)");
-    if (!shape_is_solid(kind))
+    if (kind != ShapeKind::Mesh && !shape_is_solid(kind))
         st.fail_here("a " + std::string(st.word()) + " cannot be part of a csg block yet (its inside is not traced yet)");
-    if (++csg_blocks_.front().shapes > kMaxCsgShapes)
-        st.fail_here("a csg object holds at most " + std::to_string(kMaxCsgShapes) + " shapes (its block is at " +
-                     csg_blocks_.front().at.str() + ")");
+    // A mesh may cross a line several times: it counts as the spans it may add (mesh/mesh_solid.h).
+    csg_blocks_.front().shapes += kind == ShapeKind::Mesh ? kMeshCsgSpans : 1;
+    if (csg_blocks_.front().shapes > kMaxCsgShapes)
+        st.fail_here("a csg object holds at most " + std::to_string(kMaxCsgShapes) + " shapes, a mesh counting as " +
+                     std::to_string(kMeshCsgSpans) + " (its block is at " + csg_blocks_.front().at.str() + ")");
     CsgBlock& block = csg_blocks_.back();
     Object obj;
     ObjectLoc loc;
     if (const auto name = shape(st, toks, kind, block.file, scene_materials_, obj, loc, &block))
         st.fail(name->key_col, "a csg block's shape takes no name= (the block is the object)");
+    if (kind == ShapeKind::Mesh) {
+        // materials=obj made an object of each part of the file: one solid is wanted.
+        if (const Arg* m = st.find("materials"))
+            st.fail(m->key_col, "materials=obj cannot be used in a csg block (each part of the file would be its own "
+                                "object): give the mesh one material");
+        check_closed_mesh(st, obj.mesh);
+    }
     block.node.children.push_back({false, std::uint32_t(scene.csg_shapes.size())});
     scene.csg_shapes.push_back(obj);
+}
+
+void Parser::check_closed_mesh(const Statement& st, std::uint32_t mesh) {
+    if (!closed_meshes_.insert(mesh).second) return;  // each mesh checked once
+    const auto open = first_open_edge(*scene.meshes[mesh]);
+    if (!open) return;
+    const auto point = [](const std::array<float, 3>& p) {
+        // Appended piece by piece: GCC 12 takes `"(" + std::string&&` for an overlapping copy
+        // (a false -Wrestrict).
+        std::string s = "(";
+        s.append(fmt_num(p[0])).append(", ").append(fmt_num(p[1])).append(", ").append(fmt_num(p[2])).append(")");
+        return s;
+    };
+    const Arg* file = st.find("file");
+    const std::string edge = "its edge " + point(open->a) + " - " + point(open->b);
+    const std::string why = open->same_direction ? edge + " is run along the same way by two triangles (one is turned over)"
+                            : open->triangles == 1 ? edge + " belongs to one triangle only (a hole)"
+                                                   : edge + " belongs to " + std::to_string(open->triangles) +
+                                                         " triangles (surfaces meet there)";
+    st.fail(file ? file->value_col : st.where().column,
+            "a mesh in a csg block must close a volume (each edge shared by two triangles, oriented alike), and " +
+                quote(file ? file->value : std::string_view("the mesh")) + " does not: " + why);
 }
 
 void Parser::check_csg_closed() const {

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -212,6 +213,9 @@ class Parser {
     void csg_child(Statement& st, const std::vector<Token>& toks, ShapeKind kind);
     /// After a file: a block it opened and did not end is an error at that block's `csg`.
     void check_csg_closed() const;
+    /// A mesh child must close a volume (mesh/mesh_solid.h): else an error at its file= value.
+    void check_closed_mesh(const Statement& st, std::uint32_t mesh);
+    std::unordered_set<std::uint32_t> closed_meshes_;  // scene.meshes already checked
 
     /// The one place an Object is built from a checked shape statement, in place: `obj` and
     /// `loc` are its slots in scene.objects and scene.object_locs.

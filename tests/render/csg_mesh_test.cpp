@@ -1,0 +1,150 @@
+// A closed mesh as a CSG solid (docs/scene-format.md, "CSG"; mesh/mesh_solid.h): the reader's
+// closedness check and its messages, and the recursive engine's spans of a mesh, against the
+// canonical cube the mesh cube is made to match.
+#include <doctest/doctest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include "baseline/recursive_renderer.h"
+#include "driver/render.h"
+#include "parallel/parallelism.h"
+#include "scene/expect_error.h"
+#include "scene/parser.h"
+
+using namespace streamrt;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// The cube [-1,1]^3 as 12 triangles, counter-clockwise seen from outside (OBJ numbers from 1).
+const char* const kCubeVertices =
+    "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n";
+const char* const kCubeFaces[12] = {"1 4 3", "1 3 2", "5 6 7", "5 7 8", "1 2 6", "1 6 5",
+                                    "4 8 7", "4 7 3", "1 5 8", "1 8 4", "2 3 7", "2 7 6"};
+
+/// A folder of this test's files: the cube, the cube with its last face left out (open), with
+/// a face turned over (flipped), with every face turned over (inside out).
+fs::path mesh_dir() {
+    const fs::path dir = fs::temp_directory_path() / ("streamrt_csg_mesh_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const auto write = [&](const char* name, int leave_out, bool flip_one, bool flip_all) {
+        std::ofstream f(dir / name);
+        f << kCubeVertices;
+        for (int k = 0; k < 12; ++k) {
+            if (k == leave_out) continue;
+            std::string face = kCubeFaces[k];
+            if ((flip_one && k == 0) || flip_all) std::swap(face[2], face[4]);  // "a b c" -> "a c b"
+            f << "f " << face << "\n";
+        }
+    };
+    write("cube.obj", -1, false, false);
+    write("open.obj", 11, false, false);
+    write("flipped.obj", -1, true, false);
+    write("inside_out.obj", -1, false, true);
+    return dir;
+}
+
+Scene parse_in(const fs::path& dir, const std::string& text) { return parse_scene(text, (dir / "t.cfg").string()); }
+
+bool hit_of(const Scene& scene, Vec3d from, Vec3d dir, HitD& hit, double t_min = 0.0) {
+    const RecursiveRenderer r(scene);
+    return r.closest_hit(RayD{from, dir}, t_min, kInf, hit);
+}
+
+}  // namespace
+
+TEST_CASE("csg mesh: a mesh in a csg block must close a volume, said at its file= value") {
+    const fs::path dir = mesh_dir();
+    const std::string path = (dir / "t.cfg").string();
+    test::expect_error_in(path, "csg union\n  sphere\n  mesh file=open.obj\nend\n", 3, 13,
+                          "'open.obj' does not: its edge (1, -1, -1) - (1, -1, 1) belongs to one triangle only");
+    test::expect_error_in(path, "csg union\n  sphere\n  mesh file=flipped.obj\nend\n", 3, 13,
+                          "is run along the same way by two triangles");
+    test::expect_error_in(path, "csg union\n  sphere\n  mesh file=cube.obj materials=obj\nend\n", 3, 22,
+                          "materials=obj cannot be used in a csg block");
+    // A mesh counts as 8 shapes against the 64 of an object: 8 meshes fit, a 9th does not.
+    std::string eight = "csg union\n";
+    for (int k = 0; k < 8; ++k) eight += "  mesh file=cube.obj\n";
+    CHECK(parse_in(dir, eight + "end\n").csg_shapes.size() == 8);
+    test::expect_error_in(path, eight + "  sphere\nend\n", 10, 3, "a mesh counting as 8");
+    // Outside a block an open mesh is a surface like any other.
+    CHECK(parse_in(dir, "mesh file=open.obj\n").objects.size() == 1);
+}
+
+TEST_CASE("csg mesh: the mesh cube minus a sphere is hit where the canonical cube minus it is") {
+    const fs::path dir = mesh_dir();
+    for (const char* base : {"mesh file=cube.obj", "mesh file=inside_out.obj", "cube"}) {
+        CAPTURE(base);
+        const Scene s = parse_in(dir, std::string("csg difference\n  ") + base + "\n  sphere scale=1.3\nend\n");
+        HitD hit;
+        // Down the axis the sphere (radius 1.3 > 1) has removed all the cube there.
+        CHECK(!hit_of(s, {0, 0, 5}, {0, 0, -1}, hit));
+        // Near a corner the sphere is missed (0.95^2 + 0.95^2 > 1.3^2): the face z = 1, and out
+        // of the cube at z = -1.
+        REQUIRE(hit_of(s, {0.95, 0.95, 5}, {0, 0, -1}, hit));
+        CHECK(hit.t == doctest::Approx(4.0).epsilon(1e-12));
+        CHECK(hit.normal.z == doctest::Approx(1.0).epsilon(1e-12));
+        REQUIRE(hit_of(s, {0.95, 0.95, 5}, {0, 0, -1}, hit, hit.t + 1e-9));
+        CHECK(hit.t == doctest::Approx(6.0).epsilon(1e-12));
+        // At x = 0.9 the face z = 1, then the sphere's wall at z = sqrt(1.69 - 0.81) = 0.938,
+        // facing into the cavity (toward the sphere's centre).
+        REQUIRE(hit_of(s, {0.9, 0, 5}, {0, 0, -1}, hit));
+        CHECK(hit.t == doctest::Approx(4.0).epsilon(1e-12));
+        REQUIRE(hit_of(s, {0.9, 0, 5}, {0, 0, -1}, hit, hit.t + 1e-9));
+        const double z = std::sqrt(1.69 - 0.81);
+        CHECK(hit.t == doctest::Approx(5.0 - z).epsilon(1e-12));
+        CHECK(hit.normal.x == doctest::Approx(-0.9 / 1.3).epsilon(1e-9));
+        CHECK(hit.normal.z == doctest::Approx(-z / 1.3).epsilon(1e-9));
+    }
+}
+
+TEST_CASE("csg mesh: a line through the diagonals of the mesh cube's faces crosses each face once") {
+    // x = y = 0.5 lies on the diagonal that splits the faces z = 1 and z = -1 into two triangles:
+    // the watertight test counts the crossing on one of them, so the cube's span is [4, 6].
+    const Scene s = parse_in(mesh_dir(), "csg intersection\n  mesh file=cube.obj\n  sphere scale=10\nend\n");
+    HitD hit;
+    REQUIRE(hit_of(s, {0.5, 0.5, 5}, {0, 0, -1}, hit));
+    CHECK(hit.t == doctest::Approx(4.0).epsilon(1e-12));
+    REQUIRE(hit_of(s, {0.5, 0.5, 5}, {0, 0, -1}, hit, hit.t + 1e-9));
+    CHECK(hit.t == doctest::Approx(6.0).epsilon(1e-12));
+    CHECK(!hit_of(s, {0.5, 0.5, 5}, {0, 0, -1}, hit, hit.t + 1e-9));
+    // Through the cube's corner-to-corner edge x = y = 1 of the faces x = 1 and y = 1, from
+    // inside the sphere: in at z = 1, out at z = -1, nothing else.
+    REQUIRE(hit_of(s, {1, 1, 5}, {0, 0, -1}, hit));
+    CHECK(hit.t == doctest::Approx(4.0).epsilon(1e-12));
+}
+
+TEST_CASE("csg mesh: the mesh cube minus a sphere gives the canonical cube's picture") {
+    const fs::path dir = mesh_dir();
+    const auto picture = [&](const char* base) {
+        const std::string text = std::string("image width=48 height=36 degree=5\ncamera eye=3,2.5,4 look=0,0,0 fov=40\n"
+                                             "light point pos=5,8,6\ncsg difference color=0.8,0.5,0.2\n  ") +
+                                 base + "\n  sphere scale=1.3 color=0.2,0.5,0.9\nend\n";
+        Parallelism par(1);
+        return render_scene(parse_in(dir, text), EngineKind::Recursive, par).image;
+    };
+    const Framebuffer mesh = picture("mesh file=cube.obj"), canonical = picture("cube");
+    REQUIRE(mesh.width == canonical.width);
+    int differ = 0, covered = 0;
+    for (int y = 0; y < mesh.height; ++y)
+        for (int x = 0; x < mesh.width; ++x) {
+            bool d = false, any = false;
+            for (int c = 0; c < 3; ++c) {
+                d = d || std::abs(mesh.pixel(x, y)[c] - canonical.pixel(x, y)[c]) > 1e-4f;
+                any = any || canonical.pixel(x, y)[c] > 0.f;
+            }
+            differ += d;
+            covered += any;
+        }
+    // The same surfaces, lit alike; only a silhouette pixel or two may round the other way.
+    CHECK(differ <= 4);
+    CHECK(covered > 300);  // not a picture of nothing
+}
