@@ -309,6 +309,12 @@ Framebuffer RecursiveRenderer::render(Parallelism& par, RenderProgress* progress
 void RecursiveRenderer::update(const Scene& scene, const FrameChange& change) {
     scene_ = &scene;
     for (const std::uint32_t i : change.objects) objects_[i].mi = affine_inverse(scene.objects[i].md);
+    for (const std::uint32_t k : change.csg) {
+        const CsgObject& o = scene.csg_objects[k];
+        for (std::uint32_t s = o.first_shape; s < o.first_shape + o.shape_count; ++s)
+            objects_[csg_base_ + s].mi = affine_inverse(scene.csg_shapes[s].md);
+        csg_boxes_[k] = csg_node_box(scene, o.root);
+    }
     if (change.lights) {
         lights_.clear();
         for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(rendered_light(l, settings_)));

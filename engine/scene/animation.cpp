@@ -123,6 +123,18 @@ FrameChange set_frame(Scene& scene, int frame) {
             change.objects.push_back(t.object);
         }
     }
+    for (const CsgTrack& t : anim.csg) {
+        const glm::dmat4 keyed = keyed_transform(t.keys, frame);
+        const std::uint32_t first = scene.csg_objects[t.csg].first_shape;
+        bool moved = false;
+        for (std::size_t i = 0; i < t.base.size(); ++i) {
+            const glm::dmat4x3 md(keyed * glm::dmat4(t.base[i]));
+            Object& o = scene.csg_shapes[first + i];
+            moved = moved || md != o.md;
+            o.md = md;
+        }
+        if (moved) change.csg.push_back(t.csg);
+    }
     for (const LightTrack& t : anim.lights) {
         Light& l = scene.lights[t.light];
         const Light before = l;
@@ -152,6 +164,8 @@ FrameChange frame_change(const Animation& anim, int from, int to) {
     if (from == to) return change;
     for (const ObjectTrack& t : anim.objects)
         if (keyed_md(t, from) != keyed_md(t, to)) change.objects.push_back(t.object);
+    for (const CsgTrack& t : anim.csg)
+        if (keyed_transform(t.keys, from) != keyed_transform(t.keys, to)) change.csg.push_back(t.csg);
     const auto moved = [&](const auto& track) { return !track.empty() && sample(track, from) != sample(track, to); };
     for (const LightTrack& t : anim.lights) change.lights = change.lights || moved(t.pos) || moved(t.color);
     change.camera = moved(anim.camera.eye) || moved(anim.camera.look) || moved(anim.camera.fov);

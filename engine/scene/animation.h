@@ -44,6 +44,14 @@ struct ObjectTrack {
     Track<glm::dquat> rotate;
 };
 
+/// A CSG object's keys (a `csg` block's name=): T R S applied after the block's own transform,
+/// to every shape of the object alike.
+struct CsgTrack {
+    std::uint32_t csg = 0;                 ///< index in Scene::csg_objects
+    std::vector<glm::dmat4x3> base;        ///< its shapes' Md as read, in order from first_shape
+    ObjectTrack keys;                      ///< the keyed T R S (its object and base unused)
+};
+
 /// A light's keys: they replace its position and colour.
 struct LightTrack {
     std::uint32_t light = 0;  ///< index in Scene::lights
@@ -59,6 +67,7 @@ struct CameraTrack {
 
 struct Animation {
     std::vector<ObjectTrack> objects;
+    std::vector<CsgTrack> csg;
     std::vector<LightTrack> lights;
     CameraTrack camera;
 };
@@ -67,9 +76,10 @@ struct Animation {
 /// update (driver/render.h) rebuilds only these.
 struct FrameChange {
     std::vector<std::uint32_t> objects;  ///< scene indices of the objects whose Md changed
+    std::vector<std::uint32_t> csg;      ///< indices of the CSG objects that moved (Scene::csg_objects)
     bool lights = false;
     bool camera = false;
-    bool any() const { return !objects.empty() || lights || camera; }
+    bool any() const { return !objects.empty() || !csg.empty() || lights || camera; }
 };
 
 /// The largest frame number.

@@ -12,7 +12,7 @@
 namespace streamrt::scene_reader {
 
 const char* Parser::named_word(Named w) {
-    return w == Named::Object ? "object" : w == Named::Light ? "light" : "camera";
+    return w == Named::Object ? "object" : w == Named::Light ? "light" : w == Named::Csg ? "csg object" : "camera";
 }
 
 void Parser::name_thing(const std::string& file, int line, const Arg& a, Named what, std::uint32_t index) {
@@ -52,7 +52,7 @@ void Parser::key(Statement& st, const std::vector<Token>& toks) {
                                " (name= on an object, light or camera before this line)");
     const NameDef& def = it->second;
     st.read_args(toks, 2, kKeyKeys);
-    const std::vector<std::string_view>& fits = def.what == Named::Object  ? kObjectKeyKeys
+    const std::vector<std::string_view>& fits = def.what == Named::Object || def.what == Named::Csg ? kObjectKeyKeys
                                                 : def.what == Named::Light ? kLightKeyKeys
                                                                            : kCameraKeyKeys;
     const std::string who = std::string(named_word(def.what)) + " " + quote(nt.text);
@@ -71,14 +71,29 @@ void Parser::key(Statement& st, const std::vector<Token>& toks) {
         st.fail(fa->value_col, who + " already has a key at frame " + std::to_string(frame) + " (line " +
                                    std::to_string(seen->second) + ")");
     Animation& anim = animation();
-    if (def.what == Named::Object) {
-        const auto [t, fresh] = object_tracks_.try_emplace(def.index, anim.objects.size());
-        if (fresh) {
-            anim.objects.emplace_back();
-            anim.objects.back().object = def.index;
-            anim.objects.back().base = scene.objects[def.index].md;
+    if (def.what == Named::Object || def.what == Named::Csg) {
+        ObjectTrack* keyed;
+        if (def.what == Named::Object) {
+            const auto [t, fresh] = object_tracks_.try_emplace(def.index, anim.objects.size());
+            if (fresh) {
+                anim.objects.emplace_back();
+                anim.objects.back().object = def.index;
+                anim.objects.back().base = scene.objects[def.index].md;
+            }
+            keyed = &anim.objects[t->second];
+        } else {
+            // The block has ended (a key cannot be inside one): its shapes are all read.
+            const auto [t, fresh] = csg_tracks_.try_emplace(def.index, anim.csg.size());
+            if (fresh) {
+                const CsgObject& o = scene.csg_objects[def.index];
+                anim.csg.emplace_back();
+                anim.csg.back().csg = def.index;
+                for (std::uint32_t i = 0; i < o.shape_count; ++i)
+                    anim.csg.back().base.push_back(scene.csg_shapes[o.first_shape + i].md);
+            }
+            keyed = &anim.csg[t->second].keys;
         }
-        ObjectTrack& tr = anim.objects[t->second];
+        ObjectTrack& tr = *keyed;
         for (const Arg& a : st.args) {
             if (same(a.key, "translate")) tr.translate.add(frame, st.vec3(a));
             else if (same(a.key, "scale")) {

@@ -24,9 +24,16 @@ void Parser::csg(Statement& st, const std::vector<Token>& toks) {
     if (const Arg* base = st.find("material")) block.look = lookup_material(st, *base);
     glm::dmat4 own(1.0);
     for (const Arg& a : st.args) {
-        if (same(a.key, "material") || material_key(st, a, block.look)) continue;
+        if (same(a.key, "material") || same(a.key, "name") || material_key(st, a, block.look)) continue;
         apply_transform_key(st, a, own);
     }
+    if (const Arg* name = st.find("name")) {
+        // The outermost block is the object that keys move; it is the next CSG object.
+        if (!csg_blocks_.empty())
+            st.fail(name->key_col, "a nested csg block takes no name= (the outermost block is the object)");
+        name_thing(st.file(), st.line(), *name, Named::Csg, std::uint32_t(scene.csg_objects.size()));
+    }
+    if (csg_blocks_.empty()) block.first_shape = std::uint32_t(scene.csg_shapes.size());
     if (singular(own)) st.fail_here("csg: the composed transform is singular (or not finite)");
     block.md = csg_blocks_.empty() ? own : csg_blocks_.back().md * own;
     block.at = st.where();
@@ -52,7 +59,8 @@ void Parser::csg_end(Statement& st, const std::vector<Token>& toks) {
         csg_blocks_.back().node.children.push_back({true, index});
         return;
     }
-    scene.csg_objects.push_back({index, ObjectLoc{block.file, block.at.line, block.at.column}});
+    scene.csg_objects.push_back({index, ObjectLoc{block.file, block.at.line, block.at.column}, block.first_shape,
+                                 std::uint32_t(scene.csg_shapes.size()) - block.first_shape});
 }
 
 void Parser::csg_child(Statement& st, const std::vector<Token>& toks, ShapeKind kind) {

@@ -201,6 +201,7 @@ class Parser {
         SourceLoc at;
         std::uint32_t file = 0;
         int shapes = 0;  // the outermost block's: all its object's shapes (kMaxCsgShapes)
+        std::uint32_t first_shape = 0;  // the outermost block's: its first in scene.csg_shapes
     };
     std::vector<CsgBlock> csg_blocks_;  // innermost last
     std::size_t file_csg_base_ = 0;     // blocks opened before the file being read: not its to end
@@ -309,10 +310,10 @@ class Parser {
     void include(Statement& st, const std::vector<Token>& toks, int depth);
 
     // ---- animation: name= and the key statement (docs/scene-format.md, "Animation") ------
-    enum class Named : std::uint8_t { Object, Light, Camera };
+    enum class Named : std::uint8_t { Object, Light, Camera, Csg };
     struct NameDef {
         Named what;
-        std::uint32_t index;  // in scene.objects or scene.lights
+        std::uint32_t index;  // in scene.objects, scene.lights or scene.csg_objects
         int line;
     };
     std::map<std::string, NameDef, std::less<>> names_;  // one namespace for objects, lights, camera
@@ -327,7 +328,7 @@ class Parser {
     std::vector<DeferredName> deferred_names_;
     bool defer_names_ = false;
     std::map<std::pair<std::string, int>, int> key_lines_;  // (name, frame) -> line of its key
-    std::unordered_map<std::uint32_t, std::size_t> object_tracks_, light_tracks_;  // index -> track
+    std::unordered_map<std::uint32_t, std::size_t> object_tracks_, light_tracks_, csg_tracks_;  // index -> track
 
     static const char* named_word(Named w);
 

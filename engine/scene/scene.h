@@ -81,6 +81,8 @@ struct CsgNode {
 struct CsgObject {
     std::uint32_t root = 0;  ///< into Scene::csg_nodes
     ObjectLoc loc;
+    /// Its shapes: Scene::csg_shapes[first_shape, first_shape + shape_count), in written order.
+    std::uint32_t first_shape = 0, shape_count = 0;
 };
 
 /// The handout's canonical camera (eye (0,0,1), screen [-1,1]^2 in z=0) placed by Md.

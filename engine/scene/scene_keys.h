@@ -47,7 +47,7 @@ inline const std::vector<std::string_view> kCameraKeys = join({kLookAtKeys, kExp
 inline const std::vector<std::string_view> kMaterialStatementKeys = join({kMaterialKeys, {"material"}});
 inline const std::vector<std::string_view> kShapeKeys = join({{"material"}, kMaterialKeys, kTransformKeys, {"name"}});
 /// A csg block's keys: what its children inherit (docs/scene-format.md, "CSG").
-inline const std::vector<std::string_view> kCsgKeys = join({{"material"}, kMaterialKeys, kTransformKeys});
+inline const std::vector<std::string_view> kCsgKeys = join({{"material", "name"}, kMaterialKeys, kTransformKeys});
 inline const std::vector<std::string_view> kMeshKeys = join({kShapeKeys, {"file", "smooth", "materials"}});
 // The `key` statement's keys, by what the name names (animation, scene/animation.h).
 inline const std::vector<std::string_view> kObjectKeyKeys = {"frame", "translate", "rotate", "scale"};

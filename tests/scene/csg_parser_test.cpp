@@ -122,7 +122,6 @@ TEST_CASE("csg parser: every refusal at its line and column") {
     expect_error("csg union\n  light point pos=0,0,0\nend\n", 2, 3, "'light' cannot be inside a csg block");
     // Keys a block does not take, and a child's own key checks.
     expect_error("csg union smooth=true\n sphere\nend\n", 1, 11, "unknown key 'smooth' for 'csg'");
-    expect_error("csg union name=pipe\n sphere\nend\n", 1, 11, "unknown key 'name' for 'csg'");
     expect_error("csg union\n  sphere colr=1,0,0\nend\n", 2, 10, "unknown key 'colr' for 'sphere'");
     expect_error("csg union scale=0,1,1\n sphere\nend\n", 1, 17, "scale components must be non-zero");
     expect_error("csg union material=steel\n sphere\nend\n", 1, 20, "unknown material 'steel'");
