@@ -80,17 +80,17 @@ void combine_spans(CsgOp op, const CsgSpans<V>& a, const CsgSpans<V>& b, CsgSpan
     }
 }
 
-/// The spans of node `node` of the scene's CSG trees along a line; leaf(k) gives the SpanT of
-/// Scene::csg_shapes[k] along the same line (in the same units of t).
+/// The spans of node `node` of a scene's CSG trees (`nodes`: Scene::csg_nodes) along a line;
+/// leaf(k) gives the SpanT of Scene::csg_shapes[k] along the same line (in the same units of t).
 template <class V, class Leaf>
-void csg_node_spans(const Scene& scene, std::uint32_t node, const Leaf& leaf, CsgSpans<V>& out) {
-    const CsgNode& n = scene.csg_nodes[node];
+void csg_node_spans(const CsgNode* nodes, std::uint32_t node, const Leaf& leaf, CsgSpans<V>& out) {
+    const CsgNode& n = nodes[node];
     CsgSpans<V> child, combined;
     bool first = true;
     for (const CsgNode::Child& c : n.children) {
         CsgSpans<V>& into = first ? out : child;
         if (c.is_node) {
-            csg_node_spans(scene, c.index, leaf, into);
+            csg_node_spans(nodes, c.index, leaf, into);
         } else {
             into.size = 0;
             const SpanT<V> s = leaf(c.index);
