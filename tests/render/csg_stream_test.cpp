@@ -133,7 +133,7 @@ TEST_CASE("csg stream: a ray along a lens's axis meets the two caps at their ver
     }
 }
 
-TEST_CASE("csg stream: a ray through a pipe's hole hits nothing; across, the inner wall faces the hole") {
+TEST_CASE("csg stream: a ray through a pipe's hole hits nothing, and across it the inner wall faces the hole") {
     const Scene s = parse(with_camera(std::string(kPipe) + "sphere translate=5,0,0\n"));
     for (const accel::AccelConfig& a : accel_modes()) {
         CAPTURE(int(a.mode));
