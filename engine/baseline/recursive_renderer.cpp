@@ -97,7 +97,7 @@ int RecursiveRenderer::test_csg(std::size_t k, const RayD& ray, double t_min, do
         return std::pair{apply_point(RowsOf{ob.mi}, ray.origin), apply_vector(RowsOf{ob.mi}, ray.dir)};
     };
     CsgSpans<double> spans;
-    csg_node_spans(*scene_, scene_->csg_objects[k].root,
+    csg_node_spans(scene_->csg_nodes.data(), scene_->csg_objects[k].root,
                    [&](std::uint32_t shape, CsgSpans<double>& into) {
                        const auto [o, d] = canonical_ray(shape);
                        const PreparedObject& ob = objects_[csg_base_ + shape];

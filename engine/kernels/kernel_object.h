@@ -12,11 +12,15 @@ namespace streamrt {
 /// Mi's top three rows (world -> canonical, relative to the eye), broadcast into every lane,
 /// the shape parameter (torus minor radius; 1 for a smooth mesh), the object's id in the
 /// stream engine's tables and its kind, and for a mesh its triangles and hierarchy. 64 bytes:
-/// the id and kind share a word so that a record is one cache line (see KernelObject).
+/// the id, the flip bit and the kind share a word so that a record is one cache line (see
+/// KernelObject).
 struct ObjectXf {
     float m[12];  ///< row-major 3x4
     float param;
-    std::uint32_t id : 28;  ///< below kMaxSceneObjects (scene/scene.h) = 2^24: the kernels carry it in float lanes
+    std::uint32_t id : 27;  ///< below kMaxSceneObjects (scene/scene.h) = 2^24: the kernels carry it in float lanes
+    /// A CSG shape's surface seen where it bounds the result from the outside of the shape (a
+    /// subtracted shape's, stream/stream_csg.h): the shade stage turns its normal round.
+    std::uint32_t flip : 1;
     std::uint32_t kind : 4;  ///< ShapeKind
     const MeshView* mesh;  ///< ShapeKind::Mesh only (null otherwise); no default, so records can be made unwritten
 };

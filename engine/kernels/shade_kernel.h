@@ -308,6 +308,16 @@ void shade_run(const ShadeJob& job) {
     // Shadow origins move off the flat triangles only on smooth meshes: the run's object, or
     // (gathered) the packet's smooth lanes.
     const bool smooth_mesh = kind == ShapeKind::Mesh && (kGathered || ob.param != 0.f);
+    // A CSG shape's surface seen from the shape's outside (ObjectXf::flip) has its normal
+    // turned round through Mn's rows negated, once per run: each product only changes sign,
+    // so the bits are those of the normal negated (the scalar path's). Gathered runs never
+    // hold CSG shapes (resolve_shade_mode).
+    alignas(64) float flipped_rows[12];
+    const float* normal_m = ob.m;
+    if (!kGathered && ob.flip) {
+        for (int k = 0; k < 12; ++k) flipped_rows[k] = -ob.m[k];
+        normal_m = flipped_rows;
+    }
 
     for (std::size_t i = job.begin; i < job.end; i += W) {
         // The last packet may be partial: its extra lanes read padding and are never stored
@@ -341,9 +351,12 @@ void shade_run(const ShadeJob& job) {
         const Vec3T<B> pc = apply_point(rows, o) + apply_vector(rows, d) * t;
         const Vec3T<B> p = o + d * t;
         Vec3T<B> n_out{};
-        if (kLit || m.checker || m.texture)
-            n_out = apply_normal(rows, kind == ShapeKind::Mesh ? mesh_normals<B, kGathered>(job, i)
-                                                                : canonical_normal(kind, pc, param));
+        if (kLit || m.checker || m.texture) {
+            const Vec3T<B> nc =
+                kind == ShapeKind::Mesh ? mesh_normals<B, kGathered>(job, i) : canonical_normal(kind, pc, param);
+            if constexpr (kGathered) n_out = apply_normal(rows, nc);
+            else n_out = apply_normal(BroadcastRows<B>{normal_m}, nc);
+        }
         const ArrivingRay<B> arriving{o, d, t, field(job.cone), w, w};
         if (m.texture) {  // one branch per run: the texture replaces the object's colour
             const B footprint = footprint_width(arriving.cone, B(job.rules.spread), t, dot(d, n_out));

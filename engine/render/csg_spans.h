@@ -117,18 +117,19 @@ void add_mesh_spans(CsgSpans<V>& into, const Mesh& mesh, const Vec3T<V>& o, cons
     if (into.size % 2 != 0) --into.size;  // an open span at the end: dropped
 }
 
-/// The spans of node `node` of the scene's CSG trees along a line. leaf(k, into) writes the
-/// span list of Scene::csg_shapes[k] along the same line (in the same units of t) into
-/// `into`, which it finds empty; a leaf(k) that returns the shape's SpanT does as well.
+/// The spans of node `node` of a scene's CSG trees (`nodes`: Scene::csg_nodes) along a line.
+/// leaf(k, into) writes the span list of Scene::csg_shapes[k] along the same line (in the same
+/// units of t) into `into`, which it finds empty; a leaf(k) that returns the shape's SpanT
+/// does as well.
 template <class V, class Leaf>
-void csg_node_spans(const Scene& scene, std::uint32_t node, const Leaf& leaf, CsgSpans<V>& out) {
-    const CsgNode& n = scene.csg_nodes[node];
+void csg_node_spans(const CsgNode* nodes, std::uint32_t node, const Leaf& leaf, CsgSpans<V>& out) {
+    const CsgNode& n = nodes[node];
     CsgSpans<V> child, combined;
     bool first = true;
     for (const CsgNode::Child& c : n.children) {
         CsgSpans<V>& into = first ? out : child;
         if (c.is_node) {
-            csg_node_spans(scene, c.index, leaf, into);
+            csg_node_spans(nodes, c.index, leaf, into);
         } else {
             into.size = 0;
             if constexpr (std::is_invocable_v<const Leaf&, std::uint32_t, CsgSpans<V>&>) leaf(c.index, into);

@@ -32,9 +32,11 @@ inline constexpr std::size_t kSortedShadeMaxObjects = 8192;
 /// gathered against 0.137 one ray at a time (0.034 for 100 instances, runs by object).
 inline constexpr std::size_t kGatheredShadeMaxKeys = 65536;
 
-/// The shade mode a scene gets: `asked` resolved against what the scene allows.
+/// The shade mode a scene gets: `asked` resolved against what the scene allows. A scene with
+/// CSG objects is not gathered: a run of one material and kind may mix a shape's two records
+/// (ObjectXf::flip), and the gathered kernel reads no per-lane flip.
 inline ShadeMode resolve_shade_mode(const StreamScene& sc, ShadeMode asked) {
-    const bool gather_ok = sc.materials.size() * kShapeKindCount <= kGatheredShadeMaxKeys;
+    const bool gather_ok = sc.materials.size() * kShapeKindCount <= kGatheredShadeMaxKeys && !sc.csg;
     switch (asked) {
         case ShadeMode::Scalar: return ShadeMode::Scalar;
         case ShadeMode::Sorted: return ShadeMode::Sorted;
@@ -44,6 +46,11 @@ inline ShadeMode resolve_shade_mode(const StreamScene& sc, ShadeMode asked) {
     if (sc.object_count <= kSortedShadeMaxObjects) return ShadeMode::Sorted;
     return gather_ok ? ShadeMode::Gathered : ShadeMode::Scalar;
 }
+
+/// The unit world normal shown where object `xf`'s canonical normal is nc: Mn nc, turned
+/// round on a CSG shape's surface seen from the shape's outside (ObjectXf::flip), so that it
+/// points out of the CSG result.
+inline Vec3f shown_normal(const ObjectXf& xf, const Vec3f& nc) { return apply_normal(xf.m, xf.flip ? -nc : nc); }
 
 namespace stage_detail {
 
@@ -216,7 +223,7 @@ struct ShadeStage {
             const std::size_t k = hits.hits;
             if constexpr (kShadows) hits.order[k] = std::int32_t(i), ++hits.hits;
             ScalarSink sink{accum, px, next, shadows, counts, keys, i, hits, k, rules.degree >= 6};
-            const Vec3f n_out = apply_normal(ob.xf.m, nc);
+            const Vec3f n_out = shown_normal(ob.xf, nc);
             ColorT<float> color{sf.color[0], sf.color[1], sf.color[2]};
             if (m.texture) {  // the texture replaces the object's colour (render/texture.h)
                 const float footprint = footprint_width(rays.cone[i], rules.spread, t, dot(d, n_out));

@@ -136,9 +136,8 @@ struct PipelineStages {
         if (sc.accel) {  // the object hierarchy (stream/stream_accel.h)
             sc.accel->closest(kt, view, object.data(), rays.count > 0 && rays.kind[0] == std::uint8_t(RayKind::Primary));
             if (fig) fig->lanes_used += rays.count, fig->lanes_total += rays.count;
-            return;
         }
-        for (int k = 0; k < kShapeKindCount; ++k) {
+        for (int k = 0; !sc.accel && k < kShapeKindCount; ++k) {
             const auto& group = sc.groups[k];
             if (group.empty()) continue;
             if (sc.group_bounded[k])
@@ -150,6 +149,8 @@ struct PipelineStages {
                 fig->lanes_total += stage_detail::lanes_for(rays.count, shape_computes_in_double(ShapeKind(k)) ? kt.float_lanes / 2 : kt.float_lanes);
             }
         }
+        // CSG objects after the others: their spans start from the ray's closest hit so far.
+        if (sc.csg) sc.csg->closest(view, object.data());
     }
 
     /// occlusion: any-hit kernels per shape kind (early exit per packet); the caller adds the
@@ -172,6 +173,7 @@ struct PipelineStages {
                 fig->lanes_total += stage_detail::lanes_for(shadows.count, shape_computes_in_double(ShapeKind(k)) ? kt.float_lanes / 2 : kt.float_lanes);
             }
         }
+        if (sc.csg) sc.csg->any(view_of(shadows));  // the rays still open after the others
     }
 
     /// What the stages of one chunk share.

@@ -8,6 +8,10 @@ namespace streamrt {
 
 KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t id, const glm::dvec3& shift) {
     const Object& o = scene.objects[index];
+    return kernel_object(o, scene.mesh_of(o), id, shift);
+}
+
+KernelObject kernel_object(const Object& o, const Mesh* mesh, std::int32_t id, const glm::dvec3& shift) {
     // Mi of the object moved by -shift: Mi T(shift), composed in double before rounding.
     glm::dmat4x3 mi = affine_inverse(o.md);
     mi[3] += glm::dmat3(mi) * shift;
@@ -16,7 +20,6 @@ KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t i
         for (int c = 0; c < 4; ++c) k.xf.m[r * 4 + c] = float(mi[c][r]);  // glm is column-major
     k.xf.param = float(o.param);
     k.xf.id = std::uint32_t(id);
-    const Mesh* mesh = scene.mesh_of(o);
     k.xf.mesh = mesh ? &mesh->view() : nullptr;
     k.xf.kind = std::uint32_t(o.kind);
     return k;
@@ -44,6 +47,11 @@ StreamAccel::StreamAccel(const Scene& scene, std::unique_ptr<accel::SceneBvh> bv
         objects_[id] = kernel_object(scene, order_[id], std::int32_t(id), shift);
     });
     for (std::size_t id = n_bounded; id < order_.size(); ++id) unbounded_[objects_[id].xf.kind].push_back(objects_[id].xf);
+}
+
+void StreamAccel::set_tail(std::span<const KernelObject> tail) {
+    objects_.resize(order_.size());
+    objects_.insert(objects_.end(), tail.begin(), tail.end());
 }
 
 std::size_t StreamAccel::memory_bytes() const {

@@ -21,6 +21,8 @@ namespace streamrt {
 /// The stream engine's record of scene object `index`, moved by -shift (the engine renders
 /// relative to the eye), with id `id` in the engine's tables.
 KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t id, const glm::dvec3& shift);
+/// The same for object `o` (a scene object or a CSG shape) and its mesh (null but for meshes).
+KernelObject kernel_object(const Object& o, const Mesh* mesh, std::int32_t id, const glm::dvec3& shift);
 
 class StreamAccel {
   public:
@@ -37,8 +39,13 @@ class StreamAccel {
     /// Any hit for shadow rays (see AnyHitFn).
     void any(const KernelTable& kt, RayView rays) const;
 
-    /// Every object, bounded ones in leaf order then the unbounded ones; ids index it.
+    /// Every object, bounded ones in leaf order then the unbounded ones, then the tail's; ids
+    /// index it.
     const FillLaterVec<KernelObject>& objects() const { return objects_; }
+    /// Records the walk never meets, kept after the scene's so that one array holds every
+    /// record the shade stage reads by id: a scene's CSG shapes (stream/stream_csg.h), whose
+    /// ids follow the scene objects'. Replaces the tail set before; objects() may move.
+    void set_tail(std::span<const KernelObject> tail);
     /// The scene index of the object with id `id`.
     std::uint32_t scene_index(std::int32_t id) const { return order_[std::size_t(id)]; }
     const std::vector<std::uint32_t>& scene_order() const { return order_; }

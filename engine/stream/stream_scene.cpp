@@ -47,11 +47,6 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
                          const accel::AccelConfig& accel_config)
     : settings(render_settings), accel_config_(accel_config) {
     scene.check_object_count();  // a scene made in code (the Python module) is checked here
-    // The recursive engine traces csg objects; the stream engine's CSG kind comes in a later
-    // slice (issue 49): refused at the block rather than rendered without its objects.
-    if (!scene.csg_objects.empty())
-        throw SceneError(scene.csg_where(0), "csg objects are rendered by the recursive engine only for now "
-                                             "(--engine recursive)");
     // Objects are moved as they are converted (no copy of the scene: at 1e6 objects that copy
     // doubled the memory and the set-up time).
     glm::dvec3 eye;
@@ -67,12 +62,9 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
     accel = StreamAccel::build_for(scene, accel_config_, eye);
     const std::size_t n = scene.objects.size();
     std::fill(std::begin(group_bounded), std::end(group_bounded), true);
-    if (accel) {
-        objects = accel->objects().data();
-    } else {
-        convert_flat(scene);
-    }
-    object_count = n;
+    if (!accel) convert_flat(scene);
+    csg = StreamCsg::build_for(scene, std::int32_t(n), eye);
+    link_objects(n);
     fill_surfaces(scene);
 
     bool any_refl = false, any_trans = false, any_fresnel = false, any_diff = false;
@@ -108,12 +100,25 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
 
 void StreamScene::fill_surfaces(const Scene& scene) {
     const std::size_t n = scene.objects.size();
-    surfaces.resize(n);
-    want_huge_pages(surfaces.data(), n);
+    surfaces.resize(object_count);
+    want_huge_pages(surfaces.data(), object_count);
     parallel_for_index(n, 4096, [&](std::size_t id) {
         const Object& o = scene.objects[accel ? accel->scene_index(std::int32_t(id)) : id];
         surfaces[id] = {{o.color.x, o.color.y, o.color.z}, o.material};
     });
+    if (csg) std::copy(csg->surfaces().begin(), csg->surfaces().end(), surfaces.begin() + std::ptrdiff_t(n));
+}
+
+void StreamScene::link_objects(std::size_t scene_objects) {
+    object_count = scene_objects + (csg ? csg->records().size() : 0);
+    if (accel) {
+        if (csg) accel->set_tail(csg->records());
+        objects = accel->objects().data();
+        return;
+    }
+    flat_objects_.resize(scene_objects);
+    if (csg) flat_objects_.insert(flat_objects_.end(), csg->records().begin(), csg->records().end());
+    objects = flat_objects_.data();
 }
 
 void StreamScene::convert_lights(const Scene& scene) {
@@ -156,7 +161,6 @@ void StreamScene::convert_flat(const Scene& scene) {
             }
             group_bounds[int(o.kind)].push_back(box);
         }
-        objects = flat_objects_.data();
     }
 }
 
@@ -172,13 +176,18 @@ void StreamScene::update(const Scene& scene, const FrameChange& change) {
             const glm::vec3 offset = cell_offset(scene.materials[m], eye);
             materials[m].cell_offset = {offset.x, offset.y, offset.z};
         }
-    if (!shifted && change.objects.empty()) return;
+    if (!shifted && change.objects.empty() && change.csg.empty()) return;
+    // CSG records follow the eye and a keyed block: rebuilt whole (a few per object).
+    if ((shifted || !change.csg.empty()) && csg) csg = StreamCsg::build_for(scene, std::int32_t(scene.objects.size()), eye);
     if (!accel) {
         convert_flat(scene);  // O(N): few objects, unless --accel flat forces the flat loops
+        link_objects(scene.objects.size());
     } else if (!accel->update(scene, change.objects, eye, shifted)) {
         accel = StreamAccel::build_for(scene, accel_config_, eye);
-        objects = accel->objects().data();
+        link_objects(scene.objects.size());
         fill_surfaces(scene);  // ids follow the new leaf order
+    } else {
+        link_objects(scene.objects.size());  // the CSG records follow the eye
     }
 }
 

@@ -12,6 +12,7 @@
 #include "scene/animation.h"
 #include "scene/scene.h"
 #include "stream/stream_accel.h"
+#include "stream/stream_csg.h"
 
 namespace streamrt {
 
@@ -59,6 +60,9 @@ struct StreamScene {
     /// The object hierarchy, when the scene is traced with one (stream/stream_accel.h); the
     /// intersect and occlusion stages then use it instead of `groups`, and it owns `objects`.
     std::shared_ptr<StreamAccel> accel;
+    /// The CSG objects (stream/stream_csg.h), null in a scene without them; their shapes'
+    /// records follow the scene objects' in `objects` and `surfaces` (counted in object_count).
+    std::shared_ptr<const StreamCsg> csg;
     /// The meshes the objects use (kept alive here: the objects' records point into them).
     std::vector<std::shared_ptr<const Mesh>> meshes;
     bool has_meshes = false;
@@ -89,6 +93,9 @@ struct StreamScene {
     void convert_flat(const Scene& scene);    ///< fills flat_objects_, groups and their bounds
     void convert_lights(const Scene& scene);
     void fill_surfaces(const Scene& scene);   ///< by id: colour and material
+    /// Points `objects` at the records (the hierarchy's or flat_objects_) with the CSG shapes'
+    /// after them, and sets object_count.
+    void link_objects(std::size_t scene_objects);
 };
 
 }  // namespace streamrt

@@ -30,8 +30,7 @@ LEVELS = ["sse2", "sse4.2", "avx2", "avx512"]
 
 def default_scenes():
     scenes = sorted((ROOT / "scenes").rglob("*.cfg")) + sorted((ROOT / "tests/reference/scenes").glob("*.cfg"))
-    # scenes/csg/: the stream engine refuses CSG objects until its CSG kind comes (issue 49).
-    return [s for s in scenes if s.name != "common.cfg" and s.parent.name != "csg"]
+    return [s for s in scenes if s.name != "common.cfg"]
 
 
 def read_pfm(path):

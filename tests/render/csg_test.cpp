@@ -10,8 +10,10 @@
 #include "driver/render.h"
 #include "render/csg_spans.h"
 #include "scene/parser.h"
+#include "csg_cases.h"
 
 using namespace streamrt;
+using namespace streamrt::csg_cases;
 
 namespace {
 
@@ -30,29 +32,6 @@ void check_vec(const Vec3d& v, double x, double y, double z) {
     CHECK(v.y == doctest::Approx(y).epsilon(1e-9));
     CHECK(v.z == doctest::Approx(z).epsilon(1e-9));
 }
-
-// A biconvex lens: spheres of radius 2 centred at z = -1.5 and z = +1.5, intersected. Along the
-// axis it spans z in [-0.5, 0.5]; at x = 1 it spans |z| <= sqrt(3) - 1.5.
-const char* const kLens =
-    "csg intersection\n"
-    "  sphere scale=2,2,2 translate=0,0,-1.5\n"
-    "  sphere scale=2,2,2 translate=0,0,1.5\n"
-    "end\n";
-
-// A pipe: a cylinder of radius 1 and height 4 minus a longer one of radius 0.8.
-const char* const kPipe =
-    "csg difference\n"
-    "  cylinder scale=1,2,1\n"
-    "  cylinder scale=0.8,2.1,0.8\n"
-    "end\n";
-
-// A die with one dimple: the cube [-1,1]^3 minus a sphere of radius 0.5 at z = 1.2, which cuts
-// a cap of depth 0.3 into the face z = 1.
-const char* const kDie =
-    "csg difference\n"
-    "  cube\n"
-    "  sphere scale=0.5,0.5,0.5 translate=0,0,1.2\n"
-    "end\n";
 
 }  // namespace
 
@@ -187,19 +166,6 @@ TEST_CASE("csg: a difference with a disjoint child is its first child alone") {
         recursive_image(lit_scene("csg difference\n  " + first + "\n  cylinder translate=10,0,0\nend\n"));
     CHECK(differing_pixels(plain, csg) == 0);
     CHECK(differing_pixels(plain, recursive_image(lit_scene(""))) > 100);
-}
-
-TEST_CASE("csg: the stream engine refuses csg objects at their block for now") {
-    const Scene s = parse("sphere\n\n  csg union\n  sphere\n  end\n");
-    Parallelism par(1);
-    try {
-        render_scene(s, EngineKind::Stream, par);
-        FAIL("expected a SceneError");
-    } catch (const SceneError& e) {
-        CHECK(e.where().line == 3);
-        CHECK(e.where().column == 3);
-        CHECK(std::string(e.what()).find("--engine recursive") != std::string::npos);
-    }
 }
 
 TEST_CASE("csg: combining span lists by hand") {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "image/image_compare.h"
+#include "image_bits.h"
 #include "kernels/kernel_table.h"
 #include "parallel/parallelism.h"
 #include "driver/render.h"
@@ -37,11 +38,8 @@ std::vector<fs::path> scene_files() {
     // scenes/stress/ holds the stiff cases of docs/stability.md, each with its own stated
     // bounds, asserted by tests/stress/stress_test.cpp.
     const fs::path stress = fs::path(STREAMRT_SOURCE_DIR) / "scenes" / "stress";
-    // scenes/csg/: the stream engine refuses CSG objects until its CSG kind comes (issue 49).
-    const fs::path csg = fs::path(STREAMRT_SOURCE_DIR) / "scenes" / "csg";
     for (const auto& e : fs::recursive_directory_iterator(fs::path(STREAMRT_SOURCE_DIR) / "scenes"))
-        if (e.is_regular_file() && e.path().extension() == ".cfg" && e.path().parent_path() != stress &&
-            e.path().parent_path() != csg)
+        if (e.is_regular_file() && e.path().extension() == ".cfg" && e.path().parent_path() != stress)
             v.push_back(e.path());
     std::sort(v.begin(), v.end());
     return v;
@@ -102,13 +100,6 @@ Framebuffer render_with(const Scene& s, EngineKind engine, int jobs, Isa isa = b
     opt.isa = isa;
     opt.shade = shade;
     return render_scene(s, engine, par, nullptr, opt).image;
-}
-
-bool bit_identical(const Framebuffer& a, const Framebuffer& b) {
-    if (a.width != b.width || a.height != b.height) return false;
-    for (int y = 0; y < a.height; ++y)
-        if (std::memcmp(a.pixel(0, y), b.pixel(0, y), sizeof(float) * 3 * std::size_t(a.width)) != 0) return false;
-    return true;
 }
 
 /// The worst pixels of `a` against `b`, for the failure message.

@@ -1,0 +1,30 @@
+#pragma once
+// CSG objects whose surfaces are worked out by hand, for both engines' tests (csg_test.cpp,
+// csg_stream_test.cpp).
+
+namespace streamrt::csg_cases {
+
+// A biconvex lens: spheres of radius 2 centred at z = -1.5 and z = +1.5, intersected. Along the
+// axis it spans z in [-0.5, 0.5]; at x = 1 it spans |z| <= sqrt(3) - 1.5.
+inline const char* const kLens =
+    "csg intersection\n"
+    "  sphere scale=2,2,2 translate=0,0,-1.5\n"
+    "  sphere scale=2,2,2 translate=0,0,1.5\n"
+    "end\n";
+
+// A pipe: a cylinder of radius 1 and height 4 minus a longer one of radius 0.8.
+inline const char* const kPipe =
+    "csg difference\n"
+    "  cylinder scale=1,2,1\n"
+    "  cylinder scale=0.8,2.1,0.8\n"
+    "end\n";
+
+// A die with one dimple: the cube [-1,1]^3 minus a sphere of radius 0.5 at z = 1.2, which cuts
+// a cap of depth 0.3 into the face z = 1.
+inline const char* const kDie =
+    "csg difference\n"
+    "  cube\n"
+    "  sphere scale=0.5,0.5,0.5 translate=0,0,1.2\n"
+    "end\n";
+
+}  // namespace streamrt::csg_cases
