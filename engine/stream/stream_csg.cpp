@@ -1,9 +1,29 @@
 #include "stream/stream_csg.h"
 
-#include "core/transform.h"
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+
+#include "render/csg_spans.h"
 #include "stream/stream_accel.h"
 
 namespace streamrt {
+
+namespace {
+
+/// The smallest and largest shape number under node `node`.
+void shape_range(const std::vector<CsgNode>& nodes, std::uint32_t node, std::uint32_t& lo, std::uint32_t& hi) {
+    for (const CsgNode::Child& c : nodes[node].children) {
+        if (c.is_node) {
+            shape_range(nodes, c.index, lo, hi);
+        } else {
+            lo = std::min(lo, c.index);
+            hi = std::max(hi, c.index);
+        }
+    }
+}
+
+}  // namespace
 
 std::unique_ptr<const StreamCsg> StreamCsg::build_for(const Scene& scene, std::int32_t first_id,
                                                       const glm::dvec3& eye) {
@@ -12,68 +32,42 @@ std::unique_ptr<const StreamCsg> StreamCsg::build_for(const Scene& scene, std::i
 }
 
 StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3& eye)
-    : nodes_(scene.csg_nodes), first_id_(first_id), shapes_(std::int32_t(scene.csg_shapes.size())) {
+    : nodes_(scene.csg_nodes), scene_objects_(scene.csg_objects.size()) {
+    const auto shapes = std::int32_t(scene.csg_shapes.size());
     for (const CsgObject& o : scene.csg_objects) {
-        roots_.push_back(o.root);
-        CsgBox box = csg_node_box(scene, o.root);
-        for (int a = 0; a < 3; ++a) box.lo[a] -= eye[a], box.hi[a] -= eye[a];  // infinite ends stay so
-        boxes_.push_back(box);
+        const CsgBox box = csg_node_box(scene, o.root);
+        if (box.empty()) continue;  // children that cannot overlap: nothing to hit
+        CsgObjectView v{};
+        v.root = o.root;
+        v.bounded = box.bounded();
+        if (v.bounded) v.box = padded_bounds(box.lo, box.hi, eye);
+        std::uint32_t lo = std::numeric_limits<std::uint32_t>::max(), hi = 0;
+        shape_range(nodes_, o.root, lo, hi);
+        v.first_shape = lo;
+        v.shape_count = hi - lo + 1;
+        // The reader numbers an object's shapes one after the other (at most kMaxCsgShapes):
+        // the kernels' per-lane arrays are indexed by shape - first_shape.
+        if (v.shape_count > std::uint32_t(kMaxCsgShapes))
+            throw std::logic_error("a csg object's shapes are not numbered consecutively");
+        objects_.push_back(v);
     }
-    records_.resize(2 * std::size_t(shapes_));
+    records_.resize(2 * std::size_t(shapes));
     surfaces_.resize(records_.size());
-    for (std::int32_t k = 0; k < shapes_; ++k) {
+    for (std::int32_t k = 0; k < shapes; ++k) {
         const Object& s = scene.csg_shapes[std::size_t(k)];
         for (const std::int32_t flip : {0, 1}) {
-            const std::size_t at = std::size_t(k + flip * shapes_);
+            const std::size_t at = std::size_t(k + flip * shapes);
             records_[at] = kernel_object(s, scene.mesh_of(s), first_id + std::int32_t(at), eye);
             records_[at].xf.flip = std::uint32_t(flip);
             surfaces_[at] = {{s.color.x, s.color.y, s.color.z}, s.material};
         }
     }
-}
-
-const CsgBoundary<float>* StreamCsg::first_surface(std::size_t k, const Vec3f& o, const Vec3f& d, float t_max,
-                                                   CsgSpans<float>& spans) const {
-    if (!ray_may_meet(boxes_[k], o, d, 0.f, t_max)) return nullptr;
-    // Each shape's span from the ray in its canonical space, as the shade stage will find the
-    // hit point there again (the same float Mi, the same evaluation order).
-    csg_node_spans(nodes_.data(), roots_[k],
-                   [&](std::uint32_t shape) {
-                       const ObjectXf& xf = records_[shape].xf;
-                       return csg_shape_span(ShapeKind(xf.kind), apply_point(xf.m, o), apply_vector(xf.m, d), xf.param);
-                   },
-                   spans);
-    return first_boundary(spans, 0.f, t_max);
-}
-
-void StreamCsg::closest(RayView rays, std::int32_t* object) const {
-    CsgSpans<float> spans;
-    for (std::size_t i = 0; i < rays.count; ++i) {
-        float t_max = rays.t_max[i];
-        if (!(t_max > 0.f)) continue;
-        const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
-        for (std::size_t k = 0; k < roots_.size(); ++k) {
-            const CsgBoundary<float>* at = first_surface(k, o, d, t_max, spans);
-            if (!at) continue;
-            t_max = at->t;
-            object[i] = first_id_ + std::int32_t(at->shape) + (at->flip ? shapes_ : 0);
-        }
-        rays.t_max[i] = t_max;
-    }
-}
-
-void StreamCsg::any(RayView rays) const {
-    CsgSpans<float> spans;
-    for (std::size_t i = 0; i < rays.count; ++i) {
-        const float t_max = rays.t_max[i];
-        if (!(t_max > 0.f)) continue;
-        const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
-        for (std::size_t k = 0; k < roots_.size(); ++k)
-            if (first_surface(k, o, d, t_max, spans)) {
-                rays.t_max[i] = 0.f;
-                break;
-            }
-    }
+    view_ = {.nodes = nodes_.data(),
+             .objects = objects_.data(),
+             .count = objects_.size(),
+             .records = records_.data(),
+             .first_id = first_id,
+             .shapes = shapes};
 }
 
 }  // namespace streamrt

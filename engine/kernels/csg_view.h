@@ -1,0 +1,36 @@
+#pragma once
+// CSG objects as the kernels read them (kernels/csg_kernel.h): raw data only, like the other
+// kernel records (see kernels/intersect_kernel.h on why).
+#include <cstddef>
+#include <cstdint>
+
+#include "kernels/kernel_object.h"
+#include "kernels/ray_stream.h"
+#include "scene/scene.h"
+
+namespace streamrt {
+
+/// One CSG object: its root node, the range of its shapes' records (the reader gives an
+/// object's shapes consecutive numbers) and its result's box.
+struct CsgObjectView {
+    ObjectBounds box;         ///< relative to the eye, padded outwards (never culls a ray that meets the result)
+    bool bounded;             ///< false: the box is infinite (a plane's half-space); nothing is culled
+    std::uint32_t root;       ///< into CsgView::nodes
+    std::uint32_t first_shape, shape_count;  ///< records [first_shape, first_shape + shape_count)
+};
+
+/// Every CSG object of a scene (stream/stream_csg.h).
+struct CsgView {
+    const CsgNode* nodes;          ///< Scene::csg_nodes
+    const CsgObjectView* objects;  ///< the objects with a non-empty box
+    std::size_t count;
+    const KernelObject* records;   ///< shape k's record at k, its flipped one at shapes + k
+    std::int32_t first_id;         ///< the id of records[0] in the engine's tables
+    std::int32_t shapes;           ///< Scene::csg_shapes.size()
+};
+
+/// Closest hit (see ClosestHitFn), through CSG objects; any hit (see AnyHitFn) likewise.
+using CsgClosestFn = void (*)(const CsgView& csg, RayView rays, std::int32_t* object);
+using CsgAnyFn = void (*)(const CsgView& csg, RayView rays);
+
+}  // namespace streamrt
