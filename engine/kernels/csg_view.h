@@ -17,6 +17,10 @@ struct CsgObjectView {
     bool bounded;             ///< false: the box is infinite (a plane's half-space); nothing is culled
     std::uint32_t root;       ///< into CsgView::nodes
     std::uint32_t first_shape, shape_count;  ///< records [first_shape, first_shape + shape_count)
+    /// A root of two shapes (the common node: a lens, a pipe), combined in lanes
+    /// (csg_pair_boundary); other trees are combined per lane.
+    bool pair;
+    CsgOp op;  ///< the root's
 };
 
 /// Every CSG object of a scene (stream/stream_csg.h).

@@ -49,6 +49,11 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
         // the kernels' per-lane arrays are indexed by shape - first_shape.
         if (v.shape_count > std::uint32_t(kMaxCsgShapes))
             throw std::logic_error("a csg object's shapes are not numbered consecutively");
+        const CsgNode& root = nodes_[o.root];
+        v.op = root.op;
+        // (children 0 and 1 are its shapes first_shape and first_shape + 1, in the kernels' arrays)
+        v.pair = root.children.size() == 2 && !root.children[0].is_node && !root.children[1].is_node &&
+                 root.children[0].index == lo && root.children[1].index == lo + 1;
         objects_.push_back(v);
     }
     records_.resize(2 * std::size_t(shapes));

@@ -63,6 +63,14 @@ const char* const kScenes[] = {
     " sphere scale=0.6 translate=0.8,0.8,0.8\n"
     "end\n"
     "csg intersection translate=0,0,-3\n sphere\n plane rotate_z=30\nend\n",
+    // Two-shape roots of every operation (combined in lanes), and coinciding spans: the tie rule.
+    "csg union\n sphere translate=-0.5,0,0\n cube scale=0.7 translate=0.4,0.2,0\nend\n"
+    "csg merge translate=0,0,-2\n cylinder scale=0.5,1,0.5\n cone rotate_x=90\nend\n",
+    "csg union\n sphere\n sphere\nend\ncsg merge translate=1,1,-2\n cube\n cube\nend\n",
+    "csg intersection\n sphere\n sphere\nend\ncsg difference translate=1,1,-2\n cube\n cube\nend\n"
+    "csg difference translate=-1,-1,1\n sphere\n sphere\nend\n",
+    "csg difference\n cube\n cube translate=0,0,1\nend\ncsg intersection translate=0,0,-2\n cube\n cube translate=1,0,0\nend\n"
+    "csg union translate=0,2,0\n cube\n cube translate=2,0,0\nend\n",
 };
 
 }  // namespace
