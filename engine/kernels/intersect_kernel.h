@@ -140,6 +140,12 @@ void any_hit_impl(RayView rays, const ObjectXf* objs, const ObjectBounds* bounds
     }
 }
 
+}  // namespace streamrt::STREAMRT_ISA_NAMESPACE
+
+#include "kernels/csg_kernel.h"  // after the packet helpers above, which it uses
+
+namespace streamrt::STREAMRT_ISA_NAMESPACE {
+
 template <class Arch, class Shape>
 void closest_hit(RayView rays, std::int32_t* object, const ObjectXf* objs, std::size_t n_objs) {
     closest_hit_impl<Arch, Shape>(rays, object, objs, nullptr, n_objs);
@@ -337,7 +343,9 @@ KernelTable make_table(Isa isa, const char* name, ShapeList<S...>) {
                        shade_variants<Arch, false>(std::make_integer_sequence<int, kShadeVariants>{}),
                        shade_variants<Arch, true>(std::make_integer_sequence<int, kShadeVariants>{}),
                        &generate_rays<Arch>,
-                       &generate_lens_rays<Arch>};
+                       &generate_lens_rays<Arch>,
+                       &csg_closest<Arch>,
+                       &csg_any<Arch>};
 }
 
 template <class Arch>

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "kernels/csg_view.h"
 #include "kernels/kernel_object.h"
 #include "kernels/shade_job.h"
 #include "mesh/mesh_view.h"
@@ -49,6 +50,8 @@ struct KernelTable {
     std::array<ShadeFn, kShadeVariants> shade_gathered;  ///< runs of one material and kind, objects per lane
     GenerateFn generate;
     GenerateFn generate_lens;  ///< thin-lens cameras (aperture > 0) only
+    CsgClosestFn csg_closest;  ///< scenes with CSG objects only (stream/stream_csg.h)
+    CsgAnyFn csg_any;
 };
 
 /// The best level this CPU runs.

@@ -14,8 +14,11 @@
 #include "mesh/mesh_trace.h"
 #include "scene/scene_bvh.h"
 #include "shapes/shapes.h"
+#include "simd/isa_namespace.h"
 
 namespace streamrt {
+
+STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
 /// One end of a span: where the line crosses the surface of shape `shape` (an index in
 /// Scene::csg_shapes), and whether that surface's normal points into the result (a subtracted
@@ -225,4 +228,5 @@ bool ray_may_meet(const CsgBox& box, const Vec3T<V>& o, const Vec3T<V>& d, V t_m
     return s.enter <= s.exit && s.enter < t_max && s.exit > t_min;
 }
 
+STREAMRT_ISA_END
 }  // namespace streamrt

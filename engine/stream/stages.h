@@ -150,7 +150,7 @@ struct PipelineStages {
             }
         }
         // CSG objects after the others: their spans start from the ray's closest hit so far.
-        if (sc.csg) sc.csg->closest(view, object.data());
+        if (sc.csg) sc.csg->closest(kt, view, object.data());
     }
 
     /// occlusion: any-hit kernels per shape kind (early exit per packet); the caller adds the
@@ -173,7 +173,7 @@ struct PipelineStages {
                 fig->lanes_total += stage_detail::lanes_for(shadows.count, shape_computes_in_double(ShapeKind(k)) ? kt.float_lanes / 2 : kt.float_lanes);
             }
         }
-        if (sc.csg) sc.csg->any(view_of(shadows));  // the rays still open after the others
+        if (sc.csg) sc.csg->any(kt, view_of(shadows));  // the rays still open after the others
     }
 
     /// What the stages of one chunk share.

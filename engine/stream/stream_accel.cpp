@@ -1,5 +1,8 @@
 #include "stream/stream_accel.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/memory_advice.h"
 #include "mesh/mesh.h"
 #include "parallel/parallelism.h"
@@ -23,6 +26,19 @@ KernelObject kernel_object(const Object& o, const Mesh* mesh, std::int32_t id, c
     k.xf.mesh = mesh ? &mesh->view() : nullptr;
     k.xf.kind = std::uint32_t(o.kind);
     return k;
+}
+
+ObjectBounds padded_bounds(const double lo[3], const double hi[3], const glm::dvec3& shift) {
+    ObjectBounds box{};
+    for (int a = 0; a < 3; ++a) {
+        const double l = lo[a] - shift[a], h = hi[a] - shift[a];
+        // A relative margin and a few float ulps of the coordinates, so that the float slab
+        // test never culls a packet the shape would hit.
+        const double pad = 1e-5 * (h - l) + 8.0 * 1.2e-7 * std::max(std::fabs(l), std::fabs(h));
+        box.lo[a] = std::nextafter(float(l - pad), -INFINITY);
+        box.hi[a] = std::nextafter(float(h + pad), INFINITY);
+    }
+    return box;
 }
 
 std::shared_ptr<StreamAccel> StreamAccel::build_for(const Scene& scene, const accel::AccelConfig& config,

@@ -23,6 +23,9 @@ namespace streamrt {
 KernelObject kernel_object(const Scene& scene, std::size_t index, std::int32_t id, const glm::dvec3& shift);
 /// The same for object `o` (a scene object or a CSG shape) and its mesh (null but for meshes).
 KernelObject kernel_object(const Object& o, const Mesh* mesh, std::int32_t id, const glm::dvec3& shift);
+/// The world box [lo, hi] moved by -shift, in float, padded outwards for the kernels' per-packet
+/// culling (ObjectBounds).
+ObjectBounds padded_bounds(const double lo[3], const double hi[3], const glm::dvec3& shift);
 
 class StreamAccel {
   public:

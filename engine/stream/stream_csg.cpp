@@ -1,12 +1,31 @@
 #include "stream/stream_csg.h"
 
+#include <algorithm>
 #include <limits>
+#include <stdexcept>
 
 #include "core/transform.h"
 #include "mesh/mesh_trace.h"
+#include "render/csg_spans.h"
 #include "stream/stream_accel.h"
 
 namespace streamrt {
+
+namespace {
+
+/// The smallest and largest shape number under node `node`.
+void shape_range(const std::vector<CsgNode>& nodes, std::uint32_t node, std::uint32_t& lo, std::uint32_t& hi) {
+    for (const CsgNode::Child& c : nodes[node].children) {
+        if (c.is_node) {
+            shape_range(nodes, c.index, lo, hi);
+        } else {
+            lo = std::min(lo, c.index);
+            hi = std::max(hi, c.index);
+        }
+    }
+}
+
+}  // namespace
 
 std::unique_ptr<const StreamCsg> StreamCsg::build_for(const Scene& scene, std::int32_t first_id,
                                                       const glm::dvec3& eye) {
@@ -15,85 +34,90 @@ std::unique_ptr<const StreamCsg> StreamCsg::build_for(const Scene& scene, std::i
 }
 
 StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3& eye)
-    : nodes_(scene.csg_nodes), first_id_(first_id), shapes_(std::int32_t(scene.csg_shapes.size())) {
+    : nodes_(scene.csg_nodes), scene_objects_(scene.csg_objects.size()) {
+    const auto shapes = std::int32_t(scene.csg_shapes.size());
     for (const CsgObject& o : scene.csg_objects) {
-        roots_.push_back(o.root);
-        CsgBox box = csg_node_box(scene, o.root);
-        for (int a = 0; a < 3; ++a) box.lo[a] -= eye[a], box.hi[a] -= eye[a];  // infinite ends stay so
-        boxes_.push_back(box);
+        const CsgBox box = csg_node_box(scene, o.root);
+        if (box.empty()) continue;  // children that cannot overlap: nothing to hit
+        CsgObjectView v{};
+        v.root = o.root;
+        v.bounded = box.bounded();
+        if (v.bounded) v.box = padded_bounds(box.lo, box.hi, eye);
+        std::uint32_t lo = std::numeric_limits<std::uint32_t>::max(), hi = 0;
+        shape_range(nodes_, o.root, lo, hi);
+        v.first_shape = lo;
+        v.shape_count = hi - lo + 1;
+        // The reader numbers an object's shapes one after the other (at most kMaxCsgShapes):
+        // the kernels' per-lane arrays are indexed by shape - first_shape.
+        if (v.shape_count > std::uint32_t(kMaxCsgShapes))
+            throw std::logic_error("a csg object's shapes are not numbered consecutively");
+        const CsgNode& root = nodes_[o.root];
+        v.op = root.op;
+        // (children 0 and 1 are its shapes first_shape and first_shape + 1, in the kernels' arrays)
+        v.pair = root.children.size() == 2 && !root.children[0].is_node && !root.children[1].is_node &&
+                 root.children[0].index == lo && root.children[1].index == lo + 1;
+        for (std::uint32_t s = lo; s <= hi; ++s) v.scalar = v.scalar || scene.csg_shapes[s].kind == ShapeKind::Mesh;
+        v.pair = v.pair && !v.scalar;
+        objects_.push_back(v);
     }
-    records_.resize(2 * std::size_t(shapes_));
+    records_.resize(2 * std::size_t(shapes));
     surfaces_.resize(records_.size());
-    for (std::int32_t k = 0; k < shapes_; ++k) {
+    for (std::int32_t k = 0; k < shapes; ++k) {
         const Object& s = scene.csg_shapes[std::size_t(k)];
         meshes_.push_back(scene.mesh_of(s));
         for (const std::int32_t flip : {0, 1}) {
-            const std::size_t at = std::size_t(k + flip * shapes_);
+            const std::size_t at = std::size_t(k + flip * shapes);
             records_[at] = kernel_object(s, scene.mesh_of(s), first_id + std::int32_t(at), eye);
             records_[at].xf.flip = std::uint32_t(flip);
             surfaces_[at] = {{s.color.x, s.color.y, s.color.z}, s.material};
         }
     }
+    view_ = {.nodes = nodes_.data(),
+             .objects = objects_.data(),
+             .count = objects_.size(),
+             .records = records_.data(),
+             .first_id = first_id,
+             .shapes = shapes,
+             .meshes = meshes_.data()};
 }
 
-const CsgBoundary<float>* StreamCsg::first_surface(std::size_t k, const Vec3f& o, const Vec3f& d, float t_max,
-                                                   CsgSpans<float>& spans) const {
-    if (!ray_may_meet(boxes_[k], o, d, 0.f, t_max)) return nullptr;
-    // Each shape's span from the ray in its canonical space, as the shade stage will find the
-    // hit point there again (the same float Mi, the same evaluation order).
-    csg_node_spans(nodes_.data(), roots_[k],
+bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[3], const float d[3], float& t_max,
+                     std::int32_t& object, std::int32_t* prim, float* bu, float* bv) {
+    const Vec3f ow{o[0], o[1], o[2]}, dw{d[0], d[1], d[2]};
+    // Each shape's spans from the ray in its canonical space, as the shade stage will find the
+    // hit point there again (the same float Mi).
+    const auto canonical = [&](std::uint32_t shape) {
+        const ObjectXf& xf = csg.records[shape].xf;
+        return std::pair{apply_point(xf.m, ow), apply_vector(xf.m, dw)};
+    };
+    CsgSpans<float> spans;
+    csg_node_spans(csg.nodes, ob.root,
                    [&](std::uint32_t shape, CsgSpans<float>& into) {
-                       const ObjectXf& xf = records_[shape].xf;
-                       const Vec3f oc = apply_point(xf.m, o), dc = apply_vector(xf.m, d);
-                       if (meshes_[shape]) add_mesh_spans(into, *meshes_[shape], oc, dc, shape);
-                       else add_solid_span(into, csg_shape_span(ShapeKind(xf.kind), oc, dc, xf.param), shape);
+                       const auto [oc, dc] = canonical(shape);
+                       if (const Mesh* m = csg.meshes[shape]) add_mesh_spans(into, *m, oc, dc, shape);
+                       else {
+                           const ObjectXf& xf = csg.records[shape].xf;
+                           add_solid_span(into, csg_shape_span(ShapeKind(xf.kind), oc, dc, xf.param), shape);
+                       }
                    },
                    spans);
-    return first_boundary(spans, 0.f, t_max);
-}
-
-void StreamCsg::closest(RayView rays, std::int32_t* object) const {
-    CsgSpans<float> spans;
-    for (std::size_t i = 0; i < rays.count; ++i) {
-        float t_max = rays.t_max[i];
-        if (!(t_max > 0.f)) continue;
-        const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
-        for (std::size_t k = 0; k < roots_.size(); ++k) {
-            const CsgBoundary<float>* at = first_surface(k, o, d, t_max, spans);
-            if (!at) continue;
-            t_max = at->t;
-            object[i] = first_id_ + std::int32_t(at->shape) + (at->flip ? shapes_ : 0);
-            if (const Mesh* m = meshes_[at->shape]; m && rays.prim) {
-                // The crossing's barycentric coordinates: its triangle met again over every t,
-                // in the shape's canonical space, as the shade stage reads them.
-                const ObjectXf& xf = records_[at->shape].xf;
-                const Vec3f oc = apply_point(xf.m, o), dc = apply_vector(xf.m, d);
-                const MeshView& v = m->view();
-                const float inf = std::numeric_limits<float>::infinity();
-                const TriangleHit<float> h = triangle_hit(watertight_ray(oc, dc), mesh_vertex<float>(v, at->tri, 0),
-                                                          mesh_vertex<float>(v, at->tri, 1), mesh_vertex<float>(v, at->tri, 2),
-                                                          -inf, inf);
-                rays.prim[i] = std::int32_t(at->tri);
-                rays.bu[i] = h.t < inf ? h.u : 1.f / 3.f;
-                rays.bv[i] = h.t < inf ? h.v : 1.f / 3.f;
-            }
-        }
-        rays.t_max[i] = t_max;
+    const CsgBoundary<float>* at = first_boundary(spans, 0.f, t_max);
+    if (!at) return false;
+    t_max = at->t;
+    object = csg.first_id + std::int32_t(at->shape) + (at->flip ? csg.shapes : 0);
+    if (const Mesh* m = csg.meshes[at->shape]; m && prim) {
+        // The crossing's barycentric coordinates: its triangle met again over every t.
+        const auto [oc, dc] = canonical(at->shape);
+        const MeshView& v = m->view();
+        const float inf = std::numeric_limits<float>::infinity();
+        const TriangleHit<float> h = triangle_hit(watertight_ray(oc, dc), mesh_vertex<float>(v, at->tri, 0),
+                                                  mesh_vertex<float>(v, at->tri, 1), mesh_vertex<float>(v, at->tri, 2),
+                                                  -inf, inf);
+        *prim = std::int32_t(at->tri);
+        *bu = h.t < inf ? h.u : 1.f / 3.f;
+        *bv = h.t < inf ? h.v : 1.f / 3.f;
     }
-}
-
-void StreamCsg::any(RayView rays) const {
-    CsgSpans<float> spans;
-    for (std::size_t i = 0; i < rays.count; ++i) {
-        const float t_max = rays.t_max[i];
-        if (!(t_max > 0.f)) continue;
-        const Vec3f o{rays.ox[i], rays.oy[i], rays.oz[i]}, d{rays.dx[i], rays.dy[i], rays.dz[i]};
-        for (std::size_t k = 0; k < roots_.size(); ++k)
-            if (first_surface(k, o, d, t_max, spans)) {
-                rays.t_max[i] = 0.f;
-                break;
-            }
-    }
+    return true;
 }
 
 }  // namespace streamrt

@@ -145,17 +145,7 @@ void StreamScene::convert_flat(const Scene& scene) {
             double lo[3], hi[3];
             ObjectBounds box{};
             if (accel::object_world_bounds(o, scene.mesh_of(o), lo, hi)) {
-                for (int a = 0; a < 3; ++a) {
-                    lo[a] -= eye[a];
-                    hi[a] -= eye[a];
-                    // Padded outwards by a relative margin and a few float ulps of the
-                    // coordinates, so that the float slab test never culls a packet the shape
-                    // would hit.
-                    const double pad =
-                        1e-5 * (hi[a] - lo[a]) + 8.0 * 1.2e-7 * std::max(std::fabs(lo[a]), std::fabs(hi[a]));
-                    box.lo[a] = std::nextafter(float(lo[a] - pad), -INFINITY);
-                    box.hi[a] = std::nextafter(float(hi[a] + pad), INFINITY);
-                }
+                box = padded_bounds(lo, hi, eye);
             } else {
                 group_bounded[int(o.kind)] = false;
             }

@@ -1,0 +1,52 @@
+#pragma once
+// CSG objects as the kernels read them (kernels/csg_kernel.h): raw data only, like the other
+// kernel records (see kernels/intersect_kernel.h on why).
+#include <cstddef>
+#include <cstdint>
+
+#include "kernels/kernel_object.h"
+#include "mesh/mesh.h"
+#include "kernels/ray_stream.h"
+#include "scene/scene.h"
+
+namespace streamrt {
+
+/// One CSG object: its root node, the range of its shapes' records (the reader gives an
+/// object's shapes consecutive numbers) and its result's box.
+struct CsgObjectView {
+    ObjectBounds box;         ///< relative to the eye, padded outwards (never culls a ray that meets the result)
+    bool bounded;             ///< false: the box is infinite (a plane's half-space); nothing is culled
+    std::uint32_t root;       ///< into CsgView::nodes
+    std::uint32_t first_shape, shape_count;  ///< records [first_shape, first_shape + shape_count)
+    /// A root of two shapes (the common node: a lens, a pipe), combined in lanes
+    /// (csg_pair_boundary); other trees are combined per lane.
+    bool pair;
+    CsgOp op;  ///< the root's
+    /// An object with a mesh among its shapes: its lanes take csg_scalar_lane (a mesh may
+    /// cross a line several times: more than the one span per shape the lane arrays hold).
+    bool scalar;
+};
+
+/// Every CSG object of a scene (stream/stream_csg.h).
+struct CsgView {
+    const CsgNode* nodes;          ///< Scene::csg_nodes
+    const CsgObjectView* objects;  ///< the objects with a non-empty box
+    std::size_t count;
+    const KernelObject* records;   ///< shape k's record at k, its flipped one at shapes + k
+    std::int32_t first_id;         ///< the id of records[0] in the engine's tables
+    std::int32_t shapes;           ///< Scene::csg_shapes.size()
+    const Mesh* const* meshes;     ///< per shape: its mesh, or null
+};
+
+/// One lane of an object taken whole in scalar code (CsgObjectView::scalar): its first surface
+/// along o + t d with 0 < t < t_max, or false. On a hit, t_max and the record id; on a mesh
+/// also its triangle and barycentric coordinates (when prim is not null). Compiled once
+/// (stream/stream_csg.cpp), so every ISA level gives the same bits.
+bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[3], const float d[3], float& t_max,
+                     std::int32_t& object, std::int32_t* prim, float* bu, float* bv);
+
+/// Closest hit (see ClosestHitFn), through CSG objects; any hit (see AnyHitFn) likewise.
+using CsgClosestFn = void (*)(const CsgView& csg, RayView rays, std::int32_t* object);
+using CsgAnyFn = void (*)(const CsgView& csg, RayView rays);
+
+}  // namespace streamrt
