@@ -1,0 +1,276 @@
+// streamrt serve (engine/preview/, docs/preview.md): the server in this process on a port the
+// system chooses, spoken to with cpp-httplib's client; the port-in-use case runs the program.
+// Waits are for a state to be reached (a frame, an error), never for a time to pass.
+#include <doctest/doctest.h>
+#include <httplib.h>
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include "cli/cli_support.h"
+#include "driver/render_job.h"
+#include "image/image_io.h"
+#include "preview/serve.h"
+#include "scene/parser.h"
+
+using namespace streamrt;
+using cli_support::Dir;
+
+namespace {
+
+std::string scene_text(const std::string& dir, const std::string& background) {
+    return "image width=64 height=48 spp=2 depth=3 degree=5 output=" + dir + "/out.pfm\n"
+           "background " + background + "\n"
+           "camera eye=0,1.6,6 look=0,0.8,0 up=0,1,0 fov=40\n"
+           "light point pos=-4,7,6 color=0.8,0.8,0.8\n"
+           "plane color=0.95,0.85,0.1 checker=0.85,0.1,0.05 cell=1 ambi=1 diff=0.9\n"
+           "sphere color=0.9,0.9,0.9 refl=0.6 scale=1 translate=-0.9,1,-1.5\n";
+}
+
+/// Polls /status until `done` holds (each poll is a real request); fails after a minute,
+/// which only a hang reaches.
+template <class Done>
+std::string wait_status(httplib::Client& c, Done done) {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    std::string body;
+    while (std::chrono::steady_clock::now() < give_up) {
+        if (auto r = c.Get("/status"); r && r->status == 200) {
+            body = r->body;
+            if (done(body)) return body;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    FAIL("status never reached the state waited for; last: " << body);
+    return body;
+}
+
+/// The integer after "key": in a JSON text (the first one).
+long long json_int(const std::string& json, const std::string& key) {
+    const auto at = json.find("\"" + key + "\":");
+    REQUIRE(at != std::string::npos);
+    return std::atoll(json.c_str() + at + key.size() + 3);
+}
+
+bool idle(const std::string& s) { return s.find("\"pass\":\"idle\"") != std::string::npos; }
+
+struct Served {
+    Dir dir;
+    std::string scene;
+    std::unique_ptr<preview::PreviewServer> server;
+    explicit Served(const std::string& background = "0.35,0.55,0.85") {
+        scene = dir.write("scene.cfg", scene_text(dir.path.string(), background)).string();
+        preview::ServeOptions o;
+        o.scene_path = scene;
+        o.port = 0;
+        o.jobs = 2;
+        o.watch_ms = 20;
+        server = std::make_unique<preview::PreviewServer>(o);
+        server->start();
+    }
+    httplib::Client client() const {
+        httplib::Client c("127.0.0.1", server->port());
+        c.set_read_timeout(60, 0);
+        return c;
+    }
+};
+
+/// A render of `scene` through the render job every front end uses (the command line's
+/// defaults), as the CLI's PNG holds it.
+Framebuffer render_like_cli(const std::string& scene, const std::string& png) {
+    RenderOverrides o;
+    o.engine = "stream", o.accel = "auto", o.shade = "simd", o.threads = 1;
+    o.output = png;
+    RenderJob job = build_render_job(std::make_shared<const Scene>(load_scene(scene)), o, false);
+    auto prepared = prepare_job(job, job.engine, -1);
+    Parallelism par(1);
+    const RenderResult r = render_prepared(*prepared, par);
+    write_image(png, r.image, display_of(job.render_settings));
+    return read_image(png);
+}
+
+}  // namespace
+
+TEST_CASE("serve: the page, its script and the picture are served, the full pass is the CLI's picture") {
+    Served s;
+    auto c = s.client();
+    auto page = c.Get("/");
+    REQUIRE(page);
+    CHECK(page->status == 200);
+    CHECK(page->get_header_value("Content-Type").find("text/html") == 0);
+    CHECK(page->body.find("id=\"picture\"") != std::string::npos);
+    CHECK(page->body.find("src=\"/app.js\"") != std::string::npos);
+    // Nothing from the internet: no address of another host anywhere in the page or script.
+    auto script = c.Get("/app.js");
+    REQUIRE(script);
+    CHECK(script->status == 200);
+    CHECK(script->body.find("/camera") != std::string::npos);
+    for (const std::string& text : {page->body, script->body}) CHECK(text.find("http") == std::string::npos);
+
+    wait_status(c, idle);
+    auto frame = c.Get("/frame.png");
+    REQUIRE(frame);
+    CHECK(frame->status == 200);
+    CHECK(frame->get_header_value("Content-Type") == "image/png");
+    CHECK(frame->get_header_value("X-Pass") == "full");
+    CHECK(frame->get_header_value("X-Samples") == "2");
+    const std::string served = (s.dir.path / "served.png").string();
+    std::ofstream(served, std::ios::binary) << frame->body;
+    const Framebuffer got = read_image(served);
+    CHECK(got.width == 64);
+    CHECK(got.height == 48);
+    const Framebuffer want = render_like_cli(s.scene, (s.dir.path / "cli.png").string());
+    REQUIRE(want.width == got.width);
+    REQUIRE(want.height == got.height);
+    CHECK(std::equal(got.rgb.begin(), got.rgb.end(), want.rgb.begin(), want.rgb.end()));
+    // The bytes too: the same encoder on the same pixels.
+    CHECK(frame->body == cli_support::slurp(s.dir.path / "cli.png"));
+}
+
+TEST_CASE("serve: only the served names answer, no path reaches a file") {
+    Served s;
+    auto c = s.client();
+    for (const char* path : {"/../scene.cfg", "/etc/passwd", "/%2e%2e/scene.cfg", "/%2E%2E%2Fscene.cfg",
+                             "/scene.cfg", "//etc/passwd", "/app.js/../../scene.cfg", "/frame.png/..%2f..%2fscene.cfg"}) {
+        CAPTURE(path);
+        auto r = c.Get(path);
+        REQUIRE(r);
+        CHECK(r->status == 404);
+        CHECK(r->body.find("camera") == std::string::npos);  // the scene's text is never sent
+    }
+    auto wrong_method = c.Post("/frame.png", "", "text/plain");
+    REQUIRE(wrong_method);
+    CHECK(wrong_method->status == 405);
+}
+
+TEST_CASE("serve: a foreign Host or Origin is refused (403)") {
+    Served s;
+    auto c = s.client();
+    const std::string own = "127.0.0.1:" + std::to_string(s.server->port());
+    auto rebound = c.Get("/status", {{"Host", "evil.example:" + std::to_string(s.server->port())}});
+    REQUIRE(rebound);
+    CHECK(rebound->status == 403);
+    auto other_port = c.Get("/", {{"Host", "127.0.0.1:1"}});
+    REQUIRE(other_port);
+    CHECK(other_port->status == 403);
+    auto cross_site = c.Post("/camera", {{"Origin", "http://evil.example"}}, "fov=30", "text/plain");
+    REQUIRE(cross_site);
+    CHECK(cross_site->status == 403);
+    auto null_origin = c.Get("/status", {{"Origin", "null"}});
+    REQUIRE(null_origin);
+    CHECK(null_origin->status == 403);
+    auto own_origin = c.Get("/status", {{"Origin", "http://" + own}});
+    REQUIRE(own_origin);
+    CHECK(own_origin->status == 200);
+    auto localhost = c.Get("/status", {{"Host", "localhost:" + std::to_string(s.server->port())}});
+    REQUIRE(localhost);
+    CHECK(localhost->status == 200);
+}
+
+TEST_CASE("serve: oversized requests are refused and the server answers afterwards") {
+    Served s;
+    auto c = s.client();
+    auto big_header = c.Get("/status", {{"X-Big", std::string(64 * 1024, 'a')}});
+    // httplib refuses a header line past its limit: 400, or the connection closed unanswered.
+    if (big_header) CHECK((big_header->status == 400 || big_header->status == 431 || big_header->status == 413));
+    auto big_body = c.Post("/camera", std::string(200 * 1024, 'x'), "text/plain");
+    if (big_body) CHECK(big_body->status == 413);
+    auto bad = c.Post("/camera", "fov=abc", "text/plain");
+    REQUIRE(bad);
+    CHECK(bad->status == 400);
+    CHECK(bad->body.find("fov=") != std::string::npos);
+    auto after = s.client().Get("/status");
+    REQUIRE(after);
+    CHECK(after->status == 200);
+}
+
+TEST_CASE("serve: a client gone mid-picture does not stop the server") {
+    Served s;
+    auto c = s.client();
+    wait_status(c, idle);
+    for (int i = 0; i < 5; ++i) {
+        httplib::Client quitter("127.0.0.1", s.server->port());
+        int received = 0;
+        // Stops after the first piece of the picture: the client closes the connection.
+        auto r = quitter.Get("/frame.png", [&](const char*, size_t) { return ++received < 1; });
+        CHECK(received >= 1);
+    }
+    auto after = c.Get("/frame.png");
+    REQUIRE(after);
+    CHECK(after->status == 200);
+}
+
+TEST_CASE("serve: a saved scene re-renders, a broken one shows file:line:col and keeps the picture") {
+    Served s;
+    auto c = s.client();
+    const long long first = json_int(wait_status(c, idle), "frame");
+    // A new version of the file (another background): a new picture.
+    {
+        std::ofstream(s.scene + ".new") << scene_text(s.dir.path.string(), "0.9,0.2,0.2");
+        std::filesystem::rename(s.scene + ".new", s.scene);
+    }
+    const std::string after = wait_status(c, [&](const std::string& b) { return idle(b) && json_int(b, "frame") > first; });
+    CHECK(after.find("\"error\":\"\"") != std::string::npos);
+    const long long second = json_int(after, "frame");
+    // A broken save: the error with its place, the picture kept.
+    {
+        std::ofstream(s.scene + ".new") << scene_text(s.dir.path.string(), "0.9,0.2,0.2") << "sphere radius=oops\n";
+        std::filesystem::rename(s.scene + ".new", s.scene);
+    }
+    const std::string broken = wait_status(c, [](const std::string& b) { return b.find("\"error\":\"\"") == std::string::npos; });
+    CHECK(broken.find("scene.cfg:7:") != std::string::npos);
+    CHECK(json_int(broken, "frame") == second);
+    auto kept = c.Get("/frame.png");
+    REQUIRE(kept);
+    CHECK(kept->status == 200);
+    // The next good save clears it.
+    {
+        std::ofstream(s.scene + ".new") << scene_text(s.dir.path.string(), "0.2,0.9,0.2");
+        std::filesystem::rename(s.scene + ".new", s.scene);
+    }
+    const std::string fixed = wait_status(c, [&](const std::string& b) {
+        return idle(b) && json_int(b, "frame") > second && b.find("\"error\":\"\"") != std::string::npos;
+    });
+    CHECK(json_int(fixed, "frame") > second);
+}
+
+TEST_CASE("serve: the camera moves, the settings change, the full-size render is the CLI's file") {
+    Served s;
+    auto c = s.client();
+    const std::string before = wait_status(c, idle);
+    CHECK(before.find("\"camera_statement\":\"camera eye=0,1.6,6 look=0,0.8,0 up=0,1,0 fov=40\"") != std::string::npos);
+    auto moved = c.Post("/camera", "eye=1,2,5&look=0,0.8,0&fov=35", "text/plain");
+    REQUIRE(moved);
+    CHECK(moved->status == 200);
+    const std::string after = wait_status(c, [&](const std::string& b) {
+        return idle(b) && json_int(b, "frame") > json_int(before, "frame");
+    });
+    CHECK(after.find("camera eye=1,2,5 look=0,0.8,0 up=0,1,0 fov=35") != std::string::npos);
+    auto bad_camera = c.Post("/camera", "eye=0,0.8,0&look=0,0.8,0", "text/plain");
+    REQUIRE(bad_camera);
+    CHECK(bad_camera->status == 400);
+    auto bad_setting = c.Post("/settings", "degree=9", "text/plain");
+    REQUIRE(bad_setting);
+    CHECK(bad_setting->status == 400);
+    CHECK(bad_setting->body.find("degree") != std::string::npos);
+    // Back to the scene's own camera, then the full-size file against the command line's.
+    const auto cam = c.Post("/camera", "eye=0,1.6,6&look=0,0.8,0&up=0,1,0&fov=40", "text/plain");
+    REQUIRE(cam);
+    auto full = c.Post("/render-full", "", "text/plain");
+    REQUIRE(full);
+    CHECK(full->status == 200);
+    const auto cli = cli_support::run_streamrt(cli_support::q(s.scene) + " -q -j 2 -o " +
+                                               cli_support::q(s.dir.path / "cli.pfm"));
+    REQUIRE(cli.code == 0);
+    CHECK(cli_support::slurp(s.dir.path / "out.pfm") == cli_support::slurp(s.dir.path / "cli.pfm"));
+}
+
+TEST_CASE("serve: a port in use is one line and exit status 1") {
+    Served s;
+    const auto r = cli_support::run_streamrt("serve " + cli_support::q(s.scene) + " --port " +
+                                             std::to_string(s.server->port()));
+    CHECK(r.code == 1);
+    cli_support::check_one_line_error(r, "is in use");
+    const auto missing = cli_support::run_streamrt("serve " + cli_support::q(s.dir.path / "none.cfg") + " --port 0");
+    CHECK(missing.code == 2);
+}
