@@ -10,6 +10,8 @@ let size = null;         // the full picture's width and height
 let drag = null;         // {x, y, pan, camera} while a button is down
 let moveTimer = null;
 let statement = "";
+let view = "picture";    // picture, samples (adaptive sampling's sample map) or profile
+let hasSamples = false;
 
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
@@ -109,11 +111,17 @@ $("render-full").addEventListener("click", () => {
   say("rendering the full-size picture...");
   post("/render-full", "").then(say).catch((e) => say(e.message));
 });
+$("view-select").addEventListener("change", () => {
+  view = $("view-select").value;
+  $("profile").style.display = view === "profile" ? "block" : "none";
+  $("view").style.display = view === "profile" ? "none" : "inline-block";
+  shown = 0;  // load the picture of the view chosen
+});
 $("reset-camera").addEventListener("click", () => { location.reload(); });
 
 function loadFrame(id) {
   loading = true;
-  fetch("/frame.png", { cache: "no-store" }).then((r) => {
+  fetch(view === "samples" && hasSamples ? "/samples.png" : "/frame.png", { cache: "no-store" }).then((r) => {
     if (!r.ok) throw new Error("no picture");
     return r.blob();
   }).then((blob) => {
@@ -135,6 +143,9 @@ function poll() {
     for (const k of ["degree", "spp"]) if (document.activeElement !== $(k)) $(k).value = s[k];
     if (document.activeElement !== $("engine")) $("engine").value = s.engine;
     const p = s.picture;
+    hasSamples = !!(p && p.sample_map);
+    $("profile").textContent = p && p.profile ? p.profile : "the profile comes with the stream engine's full pass";
+    if (view === "samples" && !hasSamples) say("no sample map: the scene does not sample adaptively (image adaptive=)");
     let line = `frame ${s.frame} · ${s.pass}`;
     if (s.pass !== "idle") line += ` ${Math.round(s.progress * 100)}%`;
     if (p) line += ` · ${p.width}x${p.height} spp ${p.spp} · ${(p.rays_per_second / 1e6).toFixed(2)} Mrays/s · ${p.seconds.toFixed(3)} s`;

@@ -62,6 +62,7 @@ void RenderLoop::stop() {
         std::lock_guard lock(mutex_);
         stopping_ = true;
         cancel_.store(true);
+        stop_.store(true);
     }
     wake_.notify_all();
     if (thread_.joinable()) thread_.join();
@@ -179,7 +180,10 @@ RenderJob RenderLoop::job_for(const std::shared_ptr<const Scene>& scene, const s
         o.spp = 1;
         o.adaptive = 0.0;  // one sample leaves nothing to adapt
     }
-    return build_render_job(std::move(viewed), o, false);
+    // The full pass of the stream engine keeps its per-stage figures for the page's profile
+    // view (counting them changes no pixel: the render job's test checks the CLI's bits).
+    const bool profile = !quick && o.engine == std::string("stream");
+    return build_render_job(std::move(viewed), o, profile);
 }
 
 bool RenderLoop::render_pass(const RenderJob& job, bool full, std::uint64_t generation) {
@@ -207,6 +211,22 @@ bool RenderLoop::render_pass(const RenderJob& job, bool full, std::uint64_t gene
     frame->rays = r.counts.total();
     frame->rays_per_second = double(frame->rays) / std::max(r.seconds, 1e-9);
     if (r.adaptive) frame->estimated_error = r.adaptive->estimated_rmse;
+    if (r.adaptive && r.sample_map.width == s.width && r.sample_map.height == s.height) {
+        // Channel 0 of the sample map is each pixel's sample count (driver/render.h).
+        float most = 1.f;
+        for (std::size_t i = 0; i < r.sample_map.rgb.size(); i += 3) most = std::max(most, r.sample_map.rgb[i]);
+        Framebuffer grey(s.width, s.height);
+        for (std::size_t i = 0; i < grey.rgb.size(); i += 3)
+            grey.rgb[i] = grey.rgb[i + 1] = grey.rgb[i + 2] = r.sample_map.rgb[i] / most;
+        const ByteSink grey_sink = [&](std::span<const iovec> pieces) {
+            for (const iovec& p : pieces) frame->samples_png.append(static_cast<const char*>(p.iov_base), p.iov_len);
+        };
+        encode_image(grey, image_format(".png"), Display{}, grey_sink, wo);
+    }
+    if (job.profile) {
+        job.profile->adaptive = r.adaptive;
+        frame->profile = job.profile->text();
+    }
     std::lock_guard lock(mutex_);
     if (generation != generation_) return false;  // the state moved on while encoding
     frame->id = next_frame_++;
@@ -239,8 +259,12 @@ void RenderLoop::run() {
             try {
                 const RenderJob job = job_for(scene, camera, settings, false);
                 auto prepared = prepare_job(job, job.engine, -1);
+                // Not cancelled by a camera move or a save (the file asked for is written),
+                // only by stop().
                 RenderProgress progress;
+                progress.cancel = &stop_;
                 const RenderResult r = render_prepared(*prepared, par_, &progress);
+                if (stop_.load()) throw RenderError("the preview stopped before the full-size picture was done");
                 const RenderSettings& s = job.render_settings;
                 if (const SceneInput* in = scene->input_at(s.output))
                     throw UsageError("output=" + s.output + ": is an input of the scene (" + in->describe() + ")");

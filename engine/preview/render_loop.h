@@ -52,6 +52,11 @@ struct Frame {
     std::uint64_t rays = 0;
     double rays_per_second = 0;
     std::optional<double> estimated_error;  ///< adaptive sampling's estimate, when adaptive
+    /// Adaptive sampling's full pass: each pixel's sample count over the most any took, grey
+    /// (the sample map of --aov samples=, as a picture); empty otherwise.
+    std::string samples_png;
+    /// The stream engine's full pass: its per-stage profile (the text of --profile).
+    std::string profile;
 };
 
 /// What /status reports.
@@ -119,7 +124,8 @@ class RenderLoop {
     std::shared_ptr<const Frame> frame_;
     std::shared_ptr<RenderProgress> progress_;
     std::unique_ptr<FullRequest> full_request_;
-    std::atomic<bool> cancel_{false};  ///< the render under way stops (RenderProgress::cancel)
+    std::atomic<bool> cancel_{false};  ///< the pass under way stops (RenderProgress::cancel)
+    std::atomic<bool> stop_{false};    ///< the full-size render stops (only stop() sets it)
     bool stopping_ = false;
     std::thread thread_;
 };

@@ -206,10 +206,12 @@ void PreviewServer::start() {
 
 void PreviewServer::stop() {
     if (stopping_.exchange(true)) return;
+    // Renders first: a request waiting for the full-size picture is answered (with the
+    // stop), so that the server's workers, which httplib joins when it stops, are free.
+    if (loop_) loop_->stop();
     if (server_) http_->stop(server_);
     if (listen_thread_.joinable()) listen_thread_.join();
     if (watch_thread_.joinable()) watch_thread_.join();
-    if (loop_) loop_->stop();
 }
 
 Reply PreviewServer::guard(const std::string& method, const std::string& path, const std::string& host,
@@ -247,6 +249,8 @@ Reply PreviewServer::status_reply() const {
         j += ",\"seconds\":" + json_number(frame->seconds) + ",\"rays\":" + std::to_string(frame->rays);
         j += ",\"rays_per_second\":" + json_number(frame->rays_per_second);
         j += ",\"estimated_error\":" + (frame->estimated_error ? json_number(*frame->estimated_error) : "null");
+        j += ",\"sample_map\":" + std::string(frame->samples_png.empty() ? "false" : "true");
+        j += ",\"profile\":" + json_string(frame->profile);
         j += "}";
     }
     j += ",\"camera\":{\"eye\":" + json_vec(s.camera.eye) + ",\"look\":" + json_vec(s.camera.look) +
@@ -270,7 +274,8 @@ Reply PreviewServer::handle(const std::string& method, const std::string& path, 
     static const std::map<std::string, std::string> kRoutes{{"/", "GET"},           {"/index.html", "GET"},
                                                             {"/app.js", "GET"},     {"/frame.png", "GET"},
                                                             {"/status", "GET"},     {"/camera", "POST"},
-                                                            {"/settings", "POST"},  {"/render-full", "POST"}};
+                                                            {"/settings", "POST"},  {"/render-full", "POST"},
+                                                            {"/samples.png", "GET"}};
     const auto route = kRoutes.find(path);
     if (route == kRoutes.end()) return text(404, "not found");
     if (route->second != method) return text(405, "method not allowed: " + route->second + " " + path);
@@ -304,6 +309,16 @@ Reply PreviewServer::handle(const std::string& method, const std::string& path, 
                           static_cast<unsigned long long>(frame->id), frame->full ? "full" : "quick", frame->spp,
                           frame->rays_per_second, frame->seconds);
             r.headers = h;
+            return r;
+        }
+        if (path == "/samples.png") {
+            const auto frame = loop_->frame();
+            if (!frame || frame->samples_png.empty())
+                return text(503, "no sample map: the full pass of an adaptive scene (image adaptive=) has one");
+            Reply r;
+            r.type = "image/png";
+            r.body = frame->samples_png;
+            r.headers = "Cache-Control: no-store\nX-Frame: " + std::to_string(frame->id) + "\n";
             return r;
         }
         if (path == "/camera") {

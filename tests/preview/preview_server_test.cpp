@@ -25,8 +25,8 @@ using cli_support::Dir;
 
 namespace {
 
-std::string scene_text(const std::string& dir, const std::string& background, const std::string& size = "width=64 height=48") {
-    return "image " + size + " spp=2 depth=3 degree=5 output=" + dir + "/out.pfm\n"
+std::string scene_text(const std::string& dir, const std::string& background, const std::string& size = "width=64 height=48 spp=2") {
+    return "image " + size + " depth=3 degree=5 output=" + dir + "/out.pfm\n"
            "background " + background + "\n"
            "camera eye=0,1.6,6 look=0,0.8,0 up=0,1,0 fov=40\n"
            "light point pos=-4,7,6 color=0.8,0.8,0.8\n"
@@ -64,7 +64,7 @@ struct Served {
     Dir dir;
     std::string scene;
     std::unique_ptr<preview::PreviewServer> server;
-    explicit Served(const std::string& size = "width=64 height=48") {
+    explicit Served(const std::string& size = "width=64 height=48 spp=2") {
         scene = dir.write("scene.cfg", scene_text(dir.path.string(), "0.35,0.55,0.85", size)).string();
         preview::ServeOptions o;
         o.scene_path = scene;
@@ -218,7 +218,7 @@ void leave_mid_picture(int port, const std::string& host, bool read_first) {
 TEST_CASE("serve: a client gone mid-picture does not stop the server") {
     // SIGPIPE's default action, whatever this process inherited: the server must set its own.
     std::signal(SIGPIPE, SIG_DFL);
-    Served s("width=1200 height=900");
+    Served s("width=1200 height=900 spp=2");
     auto c = s.client();
     wait_status(c, idle);
     const std::string host = "127.0.0.1:" + std::to_string(s.server->port());
@@ -292,6 +292,35 @@ TEST_CASE("serve: the camera moves, the settings change, the full-size render is
                                                cli_support::q(s.dir.path / "cli.pfm"));
     REQUIRE(cli.code == 0);
     CHECK(cli_support::slurp(s.dir.path / "out.pfm") == cli_support::slurp(s.dir.path / "cli.pfm"));
+}
+
+TEST_CASE("serve: the views: the sample map of an adaptive scene, the stream engine's profile") {
+    Served plain;
+    auto c = plain.client();
+    const std::string st = wait_status(c, idle);
+    CHECK(st.find("\"sample_map\":false") != std::string::npos);
+    CHECK(st.find("\"profile\":\"\"") == std::string::npos);  // the stream engine's full pass has one
+    auto none = c.Get("/samples.png");
+    REQUIRE(none);
+    CHECK(none->status == 503);
+
+    Served adaptive("width=64 height=48 spp=16 adaptive=0.05");
+    auto a = adaptive.client();
+    const std::string ast = wait_status(a, idle);
+    CHECK(ast.find("\"sample_map\":true") != std::string::npos);
+    CHECK(ast.find("\"estimated_error\":null") == std::string::npos);
+    auto map = a.Get("/samples.png");
+    REQUIRE(map);
+    CHECK(map->status == 200);
+    const std::string file = (adaptive.dir.path / "samples.png").string();
+    std::ofstream(file, std::ios::binary) << map->body;
+    const Framebuffer grey = read_image(file);
+    CHECK(grey.width == 64);
+    CHECK(grey.height == 48);
+    // Pixels of the sphere's edge take more samples than the sky's: not one flat grey.
+    const auto [lo, hi] = std::minmax_element(grey.rgb.begin(), grey.rgb.end());
+    CHECK(*lo < *hi);
+    CHECK(*hi == 1.0f);  // the most samples any pixel took
 }
 
 TEST_CASE("serve: a port in use is one line and exit status 1") {
