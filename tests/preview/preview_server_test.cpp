@@ -10,8 +10,10 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <fstream>
+#include <numbers>
 #include <thread>
 
 #include "cli/cli_support.h"
@@ -331,4 +333,22 @@ TEST_CASE("serve: a port in use is one line and exit status 1") {
     cli_support::check_one_line_error(r, "is in use");
     const auto missing = cli_support::run_streamrt("serve " + cli_support::q(s.dir.path / "none.cfg") + " --port 0");
     CHECK(missing.code == 2);
+}
+
+TEST_CASE("serve: an explicit-form camera is read back as the look-at camera with its eye, screen centre and up") {
+    // docs/scene-format.md's example: eye at (0, 1 + 2 sin 10deg, 6 + 2 cos 10deg), screen
+    // centre (0, 1, 6), tilted 10 degrees down; ry / df = 0.75 / 2 is tan(fov / 2).
+    const Scene scene = parse_scene("image width=64 height=48\ncamera rx=1 ry=0.75 df=2 rotate_x=-10 translate=0,1,6\n",
+                                    "explicit.cfg");
+    const preview::ViewCamera v = preview::view_of(scene.camera, 64, 48);
+    const double a = 10.0 * std::numbers::pi / 180.0;
+    CHECK(v.eye.x == doctest::Approx(0.0));
+    CHECK(v.eye.y == doctest::Approx(1.0 + 2.0 * std::sin(a)));
+    CHECK(v.eye.z == doctest::Approx(6.0 + 2.0 * std::cos(a)));
+    CHECK(v.look.y == doctest::Approx(1.0));
+    CHECK(v.look.z == doctest::Approx(6.0));
+    CHECK(v.up.y == doctest::Approx(std::cos(a)));
+    CHECK(v.up.z == doctest::Approx(-std::sin(a)));
+    CHECK(v.fov == doctest::Approx(2.0 * std::atan(0.75 / 2.0) * 180.0 / std::numbers::pi));
+    CHECK(preview::camera_statement(v, scene.camera).rfind("camera eye=0,1.3473,7.96962 look=0,1,6 ", 0) == 0);
 }
