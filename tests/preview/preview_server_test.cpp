@@ -36,11 +36,15 @@ std::string scene_text(const std::string& dir, const std::string& background, co
            "sphere color=0.9,0.9,0.9 refl=0.6 scale=1 translate=-0.9,1,-1.5\n";
 }
 
-/// Polls /status until `done` holds (each poll is a real request); fails after a minute,
-/// which only a hang reaches.
+/// Polls /status until `done` holds (each poll is a real request); fails after a minute
+/// (times STREAMRT_TEST_TIMEOUT_SCALE, which the sanitizer builds raise), which only a hang
+/// reaches.
 template <class Done>
 std::string wait_status(httplib::Client& c, Done done) {
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    const char* scale = std::getenv("STREAMRT_TEST_TIMEOUT_SCALE");
+    const double seconds = 60.0 * (scale ? std::max(1.0, std::atof(scale)) : 1.0);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                                std::chrono::duration<double>(seconds));
     std::string body;
     while (std::chrono::steady_clock::now() < give_up) {
         if (auto r = c.Get("/status"); r && r->status == 200) {
