@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "core/error.h"
+#include "driver/limits.h"
 #include "image/image_io.h"
 
 namespace streamrt::preview {
@@ -183,7 +184,12 @@ RenderJob RenderLoop::job_for(const std::shared_ptr<const Scene>& scene, const s
     // The full pass of the stream engine keeps its per-stage figures for the page's profile
     // view (counting them changes no pixel: the render job's test checks the CLI's bits).
     const bool profile = !quick && o.engine == std::string("stream");
-    return build_render_job(std::move(viewed), o, profile);
+    RenderJob job = build_render_job(std::move(viewed), o, profile);
+    // As the command line does before rendering (cli/job.cpp): a render that cannot fit in
+    // this machine is one line on the page (MemoryShortage), not an allocation failure.
+    check_render_memory(*job.scene, job.render_settings, job.engine == EngineKind::Stream,
+                        jobs_ > 0 ? jobs_ : default_jobs());
+    return job;
 }
 
 bool RenderLoop::render_pass(const RenderJob& job, bool full, std::uint64_t generation) {
