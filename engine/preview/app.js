@@ -31,9 +31,18 @@ function post(path, body) {
 
 function say(text) { $("message").textContent = text; }
 
+// One camera request at a time: a move made while one is on its way is sent when it returns
+// (the latest only), so a fast drag does not cancel every picture before it is done.
+let inFlight = false, pending = null;
 function sendCamera(moving) {
+  if (inFlight) { pending = moving; return; }
+  inFlight = true;
   post("/camera", `eye=${vec(camera.eye)}&look=${vec(camera.look)}&up=${vec(camera.up)}&fov=${+camera.fov.toPrecision(6)}&moving=${moving ? 1 : 0}`)
-    .catch((e) => say(e.message));
+    .catch((e) => say(e.message))
+    .finally(() => {
+      inFlight = false;
+      if (pending !== null) { const m = pending; pending = null; sendCamera(m); }
+    });
 }
 
 // While the camera moves: reduced passes at once; a moment after the last move, the full one.
