@@ -9,6 +9,7 @@ packages=(g++ cmake ninja-build pkg-config libxsimd-dev xtl-dev libtbb-dev libgl
           python3-venv python3-setuptools python3-wheel  # pip install --no-build-isolation . in a venv (ctest python_package)
           libopenmpi-dev openmpi-bin  # MPI (streamrt --mpi): optional for the build, tested when found
           povray  # POV-Ray 3.7: CSG's independent check (ctest csg_against_povray) and the peer benchmark
+          libcpp-httplib-dev  # the HTTP server of streamrt serve (docs/preview.md): optional for the build, tested when found
           embree-tools  # Embree's tutorial path tracer and its Cornell box: degree 6's independent check (scripts/gi_peer.py)
           dpkg-dev)  # dpkg-dev: dpkg-source, for the oneTBB source package (sanitize.sh tsan)
 missing=()

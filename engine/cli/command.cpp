@@ -5,6 +5,7 @@
 #include "cli/progress.h"
 #include "core/memory_budget.h"
 #include "core/nearest_name.h"
+#include "preview/serve.h"
 
 namespace streamrt::cli {
 
@@ -48,6 +49,7 @@ std::string parse_error_line(const CLI::App& app, const CLI::ParseError& e, cons
 
 int run(int argc, char** argv) {
     if (argc >= 2 && std::string(argv[1]) == "merge") return run_merge(argc - 1, argv + 1);
+    if (argc >= 2 && std::string(argv[1]) == "serve") return preview::run_serve(argc - 1, argv + 1);
     // "--profile json FILE" reads as the flag, then a scene named "json": say what was meant.
     for (int i = 1; i + 1 < argc; ++i)
         if (std::string(argv[i]) == "--profile" && (std::string(argv[i + 1]) == "json" || std::string(argv[i + 1]) == "text"))
@@ -55,7 +57,8 @@ int run(int argc, char** argv) {
                              argv[i + 1] + (std::string(argv[i + 1]) == "json" ? " FILE (e.g. --profile=json prof.json)" : ""));
     Options opt;
     CLI::App app{"streamrt: a SIMD ray-stream ray tracer for .cfg scenes (see docs/scene-format.md)", "streamrt"};
-    app.footer("Also: streamrt merge PART... -o OUT (the parts of --shard renders)");
+    app.footer("Also: streamrt merge PART... -o OUT (the parts of --shard renders); streamrt serve SCENE [--port P] "
+               "(a live preview in the browser, docs/preview.md)");
     app.add_option("scene", opt.scene_path, "Scene file (.cfg)")->required();
     app.add_option("-j,--jobs", opt.jobs, "Worker threads (default: all cores)")->check(kInteger)->check(CLI::Range(1, 1024));
     app.add_option("-o,--output", opt.output, "Output image (" + image_format_extensions() + "); overrides the scene's");

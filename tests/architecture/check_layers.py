@@ -21,7 +21,7 @@ LAYERS = [
     ["kernels"],
     ["stream", "baseline"],
     ["driver"],
-    ["distributed"],
+    ["distributed", "preview"],  # preview: streamrt serve (renders through driver/)
     ["cli", "modules"],
     ["python"],  # python -m streamrt runs the command (cli/command.cpp)
 ]
