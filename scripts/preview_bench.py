@@ -4,13 +4,18 @@ while the camera moves (each move posted with moving=1, the next posted once its
 the page's own rhythm at its fastest), and the time from a save of the scene to the first
 updated picture. A benchmark, not a test: it prints figures and checks nothing.
 
-    /usr/bin/python3 scripts/preview_bench.py [--streamrt build/engine/streamrt] [-j 2] SCENE...
+    /usr/bin/python3 scripts/preview_bench.py [--streamrt build/engine/streamrt] [-j 2] [--size WxH] SCENE...
+
+--size WxH serves a copy of each scene with its `image` statement's width and height replaced
+(written beside the scene, so that its relative paths hold, and removed afterwards).
 """
 import argparse
 import http.client
 import json
 import math
+import os
 import pathlib
+import re
 import shutil
 import signal
 import statistics
@@ -93,12 +98,27 @@ def main():
     ap.add_argument("-j", "--jobs", type=int, default=2)
     ap.add_argument("--moves", type=int, default=100)
     ap.add_argument("--saves", type=int, default=10)
+    ap.add_argument("--size", help="WxH: the scenes served at this width and height")
     a = ap.parse_args()
     print("| scene | moving: picture | frames/s | save to picture, median (max) |")
     print("|---|---|---|---|")
     for scene in a.scenes:
-        fps, size, lat = bench(a.streamrt, scene, a.jobs, a.moves, a.saves)
-        print(f"| `{scene}` | {size[0]}x{size[1]}, 1 spp | {fps:.0f} | {statistics.median(lat) * 1000:.0f} ms "
+        served, label = scene, scene
+        if a.size:
+            w, h = a.size.lower().split("x")
+            text = pathlib.Path(scene).read_text()
+            sized = re.sub(r"^(image\b.*?)\bwidth=\d+", rf"\g<1>width={int(w)}", text, count=1, flags=re.M)
+            sized = re.sub(r"^(image\b.*?)\bheight=\d+", rf"\g<1>height={int(h)}", sized, count=1, flags=re.M)
+            assert sized != text or f"width={int(w)}" in text, f"{scene}: no image width=/height= to replace"
+            served = os.path.join(os.path.dirname(scene), f".preview_bench_{os.getpid()}_{os.path.basename(scene)}")
+            pathlib.Path(served).write_text(sized)
+            label = f"{scene} at {int(w)}x{int(h)}"
+        try:
+            fps, size, lat = bench(a.streamrt, served, a.jobs, a.moves, a.saves)
+        finally:
+            if served != scene:
+                os.remove(served)
+        print(f"| `{label}` | {size[0]}x{size[1]}, 1 spp | {fps:.0f} | {statistics.median(lat) * 1000:.0f} ms "
               f"({max(lat) * 1000:.0f} ms) |")
 
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """streamrt serve in a real browser (docs/preview.md): Debian's headless Chromium opens the
 page, and the picture it shows must be the command line's render of the same scene, pixel for
-pixel; a save re-renders and the page shows the new frame; a broken save shows its
+pixel; a scripted drag (the page's ?drag= test hook) orbits the camera by the amount the
+page's orbit math gives, and the page then shows the command line's render with that camera; a save re-renders and the page shows the new frame; a broken save shows its
 file:line:col error on the page. Skips (exit 77) where chromium or the HTTP server is missing.
 
     scripts/preview_browser_test.py --streamrt build/engine/streamrt [--shot build/preview.png]
@@ -11,6 +12,7 @@ budget, which lets the page's polling run until the budget is spent."""
 import argparse
 import http.client
 import json
+import math
 import os
 import pathlib
 import shutil
@@ -57,10 +59,10 @@ def wait_for(port, done, what):
     raise SystemExit(f"FAIL: the server never reached {what}; last status {s}")
 
 
-def browser(exe, profile, url, *args):
+def browser(exe, profile, url, *args, budget=4000):
     cmd = [exe, "--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-extensions",
            "--force-device-scale-factor=1", "--hide-scrollbars", f"--user-data-dir={profile}",
-           "--virtual-time-budget=4000", *args, url]
+           f"--virtual-time-budget={budget}", *args, url]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=120 * SCALE)
 
 
@@ -121,6 +123,36 @@ def main():
         print(f"ok: the page shows the CLI's picture, pixel for pixel, at {where}")
         if a.shot:
             shutil.copyfile(shot, a.shot)
+
+        # A scripted drag: ?drag=DX,0 makes the page dispatch mousedown, mousemoves and mouseup on
+        # the picture once it is shown, so its own handlers and orbit code move the camera.
+        # A drag of DX pixels sideways turns the eye about the up axis through the look point by
+        # -DX * 0.01 radians: the scene's eye - look = (0, 0.8, 6) becomes (6 sin t, 0.8, 6 cos t).
+        dx = 60
+        shot_drag = work / "drag.png"
+        r = browser(exe, work / "profile_drag", url + f"?drag={dx},0", f"--screenshot={shot_drag}",
+                    "--window-size=400,300", budget=20000)
+        assert shot_drag.exists(), r.stderr[-2000:]
+        cam = status(port)["camera"]
+        t = -dx * 0.01
+        want = [6 * math.sin(t), 0.8 + 0.8, 6 * math.cos(t)]
+        assert cam["look"] == [0, 0.8, 0] and cam["up"] == [0, 1, 0] and cam["fov"] == 40, cam
+        assert all(abs(g - w) < 1e-4 for g, w in zip(cam["eye"], want)), \
+            f"the drag's eye is {cam['eye']}, the orbit math gives {want} (scene's: [0, 1.6, 6])"
+        print(f"ok: a scripted drag of {dx},0 pixels moved the eye to {cam['eye']} (orbit math: {want})")
+        sd = wait_for(port, lambda t: t["pass"] == "idle" and t["frame"] > s["frame"], "the dragged camera's full pass")
+        dragged = png_bytes(shot_drag)
+        assert find_picture(dragged, png_bytes(cli)) is None, "after the drag the page still shows the undragged picture"
+        moved_scene = work / "moved.cfg"
+        moved_scene.write_text("\n".join(sd["camera_statement"] if line.startswith("camera ") else line
+                                         for line in scene.read_text().splitlines()) + "\n")
+        cli_moved = work / "cli_moved.png"
+        subprocess.run([a.streamrt, str(moved_scene), "-q", "-o", str(cli_moved)], check=True, timeout=120 * SCALE)
+        where_moved = find_picture(dragged, png_bytes(cli_moved))
+        assert where_moved is not None, \
+            f"after the drag the page does not show the CLI's render with {sd['camera_statement']!r}"
+        print(f"ok: after the drag the page shows the CLI's render with {sd['camera_statement']!r}, pixel for pixel")
+        s = sd
 
         # A save: a new frame, which the page loads.
         scene.write_text(SCENE.format(out=work / "out.png", background="0.9,0.2,0.2"))

@@ -128,6 +128,29 @@ $("view-select").addEventListener("change", () => {
 });
 $("reset-camera").addEventListener("click", () => { location.reload(); });
 
+// A test hook (docs/preview.md): `?drag=DX,DY` drags the picture by DX, DY pixels once the
+// first picture is shown, through synthetic mouse events on the picture, so the page's own
+// handlers and orbit code above run as for a person's drag. The browser test uses it.
+const dragHook = (/[?&]drag=(-?\d+),(-?\d+)(&|$)/.exec(location.search) || []).slice(1, 3).map(Number);
+let dragDone = dragHook.length !== 2;
+function scriptedDrag() {
+  dragDone = true;
+  const img = $("picture"), box = img.getBoundingClientRect();
+  const x0 = box.left + box.width / 2, y0 = box.top + box.height / 2, steps = 5;
+  const at = (type, x, y, target) => target.dispatchEvent(new MouseEvent(type,
+    { bubbles: true, cancelable: true, view: window, clientX: x, clientY: y, button: 0, buttons: type === "mouseup" ? 0 : 1 }));
+  at("mousedown", x0, y0, img);
+  let i = 0;
+  const step = () => {
+    i++;
+    const x = x0 + dragHook[0] * i / steps, y = y0 + dragHook[1] * i / steps;
+    at("mousemove", x, y, img);
+    if (i < steps) setTimeout(step, 20);
+    else { at("mouseup", x, y, img); img.dataset.dragged = `${dragHook[0]},${dragHook[1]}`; }
+  };
+  setTimeout(step, 20);
+}
+
 function loadFrame(id) {
   loading = true;
   fetch(view === "samples" && hasSamples ? "/samples.png" : "/frame.png", { cache: "no-store" }).then((r) => {
@@ -135,7 +158,10 @@ function loadFrame(id) {
     return r.blob();
   }).then((blob) => {
     const img = $("picture"), old = img.src;
-    img.onload = () => { if (old) URL.revokeObjectURL(old); };
+    img.onload = () => {
+      if (old) URL.revokeObjectURL(old);
+      if (!dragDone && camera) scriptedDrag();
+    };
     img.src = URL.createObjectURL(blob);
     if (size) { img.style.width = size[0] + "px"; img.style.height = size[1] + "px"; }
     shown = id;
