@@ -14,12 +14,19 @@
 
 namespace streamrt::STREAMRT_ISA_NAMESPACE {
 
-/// enter[s][l], exit[s][l]: the span of object `ob`'s shape s along lane l's ray.
+/// enter[s][l], exit[s][l]: the span of object `ob`'s shape s along lane l's ray; empty for
+/// every lane of a packet that misses the shape's box over (0, t_max) (CsgView::shape_boxes).
 template <class B>
-inline void csg_packet_spans(const CsgView& csg, const CsgObjectView& ob, const RayPacket<B>& r,
-                             float (*enter)[simd::kMaxLanes], float (*exit)[simd::kMaxLanes]) {
+inline void csg_packet_spans(const CsgView& csg, const CsgObjectView& ob, const RayPacket<B>& r, const Vec3T<B>& inv,
+                             const B& t_max, float (*enter)[simd::kMaxLanes], float (*exit)[simd::kMaxLanes]) {
     for (std::uint32_t s = 0; s < ob.shape_count; ++s) {
-        const ObjectXf& xf = csg.records[ob.first_shape + s].xf;
+        const std::uint32_t k = ob.first_shape + s;
+        if (csg.shape_bounded[k] && !packet_meets_box<B, float>(r, inv, csg.shape_boxes[k], t_max)) {
+            B(std::numeric_limits<float>::infinity()).store_aligned(enter[s]);
+            B(-std::numeric_limits<float>::infinity()).store_aligned(exit[s]);
+            continue;
+        }
+        const ObjectXf& xf = csg.records[k].xf;
         const RayPacket<B> c = to_canonical<B, float>(r, xf);
         const SpanT<B> span = csg_shape_span<B>(ShapeKind(xf.kind), c.o, c.d, B(xf.param));
         span.enter.store_aligned(enter[s]);
@@ -137,7 +144,7 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
                 if (kAny && !xsimd::any(t_max > B(0.f))) break;
                 continue;
             }
-            csg_packet_spans(csg, ob, r, enter, exit);
+            csg_packet_spans(csg, ob, r, inv, t_max, enter, exit);
             if (ob.pair) {  // in lanes
                 const PairBoundary<B> at =
                     csg_pair_boundary(ob.op, B::load_aligned(enter[0]), B::load_aligned(exit[0]),

@@ -36,6 +36,11 @@ struct CsgView {
     std::int32_t first_id;         ///< the id of records[0] in the engine's tables
     std::int32_t shapes;           ///< Scene::csg_shapes.size()
     const Mesh* const* meshes;     ///< per shape: its mesh, or null
+    /// Per shape: its box, relative to the eye and padded as the objects' (a packet that
+    /// misses it over (0, t_max) takes the shape's span as empty: outside the segment a span
+    /// changes no boundary inside it); bounded false: a half-space, never skipped.
+    const ObjectBounds* shape_boxes;
+    const std::uint8_t* shape_bounded;
 };
 
 /// One lane of an object taken whole in scalar code (CsgObjectView::scalar): its first surface

@@ -65,6 +65,10 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
     for (std::int32_t k = 0; k < shapes; ++k) {
         const Object& s = scene.csg_shapes[std::size_t(k)];
         meshes_.push_back(scene.mesh_of(s));
+        double lo[3], hi[3];
+        const bool bounded = accel::object_world_bounds(s, scene.mesh_of(s), lo, hi);
+        shape_boxes_.push_back(bounded ? padded_bounds(lo, hi, eye) : ObjectBounds{});
+        shape_bounded_.push_back(bounded ? 1 : 0);
         for (const std::int32_t flip : {0, 1}) {
             const std::size_t at = std::size_t(k + flip * shapes);
             records_[at] = kernel_object(s, scene.mesh_of(s), first_id + std::int32_t(at), eye);
@@ -78,7 +82,9 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
              .records = records_.data(),
              .first_id = first_id,
              .shapes = shapes,
-             .meshes = meshes_.data()};
+             .meshes = meshes_.data(),
+             .shape_boxes = shape_boxes_.data(),
+             .shape_bounded = shape_bounded_.data()};
 }
 
 bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[3], const float d[3], float& t_max,

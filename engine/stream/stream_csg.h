@@ -50,6 +50,8 @@ class StreamCsg {
     std::vector<KernelObject> records_;
     std::vector<SurfaceRecord> surfaces_;
     std::vector<const Mesh*> meshes_;  ///< per CSG shape: its mesh, or null (held by the scene's meshes)
+    std::vector<ObjectBounds> shape_boxes_;     ///< per CSG shape (CsgView::shape_boxes)
+    std::vector<std::uint8_t> shape_bounded_;
     std::size_t scene_objects_ = 0;
     CsgView view_{};
 };
