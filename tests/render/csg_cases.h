@@ -2,7 +2,19 @@
 // CSG objects whose surfaces are worked out by hand, for both engines' tests (csg_test.cpp,
 // csg_stream_test.cpp).
 
+#include <limits>
+
+#include "baseline/recursive_renderer.h"
+#include "scene/scene.h"
+
 namespace streamrt::csg_cases {
+
+/// The recursive engine's closest hit of the ray from `from` along unit `dir`, past t_min;
+/// false on a miss.
+inline bool hit_of(const Scene& scene, Vec3d from, Vec3d dir, HitD& hit, double t_min = 0.0) {
+    const RecursiveRenderer r(scene);
+    return r.closest_hit(RayD{from, dir}, t_min, std::numeric_limits<double>::infinity(), hit);
+}
 
 // A biconvex lens: spheres of radius 2 centred at z = -1.5 and z = +1.5, intersected. Along the
 // axis it spans z in [-0.5, 0.5]; at x = 1 it spans |z| <= sqrt(3) - 1.5.

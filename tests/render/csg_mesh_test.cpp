@@ -15,14 +15,15 @@
 #include "driver/render.h"
 #include "parallel/parallelism.h"
 #include "scene/expect_error.h"
+#include "render/csg_cases.h"
 #include "scene/parser.h"
 
 using namespace streamrt;
+using csg_cases::hit_of;
 namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // The cube [-1,1]^3 as 12 triangles, counter-clockwise seen from outside (OBJ numbers from 1).
 const char* const kCubeVertices =
@@ -54,10 +55,6 @@ fs::path mesh_dir() {
 
 Scene parse_in(const fs::path& dir, const std::string& text) { return parse_scene(text, (dir / "t.cfg").string()); }
 
-bool hit_of(const Scene& scene, Vec3d from, Vec3d dir, HitD& hit, double t_min = 0.0) {
-    const RecursiveRenderer r(scene);
-    return r.closest_hit(RayD{from, dir}, t_min, kInf, hit);
-}
 
 }  // namespace
 

@@ -9,20 +9,17 @@
 #include <string>
 
 #include "baseline/recursive_renderer.h"
+#include "render/csg_cases.h"
 #include "scene/parser.h"
 
 using namespace streamrt;
+using csg_cases::hit_of;
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 Scene parse(const std::string& text) { return parse_scene(text, "t.cfg"); }
 
-bool hit_of(const Scene& scene, Vec3d from, Vec3d dir, HitD& hit, double t_min = 0.0) {
-    const RecursiveRenderer r(scene);
-    return r.closest_hit(RayD{from, dir}, t_min, kInf, hit);
-}
 
 /// Which of the CSG object's shapes (in written order) a hit is on.
 std::size_t csg_shape_of(const Scene& s, const HitD& hit) { return std::size_t(hit.object) - s.objects.size(); }

@@ -21,11 +21,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 Scene parse(const std::string& text) { return parse_scene(text, "t.cfg"); }
 
-/// The closest hit of the ray from `from` along unit `dir`, past t_min; false on a miss.
-bool hit_of(const Scene& scene, Vec3d from, Vec3d dir, HitD& hit, double t_min = 0.0) {
-    const RecursiveRenderer r(scene);
-    return r.closest_hit(RayD{from, dir}, t_min, kInf, hit);
-}
 
 void check_vec(const Vec3d& v, double x, double y, double z) {
     CHECK(v.x == doctest::Approx(x).epsilon(1e-9));
