@@ -111,16 +111,9 @@ int RecursiveRenderer::test_csg(std::size_t k, const RayD& ray, double t_min, do
     std::tie(c.o, c.d) = canonical_ray(at->shape);
     flip = at->flip;
     if (objects_[csg_base_ + at->shape].kind == ShapeKind::Mesh) {
-        // The crossing's barycentric coordinates, for the normal and the texture: its triangle
-        // met again, over every t.
-        const MeshView& m = objects_[csg_base_ + at->shape].mesh->view();
-        const double inf = std::numeric_limits<double>::infinity();
-        const TriangleHit<double> h = triangle_hit(watertight_ray(c.o, c.d), mesh_vertex<double>(m, at->tri, 0),
-                                                   mesh_vertex<double>(m, at->tri, 1), mesh_vertex<double>(m, at->tri, 2),
-                                                   -inf, inf);
+        // For the normal and the texture.
         c.tri = at->tri;
-        c.u = h.t < inf ? h.u : 1.0 / 3.0;
-        c.v = h.t < inf ? h.v : 1.0 / 3.0;
+        mesh_crossing_uv(objects_[csg_base_ + at->shape].mesh->view(), at->tri, c.o, c.d, c.u, c.v);
     }
     return int(csg_base_ + at->shape);
 }

@@ -99,6 +99,18 @@ inline int mesh_crossings(const MeshView& m, const accel::Bvh& bvh, const Vec3T<
     return n;
 }
 
+/// The barycentric coordinates (weights of p1 and p2) where the line o + t d, every t, crosses
+/// triangle tri: a crossing mesh_crossings found, met again for the shading; the centroid if
+/// rounding now lets the line pass beside it.
+template <class T>
+inline void mesh_crossing_uv(const MeshView& m, std::uint32_t tri, const Vec3T<T>& o, const Vec3T<T>& d, T& u, T& v) {
+    const T inf = std::numeric_limits<T>::infinity();
+    const TriangleHit<T> h = triangle_hit(watertight_ray(o, d), mesh_vertex<T>(m, tri, 0), mesh_vertex<T>(m, tri, 1),
+                                          mesh_vertex<T>(m, tri, 2), -inf, inf);
+    u = h.t < inf ? h.u : T(1) / T(3);
+    v = h.t < inf ? h.v : T(1) / T(3);
+}
+
 /// True if some triangle is hit for t in (t_min, t_max).
 template <class T>
 inline bool mesh_any(const MeshView& m, const accel::Bvh& bvh, const Vec3T<T>& o, const Vec3T<T>& d, T t_min,

@@ -112,16 +112,9 @@ bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[
     t_max = at->t;
     object = csg.first_id + std::int32_t(at->shape) + (at->flip ? csg.shapes : 0);
     if (const Mesh* m = csg.meshes[at->shape]; m && prim) {
-        // The crossing's barycentric coordinates: its triangle met again over every t.
         const auto [oc, dc] = canonical(at->shape);
-        const MeshView& v = m->view();
-        const float inf = std::numeric_limits<float>::infinity();
-        const TriangleHit<float> h = triangle_hit(watertight_ray(oc, dc), mesh_vertex<float>(v, at->tri, 0),
-                                                  mesh_vertex<float>(v, at->tri, 1), mesh_vertex<float>(v, at->tri, 2),
-                                                  -inf, inf);
         *prim = std::int32_t(at->tri);
-        *bu = h.t < inf ? h.u : 1.f / 3.f;
-        *bv = h.t < inf ? h.v : 1.f / 3.f;
+        mesh_crossing_uv(m->view(), at->tri, oc, dc, *bu, *bv);
     }
     return true;
 }
