@@ -55,7 +55,10 @@ RecursiveRenderer::RecursiveRenderer(const Scene& scene, const RenderSettings& s
         const Object& o = object_at(i);
         objects_[i] = {affine_inverse(o.md), o.param, o.kind, scene.mesh_of(o)};
     });
-    for (const CsgObject& o : scene.csg_objects) csg_boxes_.push_back(csg_node_box(scene, o.root));
+    for (const CsgObject& o : scene.csg_objects) {
+        csg_boxes_.push_back(csg_node_box(scene, o.root));
+        csg_layouts_.push_back(csg_slot_layout(scene, o));
+    }
     for (const Material& m : scene.materials) {
         materials_.push_back(MaterialT<double>::from(m));
         if (m.texture >= 0) materials_.back().texture = scene.textures[std::size_t(m.texture)]->view();
@@ -96,26 +99,32 @@ int RecursiveRenderer::test_csg(std::size_t k, const RayD& ray, double t_min, do
         const PreparedObject& ob = objects_[csg_base_ + shape];
         return std::pair{apply_point(RowsOf{ob.mi}, ray.origin), apply_vector(RowsOf{ob.mi}, ray.dir)};
     };
-    CsgSpans<double> spans;
-    csg_node_spans(scene_->csg_nodes.data(), scene_->csg_objects[k].root,
-                   [&](std::uint32_t shape, CsgSpans<double>& into) {
-                       const auto [o, d] = canonical_ray(shape);
-                       const PreparedObject& ob = objects_[csg_base_ + shape];
-                       if (ob.kind == ShapeKind::Mesh) add_mesh_spans(into, *ob.mesh, o, d, shape);
-                       else add_solid_span(into, csg_shape_span(ob.kind, o, d, ob.param), shape);
-                   },
-                   spans);
-    const CsgBoundary<double>* at = first_boundary(spans, t_min, t_max);
-    if (!at) return -1;
-    t_max = at->t;
-    std::tie(c.o, c.d) = canonical_ray(at->shape);
-    flip = at->flip;
-    if (objects_[csg_base_ + at->shape].kind == ShapeKind::Mesh) {
+    // Each slot's span (a mesh's several), then the walk along the line (render/csg_spans.h).
+    const CsgSlotLayout& layout = csg_layouts_[k];
+    CsgLine<double> line;
+    std::array<CsgSlotEnds, kMaxCsgShapes> ends{};
+    std::array<std::uint8_t, kMaxCsgShapes> live;
+    const int live_count = csg_scalar_line(
+        layout, canonical_ray,
+        [&](std::uint32_t shape) {
+            const PreparedObject& ob = objects_[csg_base_ + shape];
+            return std::tuple{ob.kind, ob.param, ob.kind == ShapeKind::Mesh ? ob.mesh : nullptr};
+        },
+        line, ends.data(), live.data());
+    const CsgFirst<double> at = csg_first_boundary(scene_->csg_nodes.data(), scene_->csg_objects[k].root, layout,
+                                                   line, live.data(), live_count, t_min, t_max);
+    if (!(at.t < t_max)) return -1;
+    t_max = at.t;
+    const auto slot = std::size_t(at.slot);
+    const std::uint32_t shape = layout.first_shape + layout.shape_of[slot];
+    std::tie(c.o, c.d) = canonical_ray(shape);
+    flip = csg_flip(at.at_exit, at.entering, ends[slot].turned[at.at_exit ? 1 : 0]);
+    if (objects_[csg_base_ + shape].kind == ShapeKind::Mesh) {
         // For the normal and the texture.
-        c.tri = at->tri;
-        mesh_crossing_uv(objects_[csg_base_ + at->shape].mesh->view(), at->tri, c.o, c.d, c.u, c.v);
+        c.tri = ends[slot].tri[at.at_exit ? 1 : 0];
+        mesh_crossing_uv(objects_[csg_base_ + shape].mesh->view(), c.tri, c.o, c.d, c.u, c.v);
     }
-    return int(csg_base_ + at->shape);
+    return int(csg_base_ + shape);
 }
 
 bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max, HitD& hit) const {

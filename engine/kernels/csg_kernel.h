@@ -1,11 +1,13 @@
 #pragma once
 // CSG objects in SIMD (docs/architecture.md, "CSG"): each shape's span over a packet's lanes
 // (shapes/solid_span.h with V = a batch, the same template the recursive engine runs in
-// double), stored per lane in fixed arrays, then each lane's spans combined node by node
-// (render/csg_spans.h with V = float). Included only by kernels/intersect_kernel.h.
+// double), then the first boundary of the result in lanes: in closed form for a root of two
+// shapes, else by the walk along the line (render/csg_spans.h, csg_first_boundary, the
+// recursive engine's own code with V = a batch). Included only by kernels/intersect_kernel.h.
 #include <xsimd/xsimd.hpp>
 
 #include <algorithm>
+#include <array>
 #include <limits>
 
 #include "kernels/csg_view.h"
@@ -14,24 +16,29 @@
 
 namespace streamrt::STREAMRT_ISA_NAMESPACE {
 
-/// enter[s][l], exit[s][l]: the span of object `ob`'s shape s along lane l's ray; empty for
-/// every lane of a packet that misses the shape's box over (0, t_max) (CsgView::shape_boxes).
+/// The spans of object `ob`'s shapes (each one slot: an object without meshes) over a
+/// packet's lanes into `line`, and the slots some lane's line meets, ascending, into `live`
+/// (their count returned). A packet that misses a shape's box over (0, t_max) takes the span
+/// as empty in every lane without its math (CsgView::shape_boxes).
 template <class B>
-inline void csg_packet_spans(const CsgView& csg, const CsgObjectView& ob, const RayPacket<B>& r, const Vec3T<B>& inv,
-                             const B& t_max, float (*enter)[simd::kMaxLanes], float (*exit)[simd::kMaxLanes]) {
-    for (std::uint32_t s = 0; s < ob.shape_count; ++s) {
-        const std::uint32_t k = ob.first_shape + s;
+inline int csg_packet_spans(const CsgView& csg, const CsgObjectView& ob, const RayPacket<B>& r, const Vec3T<B>& inv,
+                            const B& t_max, CsgLine<B>& line, std::uint8_t* live) {
+    int n = 0;
+    for (int s = 0; s < ob.layout.shapes; ++s) {
+        const std::uint32_t k = ob.layout.first_shape + std::uint32_t(s);
         if (csg.shape_bounded[k] && !packet_meets_box<B, float>(r, inv, csg.shape_boxes[k], t_max)) {
-            B(std::numeric_limits<float>::infinity()).store_aligned(enter[s]);
-            B(-std::numeric_limits<float>::infinity()).store_aligned(exit[s]);
+            line.enter[std::size_t(s)] = B(std::numeric_limits<float>::infinity());
+            line.exit[std::size_t(s)] = B(-std::numeric_limits<float>::infinity());
             continue;
         }
         const ObjectXf& xf = csg.records[k].xf;
         const RayPacket<B> c = to_canonical<B, float>(r, xf);
         const SpanT<B> span = csg_shape_span<B>(ShapeKind(xf.kind), c.o, c.d, B(xf.param));
-        span.enter.store_aligned(enter[s]);
-        span.exit.store_aligned(exit[s]);
+        line.enter[std::size_t(s)] = span.enter;
+        line.exit[std::size_t(s)] = span.exit;
+        if (xsimd::any(span.enter < span.exit)) live[n++] = std::uint8_t(s);
     }
+    return n;
 }
 
 /// A boundary of a two-shape result in lanes: t (+inf: none), whether it is the second
@@ -44,10 +51,11 @@ struct PairBoundary {
 };
 
 /// The first boundary with t > 0 of `op` over two shapes of spans [e0, x0], [e1, x1] (each
-/// empty unless enter < exit), in lanes: what render/csg_spans.h's sweep and first_boundary
-/// give, tie rule included (at equal t the first shape's boundary is taken first), from the
-/// same comparisons of the same values, so the same bits. The result has at most two spans,
-/// [o1, c1] and [o2, c2], in order; the earliest valid end past 0 is taken.
+/// empty unless enter < exit), in lanes, in closed form: what render/csg_spans.h's walk
+/// (csg_first_boundary) gives, tie rules included (touching spans join, coinciding ends show
+/// the first shape's surface), from comparisons of the same values, so the same bits. The
+/// result has at most two spans, [o1, c1] and [o2, c2], in order; the earliest valid end past
+/// 0 is taken.
 template <class B>
 inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, const B& e1, const B& x1) {
     using M = typename PairBoundary<B>::M;
@@ -58,9 +66,9 @@ inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, con
     M v1 = no, v2 = no;
     switch (op) {
         case CsgOp::Intersection: {
-            // Opens at the later entry (the second's on a tie), closes at the first exit
-            // (the first's on a tie); nothing when that is not after the opening.
-            const M later = e0 <= e1, first = x0 <= x1;
+            // Opens at the later entry, closes at the first exit (the first's on a tie);
+            // nothing when that is not after the opening.
+            const M later = e0 < e1, first = x0 <= x1;
             o1 = {xsimd::select(later, e1, e0), later, no};
             c1 = {xsimd::select(first, x0, x1), !first, no};
             v1 = a && b && (c1.t > o1.t);
@@ -68,22 +76,23 @@ inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, con
         }
         case CsgOp::Difference: {
             // The second shape's boundaries are turned round. inside: the first enters within
-            // the second; cut: the second enters within the first. Either way the part after
-            // the second's exit remains when that is before the first's.
-            const M inside = b && (e1 < e0) && (e0 <= x1), cut = b && !inside && (e0 <= e1) && (e1 < x0);
+            // the second (entering together included); cut: the second enters within the
+            // first. Either way the part after the second's exit remains when that is before
+            // the first's.
+            const M inside = b && (e1 <= e0) && (e0 < x1), cut = b && !inside && (e0 < e1) && (e1 < x0);
             c1 = {xsimd::select(cut, e1, x0), cut, cut};
-            v1 = a && !inside && !(cut && !(e1 > e0));
+            v1 = a && !inside;
             o2 = {x1, yes, yes};
             v2 = a && (inside || cut) && (x1 < x0);
             break;
         }
         case CsgOp::Union:
         case CsgOp::Merge: {
-            // The first to enter opens; overlapping spans close at the later exit (the
-            // second's on a tie), apart ones stay two.
+            // The first to enter opens; overlapping or touching spans close at the later exit
+            // (the first's on a tie), apart ones stay two.
             const M a_first = a && (!b || (e0 <= e1));
-            const M overlap = a && b && ((a_first && (e1 < x0)) || (!a_first && (e0 <= x1)));
-            const M later = x1 >= x0;
+            const M overlap = a && b && ((a_first && (e1 <= x0)) || (!a_first && (e0 <= x1)));
+            const M later = x1 > x0;
             o1 = {xsimd::select(a_first, e0, e1), !a_first, no};
             c1 = {xsimd::select(overlap, xsimd::select(later, x1, x0), xsimd::select(a_first, x0, x1)),
                   (overlap && later) || (!overlap && !a_first), no};
@@ -112,10 +121,11 @@ inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, con
 template <class Arch, bool kAny>
 void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
     using B = xsimd::batch<float, Arch>;
+    using M = xsimd::batch_bool<float, Arch>;
     constexpr std::size_t W = B::size;
     const simd::FlushDenormals ftz;
-    alignas(64) float enter[kMaxCsgShapes][simd::kMaxLanes], exit[kMaxCsgShapes][simd::kMaxLanes];
-    CsgSpans<float> spans;
+    CsgLine<B> line;
+    std::array<std::uint8_t, kMaxCsgShapes> live;
     for (std::size_t i = 0; i < rays.count; i += W) {  // padding makes the last packet safe
         B t_max = load_lanes<B>(rays.t_max + i);
         if (!xsimd::any(t_max > B(0.f))) continue;  // padding, or blocked already
@@ -144,53 +154,41 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
                 if (kAny && !xsimd::any(t_max > B(0.f))) break;
                 continue;
             }
-            csg_packet_spans(csg, ob, r, inv, t_max, enter, exit);
-            if (ob.pair) {  // in lanes
-                const PairBoundary<B> at =
-                    csg_pair_boundary(ob.op, B::load_aligned(enter[0]), B::load_aligned(exit[0]),
-                                      B::load_aligned(enter[1]), B::load_aligned(exit[1]));
-                const auto hit = at.t < t_max;  // false for padding and blocked lanes (t_max <= 0 < t)
-                if (!xsimd::any(hit)) continue;
-                if constexpr (kAny) {
-                    t_max = xsimd::select(hit, B(0.f), t_max);
-                } else {
-                    t_max = xsimd::select(hit, at.t, t_max);
-                    alignas(64) float second[simd::kMaxLanes], flip[simd::kMaxLanes];
-                    xsimd::select(at.second, B(1.f), B(0.f)).store_aligned(second);
-                    xsimd::select(at.flip, B(1.f), B(0.f)).store_aligned(flip);
-                    alignas(64) float hits[simd::kMaxLanes];
-                    xsimd::select(hit, B(1.f), B(0.f)).store_aligned(hits);
-                    for (std::size_t l = 0; l < lanes; ++l)
-                        if (hits[l] != 0.f)
-                            object[i + l] = csg.first_id + std::int32_t(ob.first_shape) + std::int32_t(second[l]) +
-                                            (flip[l] != 0.f ? csg.shapes : 0);
-                }
-                alignas(64) float out[simd::kMaxLanes];
-                t_max.store_aligned(out);
-                for (std::size_t l = 0; l < lanes; ++l) rays.t_max[i + l] = out[l];
-                if (kAny && !xsimd::any(t_max > B(0.f))) break;
-                continue;
+            const int live_count = csg_packet_spans(csg, ob, r, inv, t_max, line, live.data());
+            if (live_count == 0) continue;
+            // The first boundary per lane: the shape (relative to the object's first) and
+            // whether its normal is turned round.
+            B t, shape;
+            M flip;
+            if (ob.pair) {  // a root of two shapes, in closed form
+                const PairBoundary<B> at = csg_pair_boundary(ob.op, line.enter[0], line.exit[0], line.enter[1], line.exit[1]);
+                t = at.t;
+                shape = xsimd::select(at.second, B(1.f), B(0.f));
+                flip = at.flip;
+            } else {  // any tree: the walk along the line, in lanes
+                const CsgFirst<B> at =
+                    csg_first_boundary(csg.nodes, ob.root, ob.layout, line, live.data(), live_count, B(0.f), t_max);
+                t = at.t;
+                shape = at.slot;  // one slot per shape
+                flip = !simd::mask_xor(at.at_exit, at.entering);
             }
-            // The combine is a short sweep with branches per boundary: per lane.
-            for (std::size_t l = 0; l < lanes; ++l) {
-                float& t = rays.t_max[i + l];
-                if (!(t > 0.f)) continue;
-                csg_node_spans<float>(csg.nodes, ob.root,
-                                      [&](std::uint32_t shape) {
-                                          const std::uint32_t s = shape - ob.first_shape;
-                                          return SpanT<float>{enter[s][l], exit[s][l]};
-                                      },
-                                      spans);
-                const CsgBoundary<float>* at = first_boundary(spans, 0.f, t);
-                if (!at) continue;
-                if constexpr (kAny) {
-                    t = 0.f;
-                } else {
-                    t = at->t;
-                    object[i + l] = csg.first_id + std::int32_t(at->shape) + (at->flip ? csg.shapes : 0);
-                }
+            const M hit = t < t_max;  // false for padding and blocked lanes (t_max <= 0 < t)
+            if (!xsimd::any(hit)) continue;
+            if constexpr (kAny) {
+                t_max = xsimd::select(hit, B(0.f), t_max);
+            } else {
+                t_max = xsimd::select(hit, t, t_max);
+                alignas(64) float slot[simd::kMaxLanes], turned[simd::kMaxLanes];
+                xsimd::select(hit, shape, B(-1.f)).store_aligned(slot);
+                xsimd::select(flip, B(1.f), B(0.f)).store_aligned(turned);
+                const std::int32_t base = csg.first_id + std::int32_t(ob.layout.first_shape);
+                for (std::size_t l = 0; l < lanes; ++l)
+                    if (slot[l] >= 0.f)
+                        object[i + l] = base + std::int32_t(slot[l]) + (turned[l] != 0.f ? csg.shapes : 0);
             }
-            t_max = load_lanes<B>(rays.t_max + i);
+            alignas(64) float out[simd::kMaxLanes];
+            t_max.store_aligned(out);
+            for (std::size_t l = 0; l < lanes; ++l) rays.t_max[i + l] = out[l];
             if (kAny && !xsimd::any(t_max > B(0.f))) break;  // the whole packet is in shadow
         }
     }

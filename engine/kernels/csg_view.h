@@ -7,23 +7,25 @@
 #include "kernels/kernel_object.h"
 #include "mesh/mesh.h"
 #include "kernels/ray_stream.h"
+#include "render/csg_layout.h"
 #include "scene/scene.h"
 
 namespace streamrt {
 
-/// One CSG object: its root node, the range of its shapes' records (the reader gives an
-/// object's shapes consecutive numbers) and its result's box.
+/// One CSG object: its root node, its shapes' slots (the reader gives an object's shapes
+/// consecutive numbers, so its records are [first_shape, first_shape + shapes) of the
+/// layout) and its result's box.
 struct CsgObjectView {
     ObjectBounds box;         ///< relative to the eye, padded outwards (never culls a ray that meets the result)
     bool bounded;             ///< false: the box is infinite (a plane's half-space); nothing is culled
     std::uint32_t root;       ///< into CsgView::nodes
-    std::uint32_t first_shape, shape_count;  ///< records [first_shape, first_shape + shape_count)
-    /// A root of two shapes (the common node: a lens, a pipe), combined in lanes
-    /// (csg_pair_boundary); other trees are combined per lane.
+    CsgSlotLayout layout;
+    /// A root of two shapes (the common node: a lens, a pipe), combined in closed form
+    /// (csg_pair_boundary); other trees by the walk along the line (csg_first_boundary).
     bool pair;
     CsgOp op;  ///< the root's
-    /// An object with a mesh among its shapes: its lanes take csg_scalar_lane (a mesh may
-    /// cross a line several times: more than the one span per shape the lane arrays hold).
+    /// An object with a mesh among its shapes: its lanes take csg_scalar_lane (a mesh's
+    /// spans come from a walk of its own hierarchy, lane by lane).
     bool scalar;
 };
 

@@ -1,167 +1,182 @@
 #pragma once
 // Constructive solid geometry along one line (docs/architecture.md, "CSG"): each solid's span
-// (shapes/solid_span.h) combined node by node into the spans of the result. Scalar code for
-// both engines, in fixed arrays (kMaxCsgShapes): nothing is allocated per ray.
+// (shapes/solid_span.h), then the first point where the line crosses the result's surface,
+// found by classifying points against the tree (csg_first_boundary). One template for both
+// engines, scalar and in SIMD lanes, in fixed arrays (kMaxCsgShapes): nothing is allocated
+// per ray.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <tuple>
 #include <type_traits>
+#include <utility>
 
 #include "scene/scene.h"
 #include "mesh/mesh_solid.h"
+#include "render/csg_layout.h"
 #include "mesh/mesh_trace.h"
 #include "scene/scene_bvh.h"
 #include "shapes/shapes.h"
 #include "simd/isa_namespace.h"
+#include "simd/lanes.h"
 
 namespace streamrt {
 
 STREAMRT_ISA_BEGIN  // per-level names in the kernel files (simd/isa_namespace.h)
 
-/// One end of a span: where the line crosses the surface of shape `shape` (an index in
-/// Scene::csg_shapes), and whether that surface's normal points into the result (a subtracted
-/// shape's surface: the normal shown must be turned round).
+/// The spans of an object's slots along one line (t over the whole line), each empty unless
+/// enter < exit (a miss: +inf, -inf; NaN compares as a miss).
 template <class V>
-struct CsgBoundary {
-    V t;
-    std::uint32_t shape;
-    bool flip;
-    std::uint32_t tri = 0;  ///< a mesh's triangle there (leaf order); 0 for other shapes
+struct CsgLine {
+    std::array<V, kMaxCsgShapes> enter, exit;
 };
 
-/// A node's spans along the line, sorted and disjoint: [b[0], b[1]], [b[2], b[3]], ... each
-/// of positive length (a zero-length one, from a tangent line or coinciding surfaces, is
-/// dropped: it bounds nothing).
+/// A closed mesh's spans along the line o + t d (its canonical space) into its slots
+/// [first, first + kMeshCsgSpans): where the crossings, counted +1 going in and -1 going out,
+/// add up to other than 0; the first kMeshCsgSpans along the line, the other slots empty. A
+/// count left open at the last crossing (a line that rounding let through an edge) closes
+/// nothing.
 template <class V>
-struct CsgSpans {
-    std::array<CsgBoundary<V>, 2 * kMaxCsgShapes> b;
-    int size = 0;  ///< boundaries: twice the spans
-
-    void open(const CsgBoundary<V>& at) { b[std::size_t(size++)] = at; }
-    void close(const CsgBoundary<V>& at) {
-        if (at.t > b[std::size_t(size - 1)].t) b[std::size_t(size++)] = at;
-        else --size;
-    }
-    void assign(const CsgSpans& other) {
-        size = other.size;
-        for (int i = 0; i < size; ++i) b[std::size_t(i)] = other.b[std::size_t(i)];
-    }
-};
-
-/// Whether a point is in the result of op, from whether it is in each operand.
-constexpr bool csg_inside(CsgOp op, bool in_a, bool in_b) {
-    switch (op) {
-        case CsgOp::Intersection: return in_a && in_b;
-        case CsgOp::Difference: return in_a && !in_b;
-        case CsgOp::Union:
-        case CsgOp::Merge: break;
-    }
-    return in_a || in_b;
-}
-
-/// out = a op b: one sweep over both lists' boundaries in order of t. Where a boundary of a and
-/// one of b coincide, a's is taken first (docs/scene-format.md, "CSG", coinciding surfaces).
-template <class V>
-void combine_spans(CsgOp op, const CsgSpans<V>& a, const CsgSpans<V>& b, CsgSpans<V>& out) {
-    out.size = 0;
-    bool in_a = false, in_b = false, in_out = false;
-    int ia = 0, ib = 0;
-    const bool b_is_removed = op == CsgOp::Difference;  // its surfaces face into the result
-    while (ia < a.size || ib < b.size) {
-        CsgBoundary<V> at;
-        if (ib == b.size || (ia < a.size && !(b.b[std::size_t(ib)].t < a.b[std::size_t(ia)].t))) {
-            at = a.b[std::size_t(ia++)];
-            in_a = !in_a;
-        } else {
-            at = b.b[std::size_t(ib++)];
-            at.flip = at.flip != b_is_removed;
-            in_b = !in_b;
-        }
-        const bool now = csg_inside(op, in_a, in_b);
-        if (now == in_out) continue;
-        if (now) out.open(at);
-        else out.close(at);
-        in_out = now;
-    }
-}
-
-/// A convex solid's (or a half-space's) span as a span list: none for a miss (NaN included)
-/// or a span of length 0 (a tangent line).
-template <class V>
-void add_solid_span(CsgSpans<V>& into, const SpanT<V>& s, std::uint32_t shape) {
-    if (s.enter < s.exit) {
-        into.open({s.enter, shape, false});
-        into.close({s.exit, shape, false});
-    }
-}
-
-/// A closed mesh's spans along the line o + t d (its canonical space): where the crossings,
-/// counted +1 going in and -1 going out, add up to other than 0 (a mesh turned inside out is
-/// a solid too, its normals turned round to face out of it: flip). At most kMeshCsgSpans, the
-/// first along the line; a count left open at the last crossing (a line that rounding let
-/// through an edge) closes nothing.
-template <class V>
-void add_mesh_spans(CsgSpans<V>& into, const Mesh& mesh, const Vec3T<V>& o, const Vec3T<V>& d, std::uint32_t shape) {
+void mesh_slot_spans(CsgLine<V>& line, CsgSlotEnds* ends, int first, const Mesh& mesh, const Vec3T<V>& o,
+                     const Vec3T<V>& d) {
     MeshCrossing<V> c[kMeshCsgCrossings];
     const int n = mesh_crossings(mesh.view(), mesh.bvh, o, d, c, kMeshCsgCrossings);
-    int winding = 0, spans = 0;
-    for (int i = 0; i < n && spans < kMeshCsgSpans; ++i) {
+    for (int j = first; j < first + kMeshCsgSpans; ++j) {
+        line.enter[std::size_t(j)] = std::numeric_limits<V>::infinity();
+        line.exit[std::size_t(j)] = -std::numeric_limits<V>::infinity();
+    }
+    int winding = 0, slot = first;
+    for (int i = 0; i < n && slot < first + kMeshCsgSpans; ++i) {
         const int before = winding;
         winding += c[i].enters ? 1 : -1;
-        // Going in, the surface must face against the line: a triangle facing along it is turned round.
-        if (before == 0 && winding != 0) into.open({c[i].t, shape, !c[i].enters, c[i].tri});
-        else if (before != 0 && winding == 0) {
-            into.close({c[i].t, shape, c[i].enters, c[i].tri});
-            spans = into.size / 2;
+        const auto j = std::size_t(slot);
+        if (before == 0 && winding != 0) {
+            line.enter[j] = c[i].t;  // a span left open keeps exit -inf: empty
+            ends[j].tri[0] = c[i].tri;
+            ends[j].turned[0] = !c[i].enters;  // going in, the surface faces along the line
+        } else if (before != 0 && winding == 0) {
+            line.exit[j] = c[i].t;
+            ends[j].tri[1] = c[i].tri;
+            ends[j].turned[1] = c[i].enters;
+            ++slot;
         }
     }
-    if (into.size % 2 != 0) --into.size;  // an open span at the end: dropped
 }
 
-/// The spans of node `node` of a scene's CSG trees (`nodes`: Scene::csg_nodes) along a line.
-/// leaf(k, into) writes the span list of Scene::csg_shapes[k] along the same line (in the same
-/// units of t) into `into`, which it finds empty; a leaf(k) that returns the shape's SpanT
-/// does as well.
-template <class V, class Leaf>
-void csg_node_spans(const CsgNode* nodes, std::uint32_t node, const Leaf& leaf, CsgSpans<V>& out) {
+/// Where a line first crosses a CSG result's surface (csg_first_boundary), per lane.
+template <class V>
+struct CsgFirst {
+    using M = decltype(std::declval<V>() < std::declval<V>());
+    V t;          ///< +inf: none in (t_min, t_max)
+    V slot;       ///< the slot whose end it is
+    M at_exit;    ///< the slot's exit (else its enter)
+    M entering;   ///< the line goes into the result there (else out of it)
+};
+
+/// Per lane a ? b : c, for masks (bool or a batch's).
+template <class M>
+M mask_select(const M& a, const M& b, const M& c) {
+    return (a && b) || (!a && c);
+}
+
+/// Whether the points of the line where in_slot holds (per slot) are in the result of node
+/// `node`: a union (and a merge) of its children, an intersection, or the first child minus
+/// the others.
+template <class M>
+M csg_node_inside(const CsgNode* nodes, std::uint32_t node, const CsgSlotLayout& layout, const M* in_slot) {
     const CsgNode& n = nodes[node];
-    CsgSpans<V> child, combined;
+    M r(false);
     bool first = true;
     for (const CsgNode::Child& c : n.children) {
-        CsgSpans<V>& into = first ? out : child;
+        M m(false);
         if (c.is_node) {
-            csg_node_spans(nodes, c.index, leaf, into);
+            m = csg_node_inside(nodes, c.index, layout, in_slot);
         } else {
-            into.size = 0;
-            if constexpr (std::is_invocable_v<const Leaf&, std::uint32_t, CsgSpans<V>&>) leaf(c.index, into);
-            else add_solid_span(into, leaf(c.index), c.index);
+            const std::size_t s = c.index - layout.first_shape;
+            for (int j = layout.first_slot[s]; j < layout.first_slot[s + 1]; ++j) m = m || in_slot[j];
         }
         if (first) {
+            r = m;
             first = false;
-        } else if (child.size == 0) {
-            // A child the line misses removes nothing and adds nothing (the sweep would give
-            // `out` back unchanged); an intersection with it is empty. Most of a die's dimples
-            // miss most rays: this saves their sweeps.
-            if (n.op == CsgOp::Intersection) out.size = 0;
-        } else {
-            combine_spans(n.op, out, child, combined);
-            out.assign(combined);
+            continue;
         }
-        // Nothing left stays nothing: the other children cannot add to it.
-        if (out.size == 0 && (n.op == CsgOp::Intersection || n.op == CsgOp::Difference)) return;
+        switch (n.op) {
+            case CsgOp::Intersection: r = r && m; break;
+            case CsgOp::Difference: r = r && !m; break;
+            case CsgOp::Union:
+            case CsgOp::Merge: r = r || m; break;
+        }
     }
+    return r;
 }
 
-/// The first boundary with t_min < t < t_max (an infinite end is no surface), or null.
+/// The first point of the line in (t_min, t_max) where it goes into or out of the result of
+/// the tree at `root`: one definition for both engines, scalar (V = double, float) and in
+/// lanes (V = a batch). A point is in a slot's span when enter <= t < exit (so a span of length
+/// 0 holds nothing), and the walk steps from t_min to each next end of a span, classifying the
+/// point just after it by the tree (csg_node_inside): the first step whose class differs from
+/// the one before is the boundary. Where ends of several slots coincide, the class is taken
+/// after all of them (a subtracted face lying on the base's face removes it; spans that touch
+/// join), and the surface shown is the lowest slot's among them: the first-written shape's
+/// (docs/scene-format.md, "CSG"). `live`: the slots to read, ascending (the others are empty
+/// in every lane). No sorting and no lists: at most one step per span end.
 template <class V>
-const CsgBoundary<V>* first_boundary(const CsgSpans<V>& spans, V t_min, V t_max) {
-    for (int i = 0; i < spans.size; ++i) {
-        const CsgBoundary<V>& at = spans.b[std::size_t(i)];
-        if (at.t > t_min) return at.t < t_max ? &at : nullptr;
+CsgFirst<V> csg_first_boundary(const CsgNode* nodes, std::uint32_t root, const CsgSlotLayout& layout,
+                               const CsgLine<V>& line, const std::uint8_t* live, int live_count, const V& t_min,
+                               const V& t_max) {
+    using M = typename CsgFirst<V>::M;
+    using S = simd::scalar_t<V>;
+    const V inf(std::numeric_limits<S>::infinity());
+    std::array<M, kMaxCsgShapes> in, valid;
+    for (int j = 0; j < layout.slots(); ++j) in[std::size_t(j)] = M(false);
+    for (int i = 0; i < live_count; ++i) {
+        const std::size_t s = live[i];
+        valid[std::size_t(i)] = line.enter[s] < line.exit[s];
+        in[s] = valid[std::size_t(i)] && (line.enter[s] <= t_min) && (t_min < line.exit[s]);
     }
-    return nullptr;
+    M state = csg_node_inside(nodes, root, layout, in.data());
+    CsgFirst<V> r{inf, V(S(0)), M(false), M(false)};
+    M active = t_min < t_max;
+    V at = t_min;
+    while (true) {
+        V next = inf;
+        for (int i = 0; i < live_count; ++i) {
+            const std::size_t s = live[i];
+            const M v = valid[std::size_t(i)];
+            next = simd::min(next, simd::select(v && (line.enter[s] > at), line.enter[s], inf));
+            next = simd::min(next, simd::select(v && (line.exit[s] > at), line.exit[s], inf));
+        }
+        active = active && (next < t_max);
+        if (!simd::any(active)) break;
+        for (int i = 0; i < live_count; ++i) {
+            const std::size_t s = live[i];
+            in[s] = valid[std::size_t(i)] && (line.enter[s] <= next) && (next < line.exit[s]);
+        }
+        const M now = csg_node_inside(nodes, root, layout, in.data());
+        const M change = active && simd::mask_xor(now, state);
+        if (simd::any(change)) {
+            V slot(S(0));
+            M at_exit(false);
+            for (int i = live_count - 1; i >= 0; --i) {  // the lowest slot last
+                const std::size_t s = live[i];
+                const M v = valid[std::size_t(i)];
+                const M ends_exit = v && (line.exit[s] == next), here = (v && (line.enter[s] == next)) || ends_exit;
+                slot = simd::select(here, V(S(s)), slot);
+                at_exit = mask_select(here, ends_exit, at_exit);
+            }
+            r.t = simd::select(change, next, r.t);
+            r.slot = simd::select(change, slot, r.slot);
+            r.at_exit = mask_select(change, at_exit, r.at_exit);
+            r.entering = mask_select(change, now, r.entering);
+            active = active && !change;
+            if (!simd::any(active)) break;
+        }
+        state = now;
+        at = next;
+    }
+    return r;
 }
 
 /// A CSG shape's span in its canonical space (o, d: the line there); a kind that is no solid
@@ -173,6 +188,32 @@ SpanT<V> csg_shape_span(ShapeKind kind, const Vec3T<V>& o, const Vec3T<V>& d, V 
         if constexpr (Solid<decltype(shape)>) return solid_span<decltype(shape)>(o, d, param);
         else return {V(1), V(0)};
     });
+}
+
+/// One line's spans through every shape of an object, in scalar code (V = float, double):
+/// `canonical(shape)` gives the line (o, d) in the shape's canonical space, `solid(shape)` its
+/// kind, parameter and mesh (null for other kinds). Fills `line` and `ends` (a mesh's), and
+/// `live` with the slots the line meets, ascending; returns their count.
+template <class V, class Canonical, class Solid>
+int csg_scalar_line(const CsgSlotLayout& layout, const Canonical& canonical, const Solid& solid, CsgLine<V>& line,
+                    CsgSlotEnds* ends, std::uint8_t* live) {
+    int n = 0;
+    for (int s = 0; s < layout.shapes; ++s) {
+        const std::uint32_t shape = layout.first_shape + std::uint32_t(s);
+        const auto [o, d] = canonical(shape);
+        const auto [kind, param, mesh] = solid(shape);
+        const int j = layout.first_slot[std::size_t(s)];
+        if (mesh) {
+            mesh_slot_spans(line, ends, j, *mesh, o, d);
+        } else {
+            const SpanT<V> span = csg_shape_span(kind, o, d, V(param));
+            line.enter[std::size_t(j)] = span.enter;
+            line.exit[std::size_t(j)] = span.exit;
+        }
+        for (int i = j; i < layout.first_slot[std::size_t(s) + 1]; ++i)
+            if (line.enter[std::size_t(i)] < line.exit[std::size_t(i)]) live[n++] = std::uint8_t(i);
+    }
+    return n;
 }
 
 /// A world box of a CSG result: lo > hi on an axis when it is empty, infinite ends where it

@@ -1,6 +1,7 @@
 #include "stream/stream_csg.h"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <stdexcept>
 
@@ -10,22 +11,6 @@
 #include "stream/stream_accel.h"
 
 namespace streamrt {
-
-namespace {
-
-/// The smallest and largest shape number under node `node`.
-void shape_range(const std::vector<CsgNode>& nodes, std::uint32_t node, std::uint32_t& lo, std::uint32_t& hi) {
-    for (const CsgNode::Child& c : nodes[node].children) {
-        if (c.is_node) {
-            shape_range(nodes, c.index, lo, hi);
-        } else {
-            lo = std::min(lo, c.index);
-            hi = std::max(hi, c.index);
-        }
-    }
-}
-
-}  // namespace
 
 std::unique_ptr<const StreamCsg> StreamCsg::build_for(const Scene& scene, std::int32_t first_id,
                                                       const glm::dvec3& eye) {
@@ -43,20 +28,14 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
         v.root = o.root;
         v.bounded = box.bounded();
         if (v.bounded) v.box = padded_bounds(box.lo, box.hi, eye);
-        std::uint32_t lo = std::numeric_limits<std::uint32_t>::max(), hi = 0;
-        shape_range(nodes_, o.root, lo, hi);
-        v.first_shape = lo;
-        v.shape_count = hi - lo + 1;
-        // The reader numbers an object's shapes one after the other (at most kMaxCsgShapes):
-        // the kernels' per-lane arrays are indexed by shape - first_shape.
-        if (v.shape_count > std::uint32_t(kMaxCsgShapes))
-            throw std::logic_error("a csg object's shapes are not numbered consecutively");
+        v.layout = csg_slot_layout(scene, o);
+        const std::uint32_t lo = o.first_shape, hi = o.first_shape + o.shape_count;
         const CsgNode& root = nodes_[o.root];
         v.op = root.op;
-        // (children 0 and 1 are its shapes first_shape and first_shape + 1, in the kernels' arrays)
+        // (children 0 and 1 are its shapes lo and lo + 1, in the kernels' lane arrays)
         v.pair = root.children.size() == 2 && !root.children[0].is_node && !root.children[1].is_node &&
                  root.children[0].index == lo && root.children[1].index == lo + 1;
-        for (std::uint32_t s = lo; s <= hi; ++s) v.scalar = v.scalar || scene.csg_shapes[s].kind == ShapeKind::Mesh;
+        for (std::uint32_t s = lo; s < hi; ++s) v.scalar = v.scalar || scene.csg_shapes[s].kind == ShapeKind::Mesh;
         v.pair = v.pair && !v.scalar;
         objects_.push_back(v);
     }
@@ -96,25 +75,29 @@ bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[
         const ObjectXf& xf = csg.records[shape].xf;
         return std::pair{apply_point(xf.m, ow), apply_vector(xf.m, dw)};
     };
-    CsgSpans<float> spans;
-    csg_node_spans(csg.nodes, ob.root,
-                   [&](std::uint32_t shape, CsgSpans<float>& into) {
-                       const auto [oc, dc] = canonical(shape);
-                       if (const Mesh* m = csg.meshes[shape]) add_mesh_spans(into, *m, oc, dc, shape);
-                       else {
-                           const ObjectXf& xf = csg.records[shape].xf;
-                           add_solid_span(into, csg_shape_span(ShapeKind(xf.kind), oc, dc, xf.param), shape);
-                       }
-                   },
-                   spans);
-    const CsgBoundary<float>* at = first_boundary(spans, 0.f, t_max);
-    if (!at) return false;
-    t_max = at->t;
-    object = csg.first_id + std::int32_t(at->shape) + (at->flip ? csg.shapes : 0);
-    if (const Mesh* m = csg.meshes[at->shape]; m && prim) {
-        const auto [oc, dc] = canonical(at->shape);
-        *prim = std::int32_t(at->tri);
-        mesh_crossing_uv(m->view(), at->tri, oc, dc, *bu, *bv);
+    const CsgSlotLayout& layout = ob.layout;
+    CsgLine<float> line;
+    std::array<CsgSlotEnds, kMaxCsgShapes> ends{};
+    std::array<std::uint8_t, kMaxCsgShapes> live;
+    const int live_count = csg_scalar_line(
+        layout, canonical,
+        [&](std::uint32_t shape) {
+            const ObjectXf& xf = csg.records[shape].xf;
+            return std::tuple{ShapeKind(xf.kind), xf.param, csg.meshes[shape]};
+        },
+        line, ends.data(), live.data());
+    const CsgFirst<float> at = csg_first_boundary(csg.nodes, ob.root, layout, line, live.data(), live_count, 0.f, t_max);
+    if (!(at.t < t_max)) return false;
+    t_max = at.t;
+    const auto slot = std::size_t(at.slot);
+    const std::uint32_t shape = layout.first_shape + layout.shape_of[slot];
+    const int end = at.at_exit ? 1 : 0;
+    object = csg.first_id + std::int32_t(shape) +
+             (csg_flip(at.at_exit, at.entering, ends[slot].turned[std::size_t(end)]) ? csg.shapes : 0);
+    if (const Mesh* m = csg.meshes[shape]; m && prim) {
+        const auto [oc, dc] = canonical(shape);
+        *prim = std::int32_t(ends[slot].tri[std::size_t(end)]);
+        mesh_crossing_uv(m->view(), ends[slot].tri[std::size_t(end)], oc, dc, *bu, *bv);
     }
     return true;
 }

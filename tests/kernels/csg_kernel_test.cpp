@@ -1,4 +1,4 @@
-// The SIMD CSG kernels (kernels/csg_kernel.h) against the scalar spans, lane by lane: every
+// The SIMD CSG kernels (kernels/csg_kernel.h) against the scalar walk, lane by lane: every
 // ray's t and record id (closest) and blocked flag (any) at every ISA level this machine runs,
 // on random rays through CSG objects of every solid, nested, cut by a plane.
 #include <doctest/doctest.h>
@@ -24,23 +24,15 @@ struct Expected {
     std::int32_t id;
 };
 
-/// The first CSG surface in (0, t_max) along o + t d, scalar (V = float) and without any box:
-/// what every lane of the kernels must give.
+/// The first CSG surface in (0, t_max) along o + t d, lane by lane in scalar code
+/// (csg_scalar_lane: the walk with V = float) and without any box: what every lane of the
+/// kernels must give.
 Expected scalar_closest(const CsgView& v, const Vec3f& o, const Vec3f& d, float t_max) {
     Expected e{t_max, -1};
+    const float of[3] = {o.x, o.y, o.z}, df[3] = {d.x, d.y, d.z};
     for (std::size_t k = 0; k < v.count; ++k) {
-        CsgSpans<float> spans;
-        csg_node_spans<float>(v.nodes, v.objects[k].root,
-                              [&](std::uint32_t shape) {
-                                  const ObjectXf& xf = v.records[shape].xf;
-                                  return csg_shape_span<float>(ShapeKind(xf.kind), apply_point(xf.m, o),
-                                                               apply_vector(xf.m, d), xf.param);
-                              },
-                              spans);
-        const CsgBoundary<float>* at = first_boundary(spans, 0.f, e.t);
-        if (!at) continue;
-        e.t = at->t;
-        e.id = v.first_id + std::int32_t(at->shape) + (at->flip ? v.shapes : 0);
+        std::int32_t id = -1;
+        if (csg_scalar_lane(v, v.objects[k], of, df, e.t, id, nullptr, nullptr, nullptr)) e.id = id;
     }
     return e;
 }
@@ -75,7 +67,7 @@ const char* const kScenes[] = {
 
 }  // namespace
 
-TEST_CASE("csg kernels: every lane's closest and any hit equal the scalar spans, every ISA") {
+TEST_CASE("csg kernels: every lane's closest and any hit equal the scalar walk, every ISA") {
     for (const char* text : kScenes) {
         const Scene s = parse_scene(std::string("camera eye=0,0,8 look=0,0,0\nsphere translate=9,0,0\n") + text, "t.cfg");
         const StreamScene sc(s);

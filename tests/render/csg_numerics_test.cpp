@@ -29,9 +29,8 @@ std::size_t csg_shape_of(const Scene& s, const HitD& hit) { return std::size_t(h
 TEST_CASE("csg numerics: a subtracted face lying on the base's face removes it") {
     // The cube [-1,1]^3 minus the box [-0.5,0.5]^2 x [0,1] (a cube of half-size 0.5 centred at
     // z = 0.5): the two share the plane z = 1. The line down the axis enters both at z = 1 at
-    // once; the base's boundary is taken first, so the result opens and closes there (a span of
-    // length 0, dropped) and the first surface is the pocket's floor z = 0, the subtracted box's
-    // face, turned to face +z.
+    // once; the point after it is in both, so out of the result: no surface there. The first
+    // surface is the pocket's floor z = 0, the subtracted box's face, turned to face +z.
     const Scene s = parse("csg difference\n  cube\n  cube scale=0.5 translate=0,0,0.5\nend\n");
     HitD hit;
     REQUIRE(hit_of(s, {0, 0, 5}, {0, 0, -1}, hit));
@@ -50,17 +49,16 @@ TEST_CASE("csg numerics: a subtracted face lying on the base's face removes it")
     CHECK(hit.t <= 5.0);
 }
 
-TEST_CASE("csg numerics: where an intersection's children enter together, the later child's face is shown") {
+TEST_CASE("csg numerics: where an intersection's children enter together, the first child's face is shown") {
     // [-1,1]^3 and the same cube moved by 1 along z: both have the faces x = +-1 and y = +-1.
-    // Along -x at z = 0.5 both enter at x = 1 at the same t; the first child's entry is taken
-    // first (the result is not yet entered: the second child is still out), then the second's
-    // opens the result.
+    // Along -x at z = 0.5 both enter at x = 1 at the same t: the result is entered there, on
+    // both faces at once; the first-written child's is the one shown.
     const Scene s = parse("csg intersection\n  cube\n  cube translate=0,0,1\nend\n");
     HitD hit;
     REQUIRE(hit_of(s, {5, 0, 0.5}, {-1, 0, 0}, hit));
     CHECK(hit.t == 4.0);
     CHECK(hit.normal.x == doctest::Approx(1.0));
-    CHECK(csg_shape_of(s, hit) == 1);
+    CHECK(csg_shape_of(s, hit) == 0);
     // The result is [-1,1]^2 x [0,1]: the line along -z meets its top z = 1 (the first cube's
     // face; the second's top is at z = 2) and leaves at z = 0 (the second cube's bottom).
     REQUIRE(hit_of(s, {0, 0, 5}, {0, 0, -1}, hit));

@@ -3,7 +3,9 @@
 // that must hold pixel for pixel.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "baseline/recursive_renderer.h"
@@ -163,33 +165,64 @@ TEST_CASE("csg: a difference with a disjoint child is its first child alone") {
     CHECK(differing_pixels(plain, recursive_image(lit_scene(""))) > 100);
 }
 
-TEST_CASE("csg: combining span lists by hand") {
-    const auto spans = [](std::initializer_list<double> ts) {
-        CsgSpans<double> s;
-        std::uint32_t shape = 0;
-        for (const double t : ts) s.b[std::size_t(s.size++)] = {t, shape++, false};
-        return s;
-    };
-    const CsgSpans<double> a = spans({0, 4, 6, 8});  // shapes 0 .. 3
-    const CsgSpans<double> b = spans({2, 7});        // shapes 0, 1 of b
-    CsgSpans<double> out;
-    const auto ts = [&] {
-        std::string s;
-        for (int i = 0; i < out.size; ++i)
-            s += std::to_string(int(out.b[std::size_t(i)].t)) + (out.b[std::size_t(i)].flip ? "f " : " ");
-        return s;
-    };
-    combine_spans(CsgOp::Union, a, b, out);
-    CHECK(ts() == "0 8 ");
-    combine_spans(CsgOp::Intersection, a, b, out);
-    CHECK(ts() == "2 4 6 7 ");
-    combine_spans(CsgOp::Difference, a, b, out);
-    CHECK(ts() == "0 2f 7f 8 ");  // b's surfaces bound the result from its far side
-    combine_spans(CsgOp::Difference, b, a, out);
-    CHECK(ts() == "4f 6f ");
-    // Spans that touch leave nothing of zero length behind.
-    combine_spans(CsgOp::Intersection, spans({0, 2}), spans({2, 3}), out);
-    CHECK(out.size == 0);
+namespace {
+
+/// The walk (csg_first_boundary) over hand-made spans, one slot per shape: "t slot e|x in|out"
+/// of the first boundary past t_min, or "none".
+std::string walk(const Scene& scene, std::initializer_list<std::pair<double, double>> spans, double t_min = 0.0,
+                 double t_max = kInf) {
+    const CsgObject& o = scene.csg_objects[0];
+    const CsgSlotLayout layout = csg_slot_layout(scene, o);
+    REQUIRE(std::size_t(layout.slots()) == spans.size());
+    CsgLine<double> line;
+    std::array<std::uint8_t, kMaxCsgShapes> live;
+    int n = 0;
+    for (const auto& [e, x] : spans) {
+        line.enter[std::size_t(n)] = e;
+        line.exit[std::size_t(n)] = x;
+        live[std::size_t(n)] = std::uint8_t(n);
+        ++n;
+    }
+    const CsgFirst<double> at = csg_first_boundary(scene.csg_nodes.data(), o.root, layout, line, live.data(), n, t_min, t_max);
+    if (!(at.t < t_max)) return "none";
+    std::ostringstream s;
+    s << at.t << " " << at.slot << (at.at_exit ? " x " : " e ") << (at.entering ? "in" : "out");
+    return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("csg: the walk along a line over spans given by hand") {
+    const Scene uni = parse("csg union\n sphere\n sphere\nend\n");
+    const Scene inter = parse("csg intersection\n sphere\n sphere\nend\n");
+    const Scene diff = parse("csg difference\n sphere\n sphere\nend\n");
+    // Overlapping spans [1, 4] and [2, 6].
+    CHECK(walk(uni, {{1, 4}, {2, 6}}) == "1 0 e in");
+    CHECK(walk(uni, {{1, 4}, {2, 6}}, 1.5) == "6 1 x out");  // no inner surface at 4 (or 2)
+    CHECK(walk(inter, {{1, 4}, {2, 6}}) == "2 1 e in");
+    CHECK(walk(inter, {{1, 4}, {2, 6}}, 2) == "4 0 x out");
+    CHECK(walk(diff, {{1, 4}, {2, 6}}) == "1 0 e in");
+    CHECK(walk(diff, {{1, 4}, {2, 6}}, 1) == "2 1 e out");  // the removed shape's enter closes it
+    CHECK(walk(diff, {{2, 6}, {1, 4}}) == "4 1 x in");      // its exit opens it
+    CHECK(walk(diff, {{2, 6}, {1, 4}}, 0, 3.5) == "none");
+    // Spans that touch join: no surface where they meet.
+    CHECK(walk(uni, {{0.5, 2}, {2, 3}}, 1) == "3 1 x out");
+    CHECK(walk(inter, {{0.5, 2}, {2, 3}}) == "none");
+    // Coinciding ends: the class after both; the first shape's surface shown.
+    CHECK(walk(uni, {{1, 3}, {1, 5}}) == "1 0 e in");
+    CHECK(walk(inter, {{1, 3}, {1, 5}}) == "1 0 e in");
+    CHECK(walk(diff, {{1, 3}, {1, 2}}) == "2 1 x in");  // the base's face removed with the other's
+    CHECK(walk(diff, {{1, 3}, {0, 3}}) == "none");
+    // A span of length 0 (a tangent line) holds nothing; an empty one (a miss) neither.
+    CHECK(walk(diff, {{1, 3}, {2, 2}}) == "1 0 e in");
+    CHECK(walk(diff, {{1, 3}, {2, 2}}, 1) == "3 0 x out");
+    CHECK(walk(uni, {{kInf, -kInf}, {2, 3}}) == "2 1 e in");
+    // A line starting inside the result: the first way out.
+    CHECK(walk(uni, {{-1, 3}, {2, 5}}) == "5 1 x out");
+    // An infinite end (a half-space) is no surface.
+    CHECK(walk(inter, {{-kInf, 3}, {1, kInf}}) == "1 1 e in");
+    CHECK(walk(inter, {{-kInf, 3}, {1, kInf}}, 1) == "3 0 x out");
+    CHECK(walk(uni, {{-kInf, 3}, {1, kInf}}) == "none");
 }
 
 namespace {
