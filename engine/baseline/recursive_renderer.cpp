@@ -102,7 +102,7 @@ int RecursiveRenderer::test_csg(std::size_t k, const RayD& ray, double t_min, do
     // Each slot's span (a mesh's several), then the walk along the line (render/csg_spans.h).
     const CsgSlotLayout& layout = csg_layouts_[k];
     CsgLine<double> line;
-    std::array<CsgSlotEnds, kMaxCsgShapes> ends{};
+    std::array<CsgSlotEnds, kMaxCsgShapes> ends;  // csg_scalar_line fills what the walk reads
     std::array<std::uint8_t, kMaxCsgShapes> live;
     const int live_count = csg_scalar_line(
         layout, canonical_ray,

@@ -137,14 +137,30 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
             const CsgObjectView& ob = csg.objects[k];
             if (ob.bounded && !packet_meets_box<B, float>(r, inv, ob.box, t_max)) continue;
             if (ob.scalar) {  // an object with a mesh: each lane whole, in scalar code
+                // Per lane, the shapes whose box its segment (0, t_max) misses: their spans are
+                // taken as empty (a mesh's walk saved), which changes no boundary inside the
+                // segment; a lane that misses the object's box is skipped whole.
+                alignas(64) float meets[simd::kMaxLanes];
+                const auto in_box = ob.bounded ? lanes_meeting_box<B, float>(r, inv, ob.box, t_max) : (t_max > B(0.f));
+                xsimd::select(in_box, B(1.f), B(0.f)).store_aligned(meets);
+                std::uint64_t empty[simd::kMaxLanes] = {};
+                for (int s = 0; s < ob.layout.shapes; ++s) {
+                    const std::uint32_t shape = ob.layout.first_shape + std::uint32_t(s);
+                    if (!csg.shape_bounded[shape]) continue;
+                    alignas(64) float shape_meets[simd::kMaxLanes];
+                    xsimd::select(lanes_meeting_box<B, float>(r, inv, csg.shape_boxes[shape], t_max), B(1.f), B(0.f))
+                        .store_aligned(shape_meets);
+                    for (std::size_t l = 0; l < lanes; ++l)
+                        if (shape_meets[l] == 0.f) empty[l] |= std::uint64_t(1) << s;
+                }
                 for (std::size_t l = 0; l < lanes; ++l) {
                     float& t = rays.t_max[i + l];
-                    if (!(t > 0.f)) continue;
+                    if (!(t > 0.f) || meets[l] == 0.f) continue;
                     const float o[3] = {rays.ox[i + l], rays.oy[i + l], rays.oz[i + l]};
                     const float d[3] = {rays.dx[i + l], rays.dy[i + l], rays.dz[i + l]};
                     std::int32_t id = 0;
                     const bool want_prim = !kAny && rays.prim;
-                    if (!csg_scalar_lane(csg, ob, o, d, t, id, want_prim ? rays.prim + i + l : nullptr,
+                    if (!csg_scalar_lane(csg, ob, o, d, empty[l], t, id, want_prim ? rays.prim + i + l : nullptr,
                                          want_prim ? rays.bu + i + l : nullptr, want_prim ? rays.bv + i + l : nullptr))
                         continue;
                     if constexpr (kAny) t = 0.f;

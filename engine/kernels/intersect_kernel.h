@@ -60,10 +60,10 @@ inline void store_closest(RayView& rays, std::int32_t* object, std::size_t i, co
     }
 }
 
-/// Whether any lane of the packet meets the box within (0, best). Slab test with the
+/// The lanes of the packet that meet the box within (0, best). Slab test with the
 /// NaN-tolerant min/max of the cube (a zero direction component on a slab face gives 0 * inf).
 template <class B, class T>
-inline bool packet_meets_box(const RayPacket<B>& r, const Vec3T<B>& inv, const ObjectBounds& box, const B& best) {
+inline auto lanes_meeting_box(const RayPacket<B>& r, const Vec3T<B>& inv, const ObjectBounds& box, const B& best) {
     B t_near(T(0)), t_far = best;
     const B o[3] = {r.o.x, r.o.y, r.o.z}, iv[3] = {inv.x, inv.y, inv.z};
     for (int a = 0; a < 3; ++a) {
@@ -74,7 +74,13 @@ inline bool packet_meets_box(const RayPacket<B>& r, const Vec3T<B>& inv, const O
         t_near = xsimd::select(lo > t_near, lo, t_near);
         t_far = xsimd::select(hi < t_far, hi, t_far);
     }
-    return xsimd::any(t_near <= t_far);
+    return t_near <= t_far;
+}
+
+/// Whether any lane of the packet meets the box within (0, best).
+template <class B, class T>
+inline bool packet_meets_box(const RayPacket<B>& r, const Vec3T<B>& inv, const ObjectBounds& box, const B& best) {
+    return xsimd::any(lanes_meeting_box<B, T>(r, inv, box, best));
 }
 
 template <class Arch, class Shape>

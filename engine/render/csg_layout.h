@@ -25,10 +25,12 @@ struct CsgSlotLayout {
 
 /// A mesh slot's two ends (0: enter, 1: exit): the triangle crossed, and whether that
 /// triangle faces the other way from a convex shape's surface there (a mesh turned inside
-/// out: its normal must be turned round as well). Convex shapes' slots: 0, false.
+/// out: its normal must be turned round as well). Convex shapes' slots: 0, false
+/// (CsgSlotEnds{}). No default values: the walk's arrays of them are filled per line, not
+/// cleared.
 struct CsgSlotEnds {
-    std::array<std::uint32_t, 2> tri{};
-    std::array<bool, 2> turned{};
+    std::array<std::uint32_t, 2> tri;
+    std::array<bool, 2> turned;
 };
 
 /// Whether the surface at a boundary must show its normal turned round: a shape's own normal

@@ -66,8 +66,8 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
              .shape_bounded = shape_bounded_.data()};
 }
 
-bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[3], const float d[3], float& t_max,
-                     std::int32_t& object, std::int32_t* prim, float* bu, float* bv) {
+bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[3], const float d[3],
+                     std::uint64_t empty, float& t_max, std::int32_t& object, std::int32_t* prim, float* bu, float* bv) {
     const Vec3f ow{o[0], o[1], o[2]}, dw{d[0], d[1], d[2]};
     // Each shape's spans from the ray in its canonical space, as the shade stage will find the
     // hit point there again (the same float Mi).
@@ -77,7 +77,7 @@ bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[
     };
     const CsgSlotLayout& layout = ob.layout;
     CsgLine<float> line;
-    std::array<CsgSlotEnds, kMaxCsgShapes> ends{};
+    std::array<CsgSlotEnds, kMaxCsgShapes> ends;  // csg_scalar_line fills what the walk reads
     std::array<std::uint8_t, kMaxCsgShapes> live;
     const int live_count = csg_scalar_line(
         layout, canonical,
@@ -85,7 +85,7 @@ bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[
             const ObjectXf& xf = csg.records[shape].xf;
             return std::tuple{ShapeKind(xf.kind), xf.param, csg.meshes[shape]};
         },
-        line, ends.data(), live.data());
+        line, ends.data(), live.data(), empty);
     const CsgFirst<float> at = csg_first_boundary(csg.nodes, ob.root, layout, line, live.data(), live_count, 0.f, t_max);
     if (!(at.t < t_max)) return false;
     t_max = at.t;

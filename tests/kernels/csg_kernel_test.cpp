@@ -32,7 +32,7 @@ Expected scalar_closest(const CsgView& v, const Vec3f& o, const Vec3f& d, float 
     const float of[3] = {o.x, o.y, o.z}, df[3] = {d.x, d.y, d.z};
     for (std::size_t k = 0; k < v.count; ++k) {
         std::int32_t id = -1;
-        if (csg_scalar_lane(v, v.objects[k], of, df, e.t, id, nullptr, nullptr, nullptr)) e.id = id;
+        if (csg_scalar_lane(v, v.objects[k], of, df, 0, e.t, id, nullptr, nullptr, nullptr)) e.id = id;
     }
     return e;
 }
