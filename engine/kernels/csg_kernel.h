@@ -16,38 +16,150 @@
 
 namespace streamrt::STREAMRT_ISA_NAMESPACE {
 
-/// The spans of object `ob`'s shapes (each one slot: an object without meshes) over a
-/// packet's lanes into `line`, and the slots some lane's line meets, ascending, into `live`
-/// (their count returned). A packet that misses a shape's box over (0, t_max) takes the span
-/// as empty in every lane without its math (CsgView::shape_boxes).
+/// Per lane and slot of a packet, a mesh slot's ends (the walk's `CsgSlotEnds`).
+using CsgLaneEnds = CsgSlotEnds[kMaxCsgShapes][simd::kMaxLanes];
+
+/// A closed mesh's spans along each line of a packet (o, d: the packet in the mesh's
+/// canonical space; `lanes`: the lanes wanted) into the slots [first, first +
+/// kMeshCsgSpans) of `line` and `ends`: per lane what mesh_slot_spans gives, by one walk of the
+/// packet. Each lane's line starts where it enters the mesh's box, computed as mesh_crossings
+/// does; a triangle's test is the same arithmetic in every lane; the padded boxes never drop a
+/// leaf a line crosses in, and the crossings are kept in an order of their own (t, then
+/// triangle): so the same crossings, the same bits, as the scalar walk.
+template <class B, class M>
+inline void mesh_packet_slots(const Mesh& mesh, const Vec3T<B>& o, const Vec3T<B>& d, const M& lanes,
+                              CsgLine<B>& line, CsgLaneEnds& ends, int first) {
+    constexpr std::size_t W = B::size;
+    const B inf(std::numeric_limits<float>::infinity());
+    alignas(64) float enter[kMeshCsgSpans][simd::kMaxLanes], exit[kMeshCsgSpans][simd::kMaxLanes];
+    for (int j = 0; j < kMeshCsgSpans; ++j) {
+        inf.store_aligned(enter[j]);
+        (-inf).store_aligned(exit[j]);
+    }
+    const auto store = [&] {
+        for (int j = 0; j < kMeshCsgSpans; ++j) {
+            line.enter[std::size_t(first + j)] = B::load_aligned(enter[j]);
+            line.exit[std::size_t(first + j)] = B::load_aligned(exit[j]);
+        }
+    };
+    const MeshView m = mesh.view();
+    if (m.n_tris == 0 || mesh.bvh.empty()) return store();
+    // The line's stretch through the mesh's box, over every t (mesh_crossings' steps).
+    B t0 = -inf, t1 = inf;
+    M in_box(true);
+    const B os[3] = {o.x, o.y, o.z}, ds[3] = {d.x, d.y, d.z};
+    for (int a = 0; a < 3; ++a) {
+        const B lo(float(mesh.bvh.bounds.lo[a])), hi(float(mesh.bvh.bounds.hi[a]));
+        const M flat = ds[a] == B(0.f);
+        in_box = in_box && !(flat && ((os[a] < lo) || (os[a] > hi)));
+        const B ta = (lo - os[a]) / ds[a], tb = (hi - os[a]) / ds[a];
+        const B near = xsimd::select(tb < ta, tb, ta), far = xsimd::select(ta < tb, tb, ta);
+        t0 = xsimd::select(flat, t0, xsimd::select(t0 < near, near, t0));
+        t1 = xsimd::select(flat, t1, xsimd::select(far < t1, far, t1));
+    }
+    in_box = in_box && (t0 <= t1);
+    const M walking = lanes && in_box;
+    const std::uint32_t walk = lane_bits(walking);
+    if (walk == 0) return store();
+    // Lanes outside the walk get a harmless start (their results are not read).
+    const B t0w = xsimd::select(walking, t0, B(0.f)), t1w = xsimd::select(walking, t1, B(0.f));
+    const Vec3T<B> start = o + d * t0w;
+    const WatertightRay<B> wr = watertight_ray(start, d);
+    const Vec3T<B> inv{B(1.f) / d.x, B(1.f) / d.y, B(1.f) / d.z};
+    const B reach = (t1w - t0w) * B(1.0001f) + B(1e-6f);
+    MeshCrossing<float> cross[simd::kMaxLanes][kMeshCsgCrossings];
+    int count[simd::kMaxLanes] = {};
+    std::uint32_t stack[accel::kNodeWidth * 64], stack_count[accel::kNodeWidth * 64];
+    int sp = 0;
+    stack[sp] = 0;
+    stack_count[sp++] = 0;
+    alignas(64) float t_at[simd::kMaxLanes], enters_at[simd::kMaxLanes];
+    while (sp > 0) {
+        --sp;
+        const std::uint32_t c = stack[sp], cnt = stack_count[sp];
+        if (cnt == 0) {
+            const accel::WideNode& n = m.nodes[c];
+            for (int j = 0; j < accel::kNodeWidth; ++j) {
+                if (n.child[j] < 0) continue;
+                B tn;
+                if (!xsimd::any(mesh_detail::robust_box(n, j, start, inv, reach, tn) && walking)) continue;
+                stack[sp] = std::uint32_t(n.child[j]);
+                stack_count[sp++] = n.count[j];
+            }
+            continue;
+        }
+        for (std::uint32_t k = c; k < c + cnt; ++k) {
+            const Vec3T<B> p0 = mesh_detail::vertex<B>(m, k, 0), p1 = mesh_detail::vertex<B>(m, k, 1), p2 = mesh_detail::vertex<B>(m, k, 2);
+            const TriangleHit<B> h = triangle_hit(wr, p0, p1, p2, -inf, inf);
+            const M hit = walking && (h.t < inf);
+            if (!xsimd::any(hit)) continue;
+            (t0w + h.t).store_aligned(t_at);
+            xsimd::select(dot(d, triangle_normal(p0, p1, p2)) < B(0.f), B(1.f), B(0.f)).store_aligned(enters_at);
+            alignas(64) float hits[simd::kMaxLanes];
+            xsimd::select(hit, B(1.f), B(0.f)).store_aligned(hits);
+            for (std::size_t l = 0; l < W; ++l) {
+                if (hits[l] == 0.f) continue;
+                const MeshCrossing<float> x{t_at[l], k, enters_at[l] != 0.f};
+                MeshCrossing<float>* out = cross[l];
+                // Insertion into the sorted list; past capacity the farthest is let go.
+                int i = count[l] < kMeshCsgCrossings ? count[l]++ : kMeshCsgCrossings;
+                while (i > 0 && mesh_crossing_before(x, out[i - 1])) {
+                    if (i < kMeshCsgCrossings) out[i] = out[i - 1];
+                    --i;
+                }
+                if (i < kMeshCsgCrossings) out[i] = x;
+            }
+        }
+    }
+    for (std::size_t l = 0; l < W; ++l)
+        if (walk >> l & 1u)
+            mesh_winding_spans(cross[l], count[l], &enter[0][l], &exit[0][l], &ends[first][l], simd::kMaxLanes);
+    store();
+}
+
+/// The spans of object `ob`'s shapes over a packet's lanes into `line` (a mesh's into its
+/// slots, their ends into `ends`), and the slots some lane's line meets, ascending, into
+/// `live` (their count returned). A packet that misses a shape's box over (0, t_max) takes the
+/// span as empty in every lane without its math (CsgView::shape_boxes); a mesh is walked for
+/// the lanes that meet its box.
 template <class B>
 inline int csg_packet_spans(const CsgView& csg, const CsgObjectView& ob, const RayPacket<B>& r, const Vec3T<B>& inv,
-                            const B& t_max, CsgLine<B>& line, std::uint8_t* live) {
+                            const B& t_max, CsgLine<B>& line, CsgLaneEnds& ends, std::uint8_t* live) {
     int n = 0;
     for (int s = 0; s < ob.layout.shapes; ++s) {
         const std::uint32_t k = ob.layout.first_shape + std::uint32_t(s);
-        if (csg.shape_bounded[k] && !packet_meets_box<B, float>(r, inv, csg.shape_boxes[k], t_max)) {
-            line.enter[std::size_t(s)] = B(std::numeric_limits<float>::infinity());
-            line.exit[std::size_t(s)] = B(-std::numeric_limits<float>::infinity());
+        const int first = ob.layout.first_slot[std::size_t(s)], last = ob.layout.first_slot[std::size_t(s) + 1];
+        const auto meets = csg.shape_bounded[k] ? lanes_meeting_box<B, float>(r, inv, csg.shape_boxes[k], t_max)
+                                                : (t_max > B(0.f));
+        if (!xsimd::any(meets)) {
+            for (int j = first; j < last; ++j) {
+                line.enter[std::size_t(j)] = B(std::numeric_limits<float>::infinity());
+                line.exit[std::size_t(j)] = B(-std::numeric_limits<float>::infinity());
+            }
             continue;
         }
         const ObjectXf& xf = csg.records[k].xf;
         const RayPacket<B> c = to_canonical<B, float>(r, xf);
-        const SpanT<B> span = csg_shape_span<B>(ShapeKind(xf.kind), c.o, c.d, B(xf.param));
-        line.enter[std::size_t(s)] = span.enter;
-        line.exit[std::size_t(s)] = span.exit;
-        if (xsimd::any(span.enter < span.exit)) live[n++] = std::uint8_t(s);
+        if (const Mesh* mesh = csg.meshes[k]) {
+            mesh_packet_slots(*mesh, c.o, c.d, meets, line, ends, first);
+        } else {
+            const SpanT<B> span = csg_shape_span<B>(ShapeKind(xf.kind), c.o, c.d, B(xf.param));
+            line.enter[std::size_t(first)] = span.enter;
+            line.exit[std::size_t(first)] = span.exit;
+        }
+        for (int j = first; j < last; ++j)
+            if (xsimd::any(line.enter[std::size_t(j)] < line.exit[std::size_t(j)])) live[n++] = std::uint8_t(j);
     }
     return n;
 }
 
 /// A boundary of a two-shape result in lanes: t (+inf: none), whether it is the second
-/// shape's and whether its normal is turned round.
+/// shape's, whether it is that shape's exit, and whether the line enters the result there.
 template <class B>
 struct PairBoundary {
     using M = xsimd::batch_bool<float, typename B::arch_type>;
     B t;
-    M second, flip;
+    M second, exit, entering;
 };
 
 /// The first boundary with t > 0 of `op` over two shapes of spans [e0, x0], [e1, x1] (each
@@ -62,15 +174,17 @@ inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, con
     const B inf(std::numeric_limits<float>::infinity()), zero(0.f);
     const M no(false), yes(true);
     const M a = e0 < x0, b = e1 < x1;             // false on NaN: a miss
-    PairBoundary<B> o1{e0, no, no}, c1{x0, no, no}, o2{x1, yes, no}, c2{x0, no, no};
+    // Each boundary: t, whether it is the second shape's, whether that shape's exit, whether
+    // the line enters the result there.
+    PairBoundary<B> o1{e0, no, no, yes}, c1{x0, no, yes, no}, o2{x1, yes, yes, yes}, c2{x0, no, yes, no};
     M v1 = no, v2 = no;
     switch (op) {
         case CsgOp::Intersection: {
             // Opens at the later entry, closes at the first exit (the first's on a tie);
             // nothing when that is not after the opening.
             const M later = e0 < e1, first = x0 <= x1;
-            o1 = {xsimd::select(later, e1, e0), later, no};
-            c1 = {xsimd::select(first, x0, x1), !first, no};
+            o1 = {xsimd::select(later, e1, e0), later, no, yes};
+            c1 = {xsimd::select(first, x0, x1), !first, yes, no};
             v1 = a && b && (c1.t > o1.t);
             break;
         }
@@ -80,9 +194,9 @@ inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, con
             // first. Either way the part after the second's exit remains when that is before
             // the first's.
             const M inside = b && (e1 <= e0) && (e0 < x1), cut = b && !inside && (e0 < e1) && (e1 < x0);
-            c1 = {xsimd::select(cut, e1, x0), cut, cut};
+            c1 = {xsimd::select(cut, e1, x0), cut, !cut, no};
             v1 = a && !inside;
-            o2 = {x1, yes, yes};
+            o2 = {x1, yes, yes, yes};
             v2 = a && (inside || cut) && (x1 < x0);
             break;
         }
@@ -93,21 +207,22 @@ inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, con
             const M a_first = a && (!b || (e0 <= e1));
             const M overlap = a && b && ((a_first && (e1 <= x0)) || (!a_first && (e0 <= x1)));
             const M later = x1 > x0;
-            o1 = {xsimd::select(a_first, e0, e1), !a_first, no};
+            o1 = {xsimd::select(a_first, e0, e1), !a_first, no, yes};
             c1 = {xsimd::select(overlap, xsimd::select(later, x1, x0), xsimd::select(a_first, x0, x1)),
-                  (overlap && later) || (!overlap && !a_first), no};
+                  (overlap && later) || (!overlap && !a_first), yes, no};
             v1 = a || b;
-            o2 = {xsimd::select(a_first, e1, e0), a_first, no};
-            c2 = {xsimd::select(a_first, x1, x0), a_first, no};
+            o2 = {xsimd::select(a_first, e1, e0), a_first, no, yes};
+            c2 = {xsimd::select(a_first, x1, x0), a_first, yes, no};
             v2 = a && b && !overlap;
             break;
         }
     }
     // The earliest end past 0: taken from the last to the first, each earlier one replacing.
-    PairBoundary<B> r{inf, no, no};
+    PairBoundary<B> r{inf, no, no, no};
     const auto take = [&](const PairBoundary<B>& c, const M& valid) {
         const M m = valid && (c.t > zero);
-        r = {xsimd::select(m, c.t, r.t), (m && c.second) || (!m && r.second), (m && c.flip) || (!m && r.flip)};
+        r = {xsimd::select(m, c.t, r.t), mask_select(m, c.second, r.second), mask_select(m, c.exit, r.exit),
+             mask_select(m, c.entering, r.entering)};
     };
     take(c2, v2);
     take(o2, v2);
@@ -117,7 +232,8 @@ inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, con
 }
 
 /// Closest (kAny false: t_max and object[] of the rays whose first CSG surface in
-/// (0, t_max) is closer) or any hit (t_max = 0 for the rays a CSG result blocks).
+/// (0, t_max) is closer; on a mesh also prim, bu, bv) or any hit (t_max = 0 for the rays a
+/// CSG result blocks).
 template <class Arch, bool kAny>
 void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
     using B = xsimd::batch<float, Arch>;
@@ -125,6 +241,7 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
     constexpr std::size_t W = B::size;
     const simd::FlushDenormals ftz;
     CsgLine<B> line;
+    CsgLaneEnds ends;
     std::array<std::uint8_t, kMaxCsgShapes> live;
     for (std::size_t i = 0; i < rays.count; i += W) {  // padding makes the last packet safe
         B t_max = load_lanes<B>(rays.t_max + i);
@@ -136,57 +253,24 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
         for (std::size_t k = 0; k < csg.count; ++k) {
             const CsgObjectView& ob = csg.objects[k];
             if (ob.bounded && !packet_meets_box<B, float>(r, inv, ob.box, t_max)) continue;
-            if (ob.scalar) {  // an object with a mesh: each lane whole, in scalar code
-                // Per lane, the shapes whose box its segment (0, t_max) misses: their spans are
-                // taken as empty (a mesh's walk saved), which changes no boundary inside the
-                // segment; a lane that misses the object's box is skipped whole.
-                alignas(64) float meets[simd::kMaxLanes];
-                const auto in_box = ob.bounded ? lanes_meeting_box<B, float>(r, inv, ob.box, t_max) : (t_max > B(0.f));
-                xsimd::select(in_box, B(1.f), B(0.f)).store_aligned(meets);
-                std::uint64_t empty[simd::kMaxLanes] = {};
-                for (int s = 0; s < ob.layout.shapes; ++s) {
-                    const std::uint32_t shape = ob.layout.first_shape + std::uint32_t(s);
-                    if (!csg.shape_bounded[shape]) continue;
-                    alignas(64) float shape_meets[simd::kMaxLanes];
-                    xsimd::select(lanes_meeting_box<B, float>(r, inv, csg.shape_boxes[shape], t_max), B(1.f), B(0.f))
-                        .store_aligned(shape_meets);
-                    for (std::size_t l = 0; l < lanes; ++l)
-                        if (shape_meets[l] == 0.f) empty[l] |= std::uint64_t(1) << s;
-                }
-                for (std::size_t l = 0; l < lanes; ++l) {
-                    float& t = rays.t_max[i + l];
-                    if (!(t > 0.f) || meets[l] == 0.f) continue;
-                    const float o[3] = {rays.ox[i + l], rays.oy[i + l], rays.oz[i + l]};
-                    const float d[3] = {rays.dx[i + l], rays.dy[i + l], rays.dz[i + l]};
-                    std::int32_t id = 0;
-                    const bool want_prim = !kAny && rays.prim;
-                    if (!csg_scalar_lane(csg, ob, o, d, empty[l], t, id, want_prim ? rays.prim + i + l : nullptr,
-                                         want_prim ? rays.bu + i + l : nullptr, want_prim ? rays.bv + i + l : nullptr))
-                        continue;
-                    if constexpr (kAny) t = 0.f;
-                    else object[i + l] = id;
-                }
-                t_max = load_lanes<B>(rays.t_max + i);
-                if (kAny && !xsimd::any(t_max > B(0.f))) break;
-                continue;
-            }
-            const int live_count = csg_packet_spans(csg, ob, r, inv, t_max, line, live.data());
+            const int live_count = csg_packet_spans(csg, ob, r, inv, t_max, line, ends, live.data());
             if (live_count == 0) continue;
-            // The first boundary per lane: the shape (relative to the object's first) and
-            // whether its normal is turned round.
-            B t, shape;
-            M flip;
+            // The first boundary per lane: its slot and whether the line enters the result there.
+            B t, slot;
+            M at_exit, entering;
             if (ob.pair) {  // a root of two shapes, in closed form
                 const PairBoundary<B> at = csg_pair_boundary(ob.op, line.enter[0], line.exit[0], line.enter[1], line.exit[1]);
                 t = at.t;
-                shape = xsimd::select(at.second, B(1.f), B(0.f));
-                flip = at.flip;
+                slot = xsimd::select(at.second, B(1.f), B(0.f));
+                at_exit = at.exit;
+                entering = at.entering;
             } else {  // any tree: the walk along the line, in lanes
                 const CsgFirst<B> at =
                     csg_first_boundary(csg.nodes, ob.root, ob.layout, line, live.data(), live_count, B(0.f), t_max);
                 t = at.t;
-                shape = at.slot;  // one slot per shape
-                flip = !simd::mask_xor(at.at_exit, at.entering);
+                slot = at.slot;
+                at_exit = at.at_exit;
+                entering = at.entering;
             }
             const M hit = t < t_max;  // false for padding and blocked lanes (t_max <= 0 < t)
             if (!xsimd::any(hit)) continue;
@@ -194,13 +278,29 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
                 t_max = xsimd::select(hit, B(0.f), t_max);
             } else {
                 t_max = xsimd::select(hit, t, t_max);
-                alignas(64) float slot[simd::kMaxLanes], turned[simd::kMaxLanes];
-                xsimd::select(hit, shape, B(-1.f)).store_aligned(slot);
-                xsimd::select(flip, B(1.f), B(0.f)).store_aligned(turned);
-                const std::int32_t base = csg.first_id + std::int32_t(ob.layout.first_shape);
-                for (std::size_t l = 0; l < lanes; ++l)
-                    if (slot[l] >= 0.f)
-                        object[i + l] = base + std::int32_t(slot[l]) + (turned[l] != 0.f ? csg.shapes : 0);
+                alignas(64) float slots[simd::kMaxLanes], exits[simd::kMaxLanes], enters[simd::kMaxLanes];
+                xsimd::select(hit, slot, B(-1.f)).store_aligned(slots);
+                xsimd::select(at_exit, B(1.f), B(0.f)).store_aligned(exits);
+                xsimd::select(entering, B(1.f), B(0.f)).store_aligned(enters);
+                for (std::size_t l = 0; l < lanes; ++l) {
+                    if (slots[l] < 0.f) continue;
+                    const auto j = std::size_t(slots[l]);
+                    const std::uint32_t shape = ob.layout.first_shape + ob.layout.shape_of[j];
+                    const int end = exits[l] != 0.f ? 1 : 0;
+                    const Mesh* mesh = csg.meshes[shape];
+                    const bool turned = mesh && ends[j][l].turned[std::size_t(end)];
+                    object[i + l] = csg.first_id + std::int32_t(shape) +
+                                    (csg_flip(end == 1, enters[l] != 0.f, turned) ? csg.shapes : 0);
+                    if (mesh && rays.prim) {  // the triangle, and where on it (found again)
+                        const std::uint32_t tri = ends[j][l].tri[std::size_t(end)];
+                        const ObjectXf& xf = csg.records[shape].xf;
+                        const Vec3f ow{rays.ox[i + l], rays.oy[i + l], rays.oz[i + l]};
+                        const Vec3f dw{rays.dx[i + l], rays.dy[i + l], rays.dz[i + l]};
+                        rays.prim[i + l] = std::int32_t(tri);
+                        mesh_crossing_uv(mesh->view(), tri, apply_point(xf.m, ow), apply_vector(xf.m, dw),
+                                         rays.bu[i + l], rays.bv[i + l]);
+                    }
+                }
             }
             alignas(64) float out[simd::kMaxLanes];
             t_max.store_aligned(out);

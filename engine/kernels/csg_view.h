@@ -24,9 +24,8 @@ struct CsgObjectView {
     /// (csg_pair_boundary); other trees by the walk along the line (csg_first_boundary).
     bool pair;
     CsgOp op;  ///< the root's
-    /// An object with a mesh among its shapes: its lanes take csg_scalar_lane (a mesh's
-    /// spans come from a walk of its own hierarchy, lane by lane).
-    bool scalar;
+    /// An object with a mesh among its shapes (its slots' ends keep triangles).
+    bool has_mesh;
 };
 
 /// Every CSG object of a scene (stream/stream_csg.h).
@@ -44,15 +43,6 @@ struct CsgView {
     const ObjectBounds* shape_boxes;
     const std::uint8_t* shape_bounded;
 };
-
-/// One lane of an object taken whole in scalar code (CsgObjectView::scalar): its first surface
-/// along o + t d with 0 < t < t_max, or false. Bit s of `empty`: shape first_shape + s is
-/// taken as missed (its box lies off the segment: nothing it could change there). On a hit,
-/// t_max and the record id; on a mesh also its triangle and barycentric coordinates (when
-/// prim is not null). Compiled once (stream/stream_csg.cpp), so every ISA level gives the
-/// same bits.
-bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[3], const float d[3],
-                     std::uint64_t empty, float& t_max, std::int32_t& object, std::int32_t* prim, float* bu, float* bv);
 
 /// Closest hit (see ClosestHitFn), through CSG objects; any hit (see AnyHitFn) likewise.
 using CsgClosestFn = void (*)(const CsgView& csg, RayView rays, std::int32_t* object);

@@ -52,6 +52,12 @@ struct MeshCrossing {
     bool enters;
 };
 
+/// The order of crossings along a line: by t, then by triangle.
+template <class T>
+inline bool mesh_crossing_before(const MeshCrossing<T>& a, const MeshCrossing<T>& b) {
+    return a.t < b.t || (a.t == b.t && a.tri < b.tri);
+}
+
 /// The crossings of the whole line o + t d (every t) with the mesh, sorted by t: at most
 /// `capacity`, the nearest to where the line enters the mesh's box. The hierarchy is walked
 /// from that entry point (its walk covers t >= 0 only), every triangle of a visited leaf tested
@@ -86,9 +92,10 @@ inline int mesh_crossings(const MeshView& m, const accel::Bvh& bvh, const Vec3T<
             const TriangleHit<T> h = triangle_hit(r, p0, p1, p2, -inf, inf);
             if (!(h.t < inf)) continue;
             const MeshCrossing<T> c{t0 + h.t, k, dot(d, triangle_normal(p0, p1, p2)) < T(0)};
-            // Insertion into the sorted list; past capacity the farthest is let go.
+            // Insertion into the list sorted by t, then triangle (an order that does not
+            // depend on the walk's); past capacity the farthest is let go.
             int i = n < capacity ? n++ : capacity;
-            while (i > 0 && c.t < out[i - 1].t) {
+            while (i > 0 && mesh_crossing_before(c, out[i - 1])) {
                 if (i < capacity) out[i] = out[i - 1];
                 --i;
             }

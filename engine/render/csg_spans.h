@@ -33,36 +33,45 @@ struct CsgLine {
     std::array<V, kMaxCsgShapes> enter, exit;
 };
 
+/// A closed mesh's spans along a line from its crossings sorted along it (mesh_crossings):
+/// where the count, +1 going in and -1 going out, is other than 0; the first kMeshCsgSpans
+/// into enter[s * stride], exit[s * stride] and ends[s * stride] for s = 0, 1, ..., the other
+/// spans empty. A count left open at the last crossing (a line that rounding let through an
+/// edge) closes nothing.
+template <class V>
+void mesh_winding_spans(const MeshCrossing<V>* c, int n, V* enter, V* exit, CsgSlotEnds* ends, std::size_t stride) {
+    for (std::size_t j = 0; j < std::size_t(kMeshCsgSpans); ++j) {
+        enter[j * stride] = std::numeric_limits<V>::infinity();
+        exit[j * stride] = -std::numeric_limits<V>::infinity();
+    }
+    int winding = 0;
+    std::size_t span = 0;
+    for (int i = 0; i < n && span < std::size_t(kMeshCsgSpans); ++i) {
+        const int before = winding;
+        winding += c[i].enters ? 1 : -1;
+        const std::size_t j = span * stride;
+        if (before == 0 && winding != 0) {
+            enter[j] = c[i].t;  // a span left open keeps exit -inf: empty
+            ends[j].tri[0] = c[i].tri;
+            ends[j].turned[0] = !c[i].enters;  // going in, the surface faces along the line
+        } else if (before != 0 && winding == 0) {
+            exit[j] = c[i].t;
+            ends[j].tri[1] = c[i].tri;
+            ends[j].turned[1] = c[i].enters;
+            ++span;
+        }
+    }
+}
+
 /// A closed mesh's spans along the line o + t d (its canonical space) into its slots
-/// [first, first + kMeshCsgSpans): where the crossings, counted +1 going in and -1 going out,
-/// add up to other than 0; the first kMeshCsgSpans along the line, the other slots empty. A
-/// count left open at the last crossing (a line that rounding let through an edge) closes
-/// nothing.
+/// [first, first + kMeshCsgSpans) (mesh_winding_spans).
 template <class V>
 void mesh_slot_spans(CsgLine<V>& line, CsgSlotEnds* ends, int first, const Mesh& mesh, const Vec3T<V>& o,
                      const Vec3T<V>& d) {
     MeshCrossing<V> c[kMeshCsgCrossings];
     const int n = mesh_crossings(mesh.view(), mesh.bvh, o, d, c, kMeshCsgCrossings);
-    for (int j = first; j < first + kMeshCsgSpans; ++j) {
-        line.enter[std::size_t(j)] = std::numeric_limits<V>::infinity();
-        line.exit[std::size_t(j)] = -std::numeric_limits<V>::infinity();
-    }
-    int winding = 0, slot = first;
-    for (int i = 0; i < n && slot < first + kMeshCsgSpans; ++i) {
-        const int before = winding;
-        winding += c[i].enters ? 1 : -1;
-        const auto j = std::size_t(slot);
-        if (before == 0 && winding != 0) {
-            line.enter[j] = c[i].t;  // a span left open keeps exit -inf: empty
-            ends[j].tri[0] = c[i].tri;
-            ends[j].turned[0] = !c[i].enters;  // going in, the surface faces along the line
-        } else if (before != 0 && winding == 0) {
-            line.exit[j] = c[i].t;
-            ends[j].tri[1] = c[i].tri;
-            ends[j].turned[1] = c[i].enters;
-            ++slot;
-        }
-    }
+    const auto j = std::size_t(first);
+    mesh_winding_spans(c, n, &line.enter[j], &line.exit[j], ends + j, 1);
 }
 
 /// Where a line first crosses a CSG result's surface (csg_first_boundary), per lane.

@@ -35,8 +35,8 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
         // (children 0 and 1 are its shapes lo and lo + 1, in the kernels' lane arrays)
         v.pair = root.children.size() == 2 && !root.children[0].is_node && !root.children[1].is_node &&
                  root.children[0].index == lo && root.children[1].index == lo + 1;
-        for (std::uint32_t s = lo; s < hi; ++s) v.scalar = v.scalar || scene.csg_shapes[s].kind == ShapeKind::Mesh;
-        v.pair = v.pair && !v.scalar;
+        for (std::uint32_t s = lo; s < hi; ++s) v.has_mesh = v.has_mesh || scene.csg_shapes[s].kind == ShapeKind::Mesh;
+        v.pair = v.pair && !v.has_mesh;
         objects_.push_back(v);
     }
     records_.resize(2 * std::size_t(shapes));
@@ -64,42 +64,6 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
              .meshes = meshes_.data(),
              .shape_boxes = shape_boxes_.data(),
              .shape_bounded = shape_bounded_.data()};
-}
-
-bool csg_scalar_lane(const CsgView& csg, const CsgObjectView& ob, const float o[3], const float d[3],
-                     std::uint64_t empty, float& t_max, std::int32_t& object, std::int32_t* prim, float* bu, float* bv) {
-    const Vec3f ow{o[0], o[1], o[2]}, dw{d[0], d[1], d[2]};
-    // Each shape's spans from the ray in its canonical space, as the shade stage will find the
-    // hit point there again (the same float Mi).
-    const auto canonical = [&](std::uint32_t shape) {
-        const ObjectXf& xf = csg.records[shape].xf;
-        return std::pair{apply_point(xf.m, ow), apply_vector(xf.m, dw)};
-    };
-    const CsgSlotLayout& layout = ob.layout;
-    CsgLine<float> line;
-    std::array<CsgSlotEnds, kMaxCsgShapes> ends;  // csg_scalar_line fills what the walk reads
-    std::array<std::uint8_t, kMaxCsgShapes> live;
-    const int live_count = csg_scalar_line(
-        layout, canonical,
-        [&](std::uint32_t shape) {
-            const ObjectXf& xf = csg.records[shape].xf;
-            return std::tuple{ShapeKind(xf.kind), xf.param, csg.meshes[shape]};
-        },
-        line, ends.data(), live.data(), empty);
-    const CsgFirst<float> at = csg_first_boundary(csg.nodes, ob.root, layout, line, live.data(), live_count, 0.f, t_max);
-    if (!(at.t < t_max)) return false;
-    t_max = at.t;
-    const auto slot = std::size_t(at.slot);
-    const std::uint32_t shape = layout.first_shape + layout.shape_of[slot];
-    const int end = at.at_exit ? 1 : 0;
-    object = csg.first_id + std::int32_t(shape) +
-             (csg_flip(at.at_exit, at.entering, ends[slot].turned[std::size_t(end)]) ? csg.shapes : 0);
-    if (const Mesh* m = csg.meshes[shape]; m && prim) {
-        const auto [oc, dc] = canonical(shape);
-        *prim = std::int32_t(ends[slot].tri[std::size_t(end)]);
-        mesh_crossing_uv(m->view(), ends[slot].tri[std::size_t(end)], oc, dc, *bu, *bv);
-    }
-    return true;
 }
 
 }  // namespace streamrt

@@ -1,11 +1,14 @@
 // The SIMD CSG kernels (kernels/csg_kernel.h) against the scalar walk, lane by lane: every
-// ray's t and record id (closest) and blocked flag (any) at every ISA level this machine runs,
-// on random rays through CSG objects of every solid, nested, cut by a plane.
+// ray's t and record id (closest; on a mesh its triangle) and blocked flag (any) at every ISA
+// level this machine runs, on random rays through CSG objects of every solid, nested, cut by a
+// plane, with a closed mesh.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <random>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "every_isa.h"
@@ -22,17 +25,39 @@ namespace {
 struct Expected {
     float t;
     std::int32_t id;
+    std::int32_t tri = -1;  ///< on a mesh: its triangle
 };
 
-/// The first CSG surface in (0, t_max) along o + t d, lane by lane in scalar code
-/// (csg_scalar_lane: the walk with V = float) and without any box: what every lane of the
-/// kernels must give.
+/// The first CSG surface in (0, t_max) along o + t d, in scalar code (render/csg_spans.h's
+/// walk with V = float, a mesh's spans by mesh_slot_spans) and without any box: what every
+/// lane of the kernels must give, to the bit. The line is brought into each shape's space as
+/// the kernels and the shade stage do (the same float Mi).
 Expected scalar_closest(const CsgView& v, const Vec3f& o, const Vec3f& d, float t_max) {
     Expected e{t_max, -1};
-    const float of[3] = {o.x, o.y, o.z}, df[3] = {d.x, d.y, d.z};
     for (std::size_t k = 0; k < v.count; ++k) {
-        std::int32_t id = -1;
-        if (csg_scalar_lane(v, v.objects[k], of, df, 0, e.t, id, nullptr, nullptr, nullptr)) e.id = id;
+        const CsgObjectView& ob = v.objects[k];
+        const auto canonical = [&](std::uint32_t shape) {
+            const ObjectXf& xf = v.records[shape].xf;
+            return std::pair{apply_point(xf.m, o), apply_vector(xf.m, d)};
+        };
+        CsgLine<float> line;
+        std::array<CsgSlotEnds, kMaxCsgShapes> ends;
+        std::array<std::uint8_t, kMaxCsgShapes> live;
+        const int n = csg_scalar_line(
+            ob.layout, canonical,
+            [&](std::uint32_t shape) {
+                const ObjectXf& xf = v.records[shape].xf;
+                return std::tuple{ShapeKind(xf.kind), xf.param, v.meshes[shape]};
+            },
+            line, ends.data(), live.data());
+        const CsgFirst<float> at = csg_first_boundary(v.nodes, ob.root, ob.layout, line, live.data(), n, 0.f, e.t);
+        if (!(at.t < e.t)) continue;
+        e.t = at.t;
+        const auto slot = std::size_t(at.slot);
+        const std::uint32_t shape = ob.layout.first_shape + ob.layout.shape_of[slot];
+        const bool turned = v.meshes[shape] && ends[slot].turned[at.at_exit ? 1 : 0];
+        e.id = v.first_id + std::int32_t(shape) + (csg_flip(at.at_exit, at.entering, turned) ? v.shapes : 0);
+        e.tri = v.meshes[shape] ? std::int32_t(ends[slot].tri[at.at_exit ? 1 : 0]) : -1;
     }
     return e;
 }
@@ -63,6 +88,12 @@ const char* const kScenes[] = {
     "csg difference translate=-1,-1,1\n sphere\n sphere\nend\n",
     "csg difference\n cube\n cube translate=0,0,1\nend\ncsg intersection translate=0,0,-2\n cube\n cube translate=1,0,0\nend\n"
     "csg union translate=0,2,0\n cube\n cube translate=2,0,0\nend\n",
+    // A closed mesh (1,280 triangles) minus a sphere, and in a tree of three: walked by packets.
+    "csg difference\n mesh file=" STREAMRT_SOURCE_DIR "/scenes/csg/lumpy.obj\n"
+    " sphere scale=0.75 translate=0.55,0.75,0.55\nend\n"
+    "csg union translate=0.5,-0.5,-2.5\n sphere scale=0.5 translate=-1,0,0\n"
+    " csg intersection\n  mesh file=" STREAMRT_SOURCE_DIR "/scenes/csg/lumpy.obj scale=0.9\n  cube scale=0.7\n end\n"
+    " cylinder scale=0.3,1.5,0.3\nend\n",
 };
 
 }  // namespace
@@ -103,13 +134,17 @@ TEST_CASE("csg kernels: every lane's closest and any hit equal the scalar walk, 
             at_every_isa([&](Isa isa) {
                 const KernelTable& kt = kernel_table(isa);
                 RayStream closest = rays;
-                AlignedVec<std::int32_t> id(closest.capacity(), -1);
-                kt.csg_closest(v, view_of(closest), id.data());
+                AlignedVec<std::int32_t> id(closest.capacity(), -1), prim(closest.capacity(), -1);
+                AlignedVec<float> bu(closest.capacity()), bv(closest.capacity());
+                RayView cv = view_of(closest);
+                cv.prim = prim.data(), cv.bu = bu.data(), cv.bv = bv.data();
+                kt.csg_closest(v, cv, id.data());
                 RayStream any = rays;
                 kt.csg_any(v, view_of(any));
                 for (std::size_t i = 0; i < n; ++i) {
                     CAPTURE(i);
                     CHECK(id[i] == want[i].id);
+                    if (want[i].tri >= 0) CHECK(prim[i] == want[i].tri);
                     CHECK(closest.t_max[i] == want[i].t);  // the same bits: the same float arithmetic
                     CHECK((any.t_max[i] == 0.f) == (want[i].id >= 0));
                 }
