@@ -968,11 +968,13 @@ def main(argv=None):
                     "(lowest, range, runs, days per scene and ratio) and stop")
     ap.add_argument("--metrics", help="with --table: only these ratios, comma-separated names as in the "
                     "table's third column (e.g. 'ratio default,primary ratio')")
+    ap.add_argument("--since", metavar="UTC", help="with --table: only the runs logged at or after this UTC time "
+                    "(YYYY-MM-DD or YYYY-MM-DDTHH:MM; the runs of today's engine, not of one a change replaced)")
     ap.add_argument("--dry-run", action="store_true", help="check tools, write the .pov files, render nothing")
     ap.add_argument("--out", help="output folder (default BUILD/peer)")
     ap.add_argument("--flat", action="store_true", help="only the degree-0 check: each scene's flat colours by "
                     "both engines against POV-Ray's, the count of differing pixels on and off the edges "
-                    "(docs/csg.md: --flat --scenes %s --size 320x240)" % ",".join(CSG_SCENES))
+                    "(docs/testing.md; ctest csg_against_povray: --flat --scenes %s --size 160x120)" % ",".join(CSG_SCENES))
     ap.add_argument("--engines", default="stream,recursive", help="with --flat: streamrt's engines checked")
     ap.add_argument("--picture", metavar="PNG", help="only write the first scene (nopruning) at --size by streamrt "
                     "(left) and POV-Ray (right) side by side into PNG, and stop (docs/img/peer_bunny.png: "
@@ -983,6 +985,8 @@ def main(argv=None):
             print("no log at %s: run the benchmark first" % args.log)
             return 1
         entries = read_log(args.log)
+        if args.since:
+            entries = [e for e in entries if e.get("date", "") >= args.since]
         print(table(entries, [m for m in args.metrics.split(",") if m] if args.metrics else None))
         print("\n%d entries from %s; bold: the lowest over the runs (the headline), in brackets the range" % (
             len(entries), os.path.relpath(os.path.abspath(args.log), pc.ROOT)))

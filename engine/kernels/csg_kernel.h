@@ -278,6 +278,19 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
                 t_max = xsimd::select(hit, B(0.f), t_max);
             } else {
                 t_max = xsimd::select(hit, t, t_max);
+                if (!ob.has_mesh) {  // one slot per shape, and no turned ends
+                    alignas(64) float slots[simd::kMaxLanes], flips[simd::kMaxLanes];
+                    xsimd::select(hit, slot, B(-1.f)).store_aligned(slots);
+                    xsimd::select(simd::mask_xor(at_exit, entering), B(0.f), B(1.f)).store_aligned(flips);
+                    const std::int32_t base = csg.first_id + std::int32_t(ob.layout.first_shape);
+                    for (std::size_t l = 0; l < lanes; ++l)
+                        if (slots[l] >= 0.f)
+                            object[i + l] = base + std::int32_t(slots[l]) + (flips[l] != 0.f ? csg.shapes : 0);
+                    alignas(64) float out[simd::kMaxLanes];
+                    t_max.store_aligned(out);
+                    for (std::size_t l = 0; l < lanes; ++l) rays.t_max[i + l] = out[l];
+                    continue;
+                }
                 alignas(64) float slots[simd::kMaxLanes], exits[simd::kMaxLanes], enters[simd::kMaxLanes];
                 xsimd::select(hit, slot, B(-1.f)).store_aligned(slots);
                 xsimd::select(at_exit, B(1.f), B(0.f)).store_aligned(exits);

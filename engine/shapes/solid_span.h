@@ -42,11 +42,21 @@ concept ConvexSolid = requires { requires Math::kConvexSolid; };
 template <class Math>
 concept Solid = ConvexSolid<Math> || requires(Vec3T<double> p, double v) { Math::inside_span(p, p, v); };
 
-/// The solid's span along the line o + t d, t in the units of d.
+/// A shape whose two ends come from one computation (the sphere's one solve), with
+/// convex_span's bits.
+template <class Math, class V>
+concept OwnSpan = requires(Vec3T<V> p, V v) { Math::template span<V>(p, p, v); };
+
+/// The solid's span along the line o + t d, t in the units of d. A packet no lane of which
+/// may meet a shape with a cheap pre-test (may_hit) spans nothing without the solve.
 template <class Math, class V>
     requires Solid<Math>
 SpanT<V> solid_span(const Vec3T<V>& o, const Vec3T<V>& d, V param) {
-    if constexpr (ConvexSolid<Math>) return convex_span<Math>(o, d, param);
+    if constexpr (simd::is_batch<V> && requires { Math::may_hit(o, d); }) {
+        if (!simd::any(Math::may_hit(o, d))) return {infinity_v<V>(), -infinity_v<V>()};
+    }
+    if constexpr (OwnSpan<Math, V>) return Math::template span<V>(o, d, param);
+    else if constexpr (ConvexSolid<Math>) return convex_span<Math>(o, d, param);
     else return Math::inside_span(o, d, param);
 }
 

@@ -36,6 +36,23 @@ struct SphereMath {
     }
     /// A convex closed solid: its inside along a line lies between hit_t's two ends (solid_span.h).
     static constexpr bool kConvexSolid = true;
+    /// Those two ends from one solve: run backwards (d -> -d) the line gives b, t_mid and q
+    /// negated exactly and the same discriminant, so its roots are these roots negated; taking
+    /// them as hit_t takes them gives convex_span's bits at half its cost (a CSG test checks).
+    template <class V>
+    static SpanT<V> span(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/) {
+        const V a = dot(d, d);
+        const V b = dot(o, d);
+        const V c = dot(o, o) - V(1);
+        const V t_mid = -b / a;
+        const Vec3T<V> perp = o + d * t_mid;
+        const V disc = a * (V(1) - dot(perp, perp));
+        const auto r = solve_quadratic(a, b, c, disc);
+        const V inf = infinity_v<V>();
+        const V ahead = keep_closest(keep_closest(inf, r.t0, r.valid, -inf), r.t1, r.valid, -inf);
+        const V behind = keep_closest(keep_closest(inf, -r.t0, r.valid, -inf), -r.t1, r.valid, -inf);
+        return {miss_if_unchanged(ahead, inf), -miss_if_unchanged(behind, inf)};
+    }
     /// False only where the ray's line surely misses the unit sphere; a packet kernel skips
     /// hit_t (a division, a square root and two more divisions) when no lane may hit, and where
     /// any lane may, hit_t decides every lane as before, so the answers keep their bits.
