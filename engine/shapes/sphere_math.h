@@ -17,9 +17,9 @@ struct SphereMath {
     static constexpr CanonicalBounds bounds(double /*param*/) {
         return {CanonicalBounds::Form::UnitBall, {-1, -1, -1}, {1, 1, 1}};
     }
-    /// Nearest t in (t_min, t_max) with |o + t d| = 1, or +inf. d need not be unit length.
+    /// The two t with |o + t d| = 1 (unordered; `valid` false where the line misses).
     template <class V>
-    static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
+    static QuadraticRoots<V> roots(const Vec3T<V>& o, const Vec3T<V>& d) {
         const V a = dot(d, d);
         const V b = dot(o, d);
         const V c = dot(o, o) - V(1);
@@ -28,7 +28,12 @@ struct SphereMath {
         const V t_mid = -b / a;
         const Vec3T<V> perp = o + d * t_mid;
         const V disc = a * (V(1) - dot(perp, perp));
-        const auto r = solve_quadratic(a, b, c, disc);
+        return solve_quadratic(a, b, c, disc);
+    }
+    /// Nearest t in (t_min, t_max) with |o + t d| = 1, or +inf. d need not be unit length.
+    template <class V>
+    static V hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/, V t_min, V t_max) {
+        const auto r = roots(o, d);
         V best = t_max;
         best = keep_closest(best, r.t0, r.valid, t_min);
         best = keep_closest(best, r.t1, r.valid, t_min);
@@ -41,13 +46,7 @@ struct SphereMath {
     /// them as hit_t takes them gives convex_span's bits at half its cost (a CSG test checks).
     template <class V>
     static SpanT<V> span(const Vec3T<V>& o, const Vec3T<V>& d, V /*param*/) {
-        const V a = dot(d, d);
-        const V b = dot(o, d);
-        const V c = dot(o, o) - V(1);
-        const V t_mid = -b / a;
-        const Vec3T<V> perp = o + d * t_mid;
-        const V disc = a * (V(1) - dot(perp, perp));
-        const auto r = solve_quadratic(a, b, c, disc);
+        const auto r = roots(o, d);
         const V inf = infinity_v<V>();
         const V ahead = keep_closest(keep_closest(inf, r.t0, r.valid, -inf), r.t1, r.valid, -inf);
         const V behind = keep_closest(keep_closest(inf, -r.t0, r.valid, -inf), -r.t1, r.valid, -inf);
