@@ -952,7 +952,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default=os.path.join(pc.ROOT, "build"), help="build folder (default build/)")
     ap.add_argument("--runs", type=int, default=3, help="timed runs per program and case (median; default 3)")
-    ap.add_argument("--scenes", default="bunny,bunny235k,million,whitted")
+    ap.add_argument("--scenes", help="scenes to run (default bunny,bunny235k,million,whitted); with --table: "
+                    "only these rows (the Embree table's are its meshes)")
     ap.add_argument("--modes", default="default,nopruning,matched")
     ap.add_argument("--size", default="1280x720", help="WxH of every picture (default 1280x720)")
     ap.add_argument("--povray", default=shutil.which("povray") or "/usr/bin/povray", help="the POV-Ray program")
@@ -987,6 +988,9 @@ def main(argv=None):
         entries = read_log(args.log)
         if args.since:
             entries = [e for e in entries if e.get("date", "") >= args.since]
+        if args.scenes:
+            wanted = set(args.scenes.split(","))
+            entries = [e for e in entries if e.get("scene") in wanted]
         print(table(entries, [m for m in args.metrics.split(",") if m] if args.metrics else None))
         print("\n%d entries from %s; bold: the lowest over the runs (the headline), in brackets the range" % (
             len(entries), os.path.relpath(os.path.abspath(args.log), pc.ROOT)))
@@ -995,7 +999,7 @@ def main(argv=None):
         if m and m not in EMBREE_MESHES:
             ap.error("unknown Embree mesh %r (one of %s)" % (m, ", ".join(EMBREE_MESHES)))
     width, height = (int(x) for x in args.size.split("x"))
-    names = [s for s in args.scenes.split(",") if s]
+    names = [s for s in (args.scenes or "bunny,bunny235k,million,whitted").split(",") if s]
     modes = [m for m in args.modes.split(",") if m]
     for s in names:
         if s not in SCENES:
