@@ -48,3 +48,15 @@ def test_metric_filter():
 
 def test_entry_count_line():
     assert any(ln.startswith("5 entries from ") for ln in table())
+
+
+# Proven against: --since compared with ">" (the run at exactly 2026-12-01T11:00Z dropped:
+# 2 read 1) and --scenes ignored by --table (the sphere1m row kept).
+def test_since_and_scenes():
+    # From 11:00 on the first day: bunny's 18.5 and 22.25 (17.0 alone for nopruning).
+    assert rows(table("--since", "2026-12-01T11:00Z", "--scenes", "bunny")) == [
+        "| bunny | 2 | 2 (2026-12-01, 2026-12-02) | 0.5 - 2.5 | avx2, avx512 | **18.50x** (18.50 - 22.25) "
+        "| **17.00x** (17.00 - 17.00, n=1) |"]
+    # A day alone, as a date: the last sphere1m run.
+    assert rows(table("--since", "2026-12-03")) == [
+        "| sphere1m | 1 | 1 (2026-12-03) | 1.8 - 1.8 | avx512 | **1.50x** (1.50 - 1.50) | **1.60x** (1.60 - 1.60) |"]
