@@ -1,12 +1,5 @@
 #include "stream/stream_csg.h"
 
-#include <algorithm>
-#include <array>
-#include <limits>
-#include <stdexcept>
-
-#include "core/transform.h"
-#include "mesh/mesh_trace.h"
 #include "render/csg_spans.h"
 #include "stream/stream_accel.h"
 
