@@ -203,20 +203,13 @@ SpanT<V> csg_shape_span(ShapeKind kind, const Vec3T<V>& o, const Vec3T<V>& d, V 
 /// `canonical(shape)` gives the line (o, d) in the shape's canonical space, `solid(shape)` its
 /// kind, parameter and mesh (null for other kinds). Fills `line` and `ends` (a mesh's; a
 /// convex shape's plain), and `live` with the slots the line meets, ascending; returns their
-/// count. Bit s of `empty`: shape first_shape + s is taken as missed, without its math.
+/// count.
 template <class V, class Canonical, class Solid>
 int csg_scalar_line(const CsgSlotLayout& layout, const Canonical& canonical, const Solid& solid, CsgLine<V>& line,
-                    CsgSlotEnds* ends, std::uint8_t* live, std::uint64_t empty = 0) {
+                    CsgSlotEnds* ends, std::uint8_t* live) {
     int n = 0;
     for (int s = 0; s < layout.shapes; ++s) {
         const std::uint32_t shape = layout.first_shape + std::uint32_t(s);
-        if (empty >> s & 1) {
-            for (int j = layout.first_slot[std::size_t(s)]; j < layout.first_slot[std::size_t(s) + 1]; ++j) {
-                line.enter[std::size_t(j)] = std::numeric_limits<V>::infinity();
-                line.exit[std::size_t(j)] = -std::numeric_limits<V>::infinity();
-            }
-            continue;
-        }
         const auto [o, d] = canonical(shape);
         const auto [kind, param, mesh] = solid(shape);
         const int j = layout.first_slot[std::size_t(s)];
