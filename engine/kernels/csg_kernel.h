@@ -89,7 +89,8 @@ inline void mesh_packet_slots(const Mesh& mesh, const Vec3T<B>& o, const Vec3T<B
             continue;
         }
         for (std::uint32_t k = c; k < c + cnt; ++k) {
-            const Vec3T<B> p0 = mesh_detail::vertex<B>(m, k, 0), p1 = mesh_detail::vertex<B>(m, k, 1), p2 = mesh_detail::vertex<B>(m, k, 2);
+            using mesh_detail::vertex;
+            const Vec3T<B> p0 = vertex<B>(m, k, 0), p1 = vertex<B>(m, k, 1), p2 = vertex<B>(m, k, 2);
             const TriangleHit<B> h = triangle_hit(wr, p0, p1, p2, -inf, inf);
             const M hit = walking && (h.t < inf);
             if (!xsimd::any(hit)) continue;
@@ -100,14 +101,7 @@ inline void mesh_packet_slots(const Mesh& mesh, const Vec3T<B>& o, const Vec3T<B
             for (std::size_t l = 0; l < W; ++l) {
                 if (hits[l] == 0.f) continue;
                 const MeshCrossing<float> x{t_at[l], k, enters_at[l] != 0.f};
-                MeshCrossing<float>* out = cross[l];
-                // Insertion into the sorted list; past capacity the farthest is let go.
-                int i = count[l] < kMeshCsgCrossings ? count[l]++ : kMeshCsgCrossings;
-                while (i > 0 && mesh_crossing_before(x, out[i - 1])) {
-                    if (i < kMeshCsgCrossings) out[i] = out[i - 1];
-                    --i;
-                }
-                if (i < kMeshCsgCrossings) out[i] = x;
+                keep_crossing(cross[l], count[l], kMeshCsgCrossings, x);
             }
         }
     }
@@ -259,7 +253,8 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
             B t, slot;
             M at_exit, entering;
             if (ob.pair) {  // a root of two shapes, in closed form
-                const PairBoundary<B> at = csg_pair_boundary(ob.op, line.enter[0], line.exit[0], line.enter[1], line.exit[1]);
+                const PairBoundary<B> at =
+                    csg_pair_boundary(ob.op, line.enter[0], line.exit[0], line.enter[1], line.exit[1]);
                 t = at.t;
                 slot = xsimd::select(at.second, B(1.f), B(0.f));
                 at_exit = at.exit;
@@ -278,7 +273,7 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
                 t_max = xsimd::select(hit, B(0.f), t_max);
             } else {
                 t_max = xsimd::select(hit, t, t_max);
-                if (!ob.has_mesh) {  // one slot per shape, and no turned ends
+                if (!ob.has_mesh) {  // one slot per shape, and no turned ends: csg_flip in lanes
                     alignas(64) float slots[simd::kMaxLanes], flips[simd::kMaxLanes];
                     xsimd::select(hit, slot, B(-1.f)).store_aligned(slots);
                     xsimd::select(simd::mask_xor(at_exit, entering), B(0.f), B(1.f)).store_aligned(flips);

@@ -58,6 +58,18 @@ inline bool mesh_crossing_before(const MeshCrossing<T>& a, const MeshCrossing<T>
     return a.t < b.t || (a.t == b.t && a.tri < b.tri);
 }
 
+/// Inserts c into out[0 .. n), kept sorted by mesh_crossing_before (an order that does not
+/// depend on the walk's, so every walk keeps the same list); past capacity the farthest is let go.
+template <class T>
+inline void keep_crossing(MeshCrossing<T>* out, int& n, int capacity, const MeshCrossing<T>& c) {
+    int i = n < capacity ? n++ : capacity;
+    while (i > 0 && mesh_crossing_before(c, out[i - 1])) {
+        if (i < capacity) out[i] = out[i - 1];
+        --i;
+    }
+    if (i < capacity) out[i] = c;
+}
+
 /// The crossings of the whole line o + t d (every t) with the mesh, sorted by t: at most
 /// `capacity`, the nearest to where the line enters the mesh's box. The hierarchy is walked
 /// from that entry point (its walk covers t >= 0 only), every triangle of a visited leaf tested
@@ -92,14 +104,7 @@ inline int mesh_crossings(const MeshView& m, const accel::Bvh& bvh, const Vec3T<
             const TriangleHit<T> h = triangle_hit(r, p0, p1, p2, -inf, inf);
             if (!(h.t < inf)) continue;
             const MeshCrossing<T> c{t0 + h.t, k, dot(d, triangle_normal(p0, p1, p2)) < T(0)};
-            // Insertion into the list sorted by t, then triangle (an order that does not
-            // depend on the walk's); past capacity the farthest is let go.
-            int i = n < capacity ? n++ : capacity;
-            while (i > 0 && mesh_crossing_before(c, out[i - 1])) {
-                if (i < capacity) out[i] = out[i - 1];
-                --i;
-            }
-            if (i < capacity) out[i] = c;
+            keep_crossing(out, n, capacity, c);
         }
         return false;  // every leaf the line passes
     });
