@@ -58,6 +58,7 @@ RecursiveRenderer::RecursiveRenderer(const Scene& scene, const RenderSettings& s
     for (const CsgObject& o : scene.csg_objects) {
         csg_boxes_.push_back(csg_node_box(scene, o.root));
         csg_layouts_.push_back(csg_slot_layout(scene, o));
+        csg_inner_.push_back(csg_shows_inner_surfaces(scene.csg_nodes.data(), o.root) ? 1 : 0);
     }
     for (const Material& m : scene.materials) {
         materials_.push_back(MaterialT<double>::from(m));
@@ -112,7 +113,7 @@ int RecursiveRenderer::test_csg(std::size_t k, const RayD& ray, double t_min, do
         },
         line, ends.data(), live.data());
     const CsgFirst<double> at = csg_first_boundary(scene_->csg_nodes.data(), scene_->csg_objects[k].root, layout,
-                                                   line, live.data(), live_count, t_min, t_max);
+                                                   line, live.data(), live_count, t_min, t_max, csg_inner_[k] != 0);
     if (!(at.t < t_max)) return -1;
     t_max = at.t;
     const auto slot = std::size_t(at.slot);

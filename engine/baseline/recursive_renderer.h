@@ -112,6 +112,7 @@ class RecursiveRenderer {
     std::size_t csg_base_ = 0;             ///< the first CSG shape's index in objects_
     std::vector<CsgBox> csg_boxes_;        ///< per CSG object: its result's box (csg_node_box)
     std::vector<CsgSlotLayout> csg_layouts_;  ///< per CSG object: its shapes' slots
+    std::vector<std::uint8_t> csg_inner_;      ///< per CSG object: shows inner surfaces (csg_shows_inner_surfaces)
     std::vector<MaterialT<double>> materials_;  ///< per scene material
     std::vector<LightT<double>> lights_;
 };

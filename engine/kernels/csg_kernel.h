@@ -111,6 +111,31 @@ inline void mesh_packet_slots(const Mesh& mesh, const Vec3T<B>& o, const Vec3T<B
     store();
 }
 
+/// A torus's two spans along each line of a packet (o, d: its canonical space) into the slots
+/// [first, first + 2): torus_spans in double lanes, two or more double batches to a float
+/// one, each lane rounded to float as the scalar walk's (torus_slot_spans).
+template <class B>
+inline void torus_packet_slots(const Vec3T<B>& o, const Vec3T<B>& d, float minor, CsgLine<B>& line, int first) {
+    using D = xsimd::batch<double, typename B::arch_type>;
+    constexpr std::size_t W = B::size, WD = D::size;
+    alignas(64) float in[6][simd::kMaxLanes], out[4][simd::kMaxLanes];
+    const B parts[6] = {o.x, o.y, o.z, d.x, d.y, d.z};
+    for (int k = 0; k < 6; ++k) parts[k].store_aligned(in[k]);
+    for (std::size_t h = 0; h < W; h += WD) {
+        const auto wide = [&](int k) { return D::load_unaligned(in[k] + h); };  // float -> double
+        const std::array<SpanT<D>, 2> s =
+            torus_spans<D>({wide(0), wide(1), wide(2)}, {wide(3), wide(4), wide(5)}, D(double(minor)));
+        s[0].enter.store_unaligned(out[0] + h);  // double -> float, rounded to nearest
+        s[0].exit.store_unaligned(out[1] + h);
+        s[1].enter.store_unaligned(out[2] + h);
+        s[1].exit.store_unaligned(out[3] + h);
+    }
+    for (std::size_t j = 0; j < 2; ++j) {
+        line.enter[std::size_t(first) + j] = B::load_aligned(out[2 * j]);
+        line.exit[std::size_t(first) + j] = B::load_aligned(out[2 * j + 1]);
+    }
+}
+
 /// The spans of object `ob`'s shapes over a packet's lanes into `line` (a mesh's into its
 /// slots, their ends into `ends`), and the slots some lane's line meets, ascending, into
 /// `live` (their count returned). A packet that misses a shape's box over (0, t_max) takes the
@@ -136,6 +161,8 @@ inline int csg_packet_spans(const CsgView& csg, const CsgObjectView& ob, const R
         const RayPacket<B> c = to_canonical<B, float>(r, xf);
         if (const Mesh* mesh = csg.meshes[k]) {
             mesh_packet_slots(*mesh, c.o, c.d, meets, line, ends, first);
+        } else if (ShapeKind(xf.kind) == ShapeKind::Torus) {
+            torus_packet_slots(c.o, c.d, xf.param, line, first);
         } else {
             const SpanT<B> span = csg_shape_span<B>(ShapeKind(xf.kind), c.o, c.d, B(xf.param));
             line.enter[std::size_t(first)] = span.enter;
@@ -159,9 +186,9 @@ struct PairBoundary {
 /// The first boundary with t > 0 of `op` over two shapes of spans [e0, x0], [e1, x1] (each
 /// empty unless enter < exit), in lanes, in closed form: what render/csg_spans.h's walk
 /// (csg_first_boundary) gives, tie rules included (touching spans join, coinciding ends show
-/// the first shape's surface), from comparisons of the same values, so the same bits. The
-/// result has at most two spans, [o1, c1] and [o2, c2], in order; the earliest valid end past
-/// 0 is taken.
+/// the first shape's surface), from comparisons of the same values, so the same bits. A
+/// union's boundaries are every end (its inner surfaces); another result has at most two
+/// spans, [o1, c1] and [o2, c2], in order, and the earliest valid end past 0 is taken.
 template <class B>
 inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, const B& e1, const B& x1) {
     using M = typename PairBoundary<B>::M;
@@ -194,7 +221,22 @@ inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, con
             v2 = a && (inside || cut) && (x1 < x0);
             break;
         }
-        case CsgOp::Union:
+        case CsgOp::Union: {
+            // Every end of either shape is a surface (the inner ones too): the earliest past
+            // 0, the first shape's on a tie; the line enters the result's side of it at an
+            // enter.
+            PairBoundary<B> r{inf, no, no, no};
+            const auto earlier = [&](const B& t, const M& valid, const M& second, const M& exit) {
+                const M m = valid && (t > zero) && (t <= r.t);
+                r = {xsimd::select(m, t, r.t), mask_select(m, second, r.second), mask_select(m, exit, r.exit),
+                     mask_select(m, !exit, r.entering)};
+            };
+            earlier(x1, b, yes, yes);  // the first shape's last, so that it wins ties
+            earlier(e1, b, yes, no);
+            earlier(x0, a, no, yes);
+            earlier(e0, a, no, no);
+            return r;
+        }
         case CsgOp::Merge: {
             // The first to enter opens; overlapping or touching spans close at the later exit
             // (the first's on a tie), apart ones stay two.
@@ -261,7 +303,8 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
                 entering = at.entering;
             } else {  // any tree: the walk along the line, in lanes
                 const CsgFirst<B> at =
-                    csg_first_boundary(csg.nodes, ob.root, ob.layout, line, live.data(), live_count, B(0.f), t_max);
+                    csg_first_boundary(csg.nodes, ob.root, ob.layout, line, live.data(), live_count, B(0.f), t_max,
+                                       ob.inner_surfaces);
                 t = at.t;
                 slot = at.slot;
                 at_exit = at.at_exit;
@@ -273,7 +316,7 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
                 t_max = xsimd::select(hit, B(0.f), t_max);
             } else {
                 t_max = xsimd::select(hit, t, t_max);
-                if (!ob.has_mesh) {  // one slot per shape, and no turned ends: csg_flip in lanes
+                if (!ob.multi_slot) {  // one slot per shape, and no turned ends: csg_flip in lanes
                     alignas(64) float slots[simd::kMaxLanes], flips[simd::kMaxLanes];
                     xsimd::select(hit, slot, B(-1.f)).store_aligned(slots);
                     xsimd::select(simd::mask_xor(at_exit, entering), B(0.f), B(1.f)).store_aligned(flips);

@@ -24,8 +24,11 @@ struct CsgObjectView {
     /// (csg_pair_boundary); other trees by the walk along the line (csg_first_boundary).
     bool pair;
     CsgOp op;  ///< the root's
-    /// An object with a mesh among its shapes (its slots' ends keep triangles).
-    bool has_mesh;
+    /// An object with a shape of several slots (a mesh, whose slots' ends keep triangles; a
+    /// torus): its slots are mapped back to shapes by the layout.
+    bool multi_slot;
+    /// A tree that shows inner surfaces (csg_shows_inner_surfaces: a union not subtracted).
+    bool inner_surfaces;
 };
 
 /// Every CSG object of a scene (stream/stream_csg.h).

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "mesh/mesh.h"
+#include "shapes/shapes.h"
 
 namespace streamrt {
 
@@ -27,5 +28,10 @@ std::optional<OpenEdge> first_open_edge(const Mesh& mesh);
 inline constexpr int kMeshCsgSpans = 8;
 /// The most crossings of a line with one mesh that are kept, nearest first along the line.
 inline constexpr int kMeshCsgCrossings = 64;
+
+/// The slots a CSG shape of kind k takes (render/csg_layout.h): the spans a line may meet it
+/// in, a closed mesh's first kMeshCsgSpans along the line, a canonical solid's 1 or its
+/// kCsgSpans (the torus: 2).
+constexpr int csg_slots_of(ShapeKind k) { return k == ShapeKind::Mesh ? kMeshCsgSpans : shape_csg_spans(k); }
 
 }  // namespace streamrt

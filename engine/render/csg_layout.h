@@ -11,7 +11,7 @@
 namespace streamrt {
 
 /// How an object's shapes map to slots, one span along a line each: a convex shape or a
-/// half-space has one slot, a closed mesh kMeshCsgSpans (its first spans along the line). The
+/// half-space has one slot, a torus two, a closed mesh kMeshCsgSpans (csg_slots_of). The
 /// reader counts slots against kMaxCsgShapes, so an object's fit the fixed arrays below.
 struct CsgSlotLayout {
     std::uint32_t first_shape = 0;  ///< the object's first shape (Scene::csg_shapes)
@@ -46,7 +46,7 @@ inline CsgSlotLayout csg_slot_layout(const Scene& scene, const CsgObject& o) {
     int slot = 0;
     for (std::uint32_t s = 0; s < o.shape_count; ++s) {
         l.first_slot[s] = std::uint8_t(slot);
-        const int n = scene.csg_shapes[o.first_shape + s].kind == ShapeKind::Mesh ? kMeshCsgSpans : 1;
+        const int n = csg_slots_of(scene.csg_shapes[o.first_shape + s].kind);
         for (int j = 0; j < n; ++j) l.shape_of[std::size_t(slot + j)] = std::uint8_t(s);
         slot += n;
     }

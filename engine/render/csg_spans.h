@@ -74,6 +74,19 @@ void mesh_slot_spans(CsgLine<V>& line, CsgSlotEnds* ends, int first, const Mesh&
     mesh_winding_spans(c, n, &line.enter[j], &line.exit[j], ends + j, 1);
 }
 
+/// A torus's spans along the line o + t d (its canonical space) into its slots [first,
+/// first + 2): torus_spans, solved in double in every engine (as the torus always is) and
+/// rounded to V.
+template <class V>
+void torus_slot_spans(CsgLine<V>& line, int first, const Vec3T<V>& o, const Vec3T<V>& d, V minor) {
+    const auto wide = [](const Vec3T<V>& v) { return Vec3T<double>{double(v.x), double(v.y), double(v.z)}; };
+    const std::array<SpanT<double>, 2> s = torus_spans<double>(wide(o), wide(d), double(minor));
+    for (std::size_t j = 0; j < 2; ++j) {
+        line.enter[std::size_t(first) + j] = V(s[j].enter);
+        line.exit[std::size_t(first) + j] = V(s[j].exit);
+    }
+}
+
 /// Where a line first crosses a CSG result's surface (csg_first_boundary), per lane.
 template <class V>
 struct CsgFirst {
@@ -121,6 +134,77 @@ M csg_node_inside(const CsgNode* nodes, std::uint32_t node, const CsgSlotLayout&
     return r;
 }
 
+/// Whether the tree at `root` shows inner surfaces: a `union` that is not inside an odd number
+/// of subtracted children (a subtracted union is an intersection of what it leaves, which has
+/// none). Trees without one take the walk's plain rule: a surface where the class changes.
+inline bool csg_shows_inner_surfaces(const CsgNode* nodes, std::uint32_t node, bool inverted = false) {
+    const CsgNode& n = nodes[node];
+    if (n.op == CsgOp::Union && !inverted) return true;
+    for (std::size_t i = 0; i < n.children.size(); ++i) {
+        const bool subtracted = n.op == CsgOp::Difference && i > 0;
+        if (n.children[i].is_node && csg_shows_inner_surfaces(nodes, n.children[i].index, inverted != subtracted))
+            return true;
+    }
+    return false;
+}
+
+/// A step of the walk at a surface of a node's result, per lane: whether one is there, and
+/// whether the line goes into the solid it bounds (seen from the result's side).
+template <class M>
+struct CsgSurface {
+    M visible, entering;
+};
+
+/// Whether node `node` shows a surface at a step of the walk from the slots' classes before
+/// it to those after (POV-Ray's rules): where its class changes, and, where it does not, a
+/// child's own surface that the node keeps: a `union` keeps every child's (its inner
+/// surfaces) unless it is subtracted (`inverted`), any other node a child's only where each
+/// of the other children is, on both sides of the point, in the state that lets the child's
+/// class decide the node's (inside for an intersection, outside for a union or merge; for a
+/// difference the first child inside and the others outside). Such a filtered surface of a
+/// plain shape is a class change already: only nested unions add surfaces. Ties: the first
+/// child (in written order) that shows one gives `entering`.
+template <class M>
+CsgSurface<M> csg_node_surface(const CsgNode* nodes, std::uint32_t node, const CsgSlotLayout& layout,
+                               const M* before, const M* after, bool inverted) {
+    const CsgNode& n = nodes[node];
+    const M now = csg_node_inside(nodes, node, layout, after);
+    CsgSurface<M> r{simd::mask_xor(csg_node_inside(nodes, node, layout, before), now), now};
+    const bool keeps_all = n.op == CsgOp::Union && !inverted;
+    const auto child_inside = [&](std::size_t i, const M* in) {
+        const CsgNode::Child& c = n.children[i];
+        if (c.is_node) return csg_node_inside(nodes, c.index, layout, in);
+        M m(false);
+        const std::size_t s = c.index - layout.first_shape;
+        for (int j = layout.first_slot[s]; j < layout.first_slot[s + 1]; ++j) m = m || in[j];
+        return m;
+    };
+    for (std::size_t i = 0; i < n.children.size(); ++i) {
+        const CsgNode::Child& c = n.children[i];
+        if (!keeps_all && !c.is_node) continue;  // a class change of this node if kept
+        const bool subtracted = n.op == CsgOp::Difference && i > 0;
+        CsgSurface<M> cs;
+        if (c.is_node) {
+            cs = csg_node_surface(nodes, c.index, layout, before, after, inverted != subtracted);
+        } else {
+            const M in = child_inside(i, after);
+            cs = {simd::mask_xor(child_inside(i, before), in), in};
+        }
+        M take = cs.visible && !r.visible;
+        if (!simd::any(take)) continue;
+        for (std::size_t k = 0; k < n.children.size() && !keeps_all; ++k) {
+            if (k == i) continue;
+            // The state sibling k must hold on both sides.
+            const bool want_inside = n.op == CsgOp::Intersection || (n.op == CsgOp::Difference && k == 0);
+            const M b = child_inside(k, before), a = child_inside(k, after);
+            take = take && (want_inside ? (b && a) : !(b || a));
+        }
+        r.entering = mask_select(take, subtracted ? !cs.entering : cs.entering, r.entering);
+        r.visible = r.visible || take;
+    }
+    return r;
+}
+
 /// The first point of the line in (t_min, t_max) where it goes into or out of the result of
 /// the tree at `root`: one definition for both engines, scalar (V = double, float) and in
 /// lanes (V = a batch). A point is in a slot's span when enter <= t < exit (so a span of length
@@ -130,16 +214,18 @@ M csg_node_inside(const CsgNode* nodes, std::uint32_t node, const CsgSlotLayout&
 /// after all of them (a subtracted face lying on the base's face removes it; spans that touch
 /// join), and the surface shown is the lowest slot's among them: the first-written shape's
 /// (docs/scene-format.md, "CSG"). `live`: the slots to read, ascending (the others are empty
-/// in every lane). No sorting and no lists: at most one step per span end.
+/// in every lane). No sorting and no lists: at most one step per span end. `inner_surfaces`
+/// (csg_shows_inner_surfaces of the tree): a step is also a boundary where a union keeps a
+/// child's surface inside the result (csg_node_surface), `entering` then that child's.
 template <class V>
 CsgFirst<V> csg_first_boundary(const CsgNode* nodes, std::uint32_t root, const CsgSlotLayout& layout,
                                const CsgLine<V>& line, const std::uint8_t* live, int live_count, const V& t_min,
-                               const V& t_max) {
+                               const V& t_max, bool inner_surfaces = false) {
     using M = typename CsgFirst<V>::M;
     using S = simd::scalar_t<V>;
     const V inf(std::numeric_limits<S>::infinity());
-    std::array<M, kMaxCsgShapes> in, valid;
-    for (int j = 0; j < layout.slots(); ++j) in[std::size_t(j)] = M(false);
+    std::array<M, kMaxCsgShapes> in, valid, before;
+    for (int j = 0; j < layout.slots(); ++j) in[std::size_t(j)] = before[std::size_t(j)] = M(false);
     for (int i = 0; i < live_count; ++i) {
         const std::size_t s = live[i];
         valid[std::size_t(i)] = line.enter[s] < line.exit[s];
@@ -161,10 +247,23 @@ CsgFirst<V> csg_first_boundary(const CsgNode* nodes, std::uint32_t root, const C
         if (!simd::any(active)) break;
         for (int i = 0; i < live_count; ++i) {
             const std::size_t s = live[i];
+            if (inner_surfaces) before[s] = in[s];
             in[s] = valid[std::size_t(i)] && (line.enter[s] <= next) && (next < line.exit[s]);
         }
         const M now = csg_node_inside(nodes, root, layout, in.data());
-        const M change = active && simd::mask_xor(now, state);
+        M change = active && simd::mask_xor(now, state), entering = now;
+        if (inner_surfaces) {
+            // A kept inner surface lies inside the result on both sides of it (a union's
+            // child's surface inside another child, or one its siblings hold inside): only
+            // such steps ask the tree, so a line from outside pays nothing up to its way in.
+            const M inside = active && now && state;
+            if (simd::any(inside)) {
+                const CsgSurface<M> surface = csg_node_surface(nodes, root, layout, before.data(), in.data(), false);
+                const M inner = inside && surface.visible;
+                entering = mask_select(inner, surface.entering, entering);
+                change = change || inner;
+            }
+        }
         if (simd::any(change)) {
             V slot(S(0));
             M at_exit(false);
@@ -178,7 +277,7 @@ CsgFirst<V> csg_first_boundary(const CsgNode* nodes, std::uint32_t root, const C
             r.t = simd::select(change, next, r.t);
             r.slot = simd::select(change, slot, r.slot);
             r.at_exit = mask_select(change, at_exit, r.at_exit);
-            r.entering = mask_select(change, now, r.entering);
+            r.entering = mask_select(change, entering, r.entering);
             active = active && !change;
             if (!simd::any(active)) break;
         }
@@ -215,6 +314,9 @@ int csg_scalar_line(const CsgSlotLayout& layout, const Canonical& canonical, con
         const int j = layout.first_slot[std::size_t(s)];
         if (mesh) {
             mesh_slot_spans(line, ends, j, *mesh, o, d);
+        } else if (kind == ShapeKind::Torus) {
+            torus_slot_spans(line, j, o, d, V(param));
+            ends[j] = ends[j + 1] = CsgSlotEnds{};
         } else {
             const SpanT<V> span = csg_shape_span(kind, o, d, V(param));
             line.enter[std::size_t(j)] = span.enter;

@@ -67,17 +67,26 @@ void Parser::csg_child(Statement& st, const std::vector<Token>& toks, ShapeKind 
     if (kind == ShapeKind::Disk)
         st.fail_here("a disk has no inside, so it cannot be part of a csg block (a thin cylinder has one)");
     if (kind != ShapeKind::Mesh && !shape_is_solid(kind))
-        st.fail_here("a " + std::string(st.word()) + " cannot be part of a csg block yet (its inside is not traced yet)");
-    // A mesh may cross a line several times: it counts as the spans it may add (mesh/mesh_solid.h).
-    csg_blocks_.front().shapes += kind == ShapeKind::Mesh ? kMeshCsgSpans : 1;
+        st.fail_here("a " + std::string(st.word()) + " cannot be part of a csg block (it has no inside)");
+    // A shape a line may cross several times counts as the spans it may add (csg_slots_of).
+    csg_blocks_.front().shapes += csg_slots_of(kind);
     if (csg_blocks_.front().shapes > kMaxCsgShapes)
         st.fail_here("a csg object holds at most " + std::to_string(kMaxCsgShapes) + " shapes, a mesh counting as " +
-                     std::to_string(kMeshCsgSpans) + " (its block is at " + csg_blocks_.front().at.str() + ")");
+                     std::to_string(kMeshCsgSpans) + " and a torus as " + std::to_string(csg_slots_of(ShapeKind::Torus)) +
+                     " (its block is at " + csg_blocks_.front().at.str() + ")");
     CsgBlock& block = csg_blocks_.back();
     Object obj;
     ObjectLoc loc;
     if (const auto name = shape(st, toks, kind, block.file, scene_materials_, obj, loc, &block))
         st.fail(name->key_col, "a csg block's shape takes no name= (the block is the object)");
+    if (kind == ShapeKind::Torus && obj.param > 1.0) {
+        // Past minor = 1 the tube overlaps itself and the quartic's inner sheet lies inside
+        // the solid: no surface of it.
+        const Arg* minor = st.find("minor");
+        st.fail(minor ? minor->value_col : st.where().column,
+                "a torus in a csg block needs minor <= 1 (a thicker tube overlaps itself: its inner surface bounds no "
+                "solid), got " + fmt_num(obj.param));
+    }
     if (kind == ShapeKind::Mesh) {
         // materials=obj made an object of each part of the file: one solid is wanted.
         if (const Arg* m = st.find("materials"))

@@ -165,13 +165,24 @@ constexpr CanonicalBounds canonical_bounds(ShapeKind k, double param) {
     return b;
 }
 
-/// Whether the kind is a solid a csg block may hold (shapes/solid_span.h; not Mesh, yet).
+/// Whether the canonical kind is a solid a csg block may hold (shapes/solid_span.h).
 constexpr bool shape_is_solid(ShapeKind k) {
     bool solid = false;
     CanonicalShapes::for_each([&](auto s) {
-        if (s.kind == k) solid = Solid<decltype(s)>;
+        if (s.kind == k) solid = Solid<decltype(s)> || MultiSpanSolid<decltype(s)>;
     });
     return solid;
+}
+
+/// The spans a line may meet a canonical solid in (its CSG slots): 1, or its kCsgSpans.
+constexpr int shape_csg_spans(ShapeKind k) {
+    int n = 1;
+    CanonicalShapes::for_each([&](auto s) {
+        if constexpr (MultiSpanSolid<decltype(s)>) {
+            if (s.kind == k) n = decltype(s)::kCsgSpans;
+        }
+    });
+    return n;
 }
 
 /// Whether the kernels solve this kind in double lanes (half as many per register).

@@ -35,12 +35,15 @@ SpanT<V> convex_span(const Vec3T<V>& o, const Vec3T<V>& d, V param) {
     return {enter, exit};
 }
 
-/// A shape that is a solid for CSG: a convex one (kConvexSolid) or one with its own
-/// inside_span (the plane's half-space). The disk is no solid; the torus not yet.
+/// A shape that is a solid for CSG with one span along a line: a convex one (kConvexSolid) or
+/// one with its own inside_span (the plane's half-space). The disk is no solid.
 template <class Math>
 concept ConvexSolid = requires { requires Math::kConvexSolid; };
 template <class Math>
 concept Solid = ConvexSolid<Math> || requires(Vec3T<double> p, double v) { Math::inside_span(p, p, v); };
+/// A solid a line may meet in several spans (the torus: two), given by its own spans().
+template <class Math>
+concept MultiSpanSolid = requires { requires Math::kCsgSpans > 1; };
 
 /// A shape whose two ends come from one computation (the sphere's one solve), with
 /// convex_span's bits.

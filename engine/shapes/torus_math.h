@@ -22,10 +22,12 @@
 //      factored, cancellation-free form) and solve it with safeguarded Newton/bisection on the
 //      factored F, which doubles as the final Newton polish.
 #include <algorithm>
+#include <array>
 #include <limits>
 
 #include "core/vec3.h"
 #include "shapes/shape_traits.h"
+#include "shapes/solid_span.h"
 #include "shapes/quadratic.h"
 #include "simd/lanes.h"
 #include "simd/isa_namespace.h"
@@ -170,10 +172,22 @@ inline void torus_f(const Vec3T<V>& p0, const Vec3T<V>& D, const V& r2, const V&
 
 }  // namespace torus_detail
 
-/// Nearest t in (t_min, t_max) with o + t*d on the torus (d need NOT be unit length), or
-/// +infinity for a miss. NaN/inf inputs give a miss (+inf), never NaN.
+/// Steps 1 - 4 of the method for a line o + t d, t in (t_min, t_max): the line in the torus's
+/// frame (s = t len - tc along the unit D from p0) and the <= 4 monotone pieces of F between
+/// pts[0..4], with F and its sign at each end. `valid`: the lanes whose clipped line is not
+/// empty.
 template <class V>
-V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
+struct TorusPieces {
+    torus_detail::mask_t<V> valid;
+    Vec3T<V> p0, D;
+    V r2, tc, len;
+    V pts[5], fpts[5];
+    torus_detail::mask_t<V> neg[5];
+};
+
+/// Fills `tp` (TorusPieces); false when no lane is valid (tp then holds only `valid`).
+template <class V>
+bool torus_pieces(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max, TorusPieces<V>& tp) {
     using namespace torus_detail;
     using S = simd::scalar_t<V>;
     using M = mask_t<V>;
@@ -240,7 +254,8 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
         hi = simd::min(hi, smax);
     }
     valid = valid & (lo <= hi);
-    if (!simd::any(valid)) return inf;
+    tp.valid = valid;
+    if (!simd::any(valid)) return false;
     lo = simd::select(valid, lo, zero);
     hi = simd::select(valid, hi, zero);
 
@@ -278,16 +293,44 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     const V k2 = simd::select(cchange[1], k[1], cend[1]);
     const V k3 = simd::select(cchange[2], k[2], cend[2]);
 
-    // 5. First monotone piece with a sign change of F, then solve it.
-    auto ffun = [&](const V& s, V& f, V& df) { torus_f(p0, D, r2, s, f, df); };
+    // The pieces' ends, and F there.
+    tp.p0 = p0;
+    tp.D = D;
+    tp.r2 = r2;
+    tp.tc = tc;
+    tp.len = len;
     const V pts[5] = {lo, k1, k2, k3, hi};
-    V fpts[5];
-    M neg[5];
     for (int i = 0; i < 5; ++i) {
         V df;
-        ffun(pts[i], fpts[i], df);
-        neg[i] = fpts[i] < zero;
+        tp.pts[i] = pts[i];
+        torus_f(p0, D, r2, pts[i], tp.fpts[i], df);
+        tp.neg[i] = tp.fpts[i] < zero;
     }
+    return true;
+}
+
+/// Nearest t in (t_min, t_max) with o + t*d on the torus (d need NOT be unit length), or
+/// +infinity for a miss. NaN/inf inputs give a miss (+inf), never NaN.
+template <class V>
+V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
+    using namespace torus_detail;
+    using S = simd::scalar_t<V>;
+    using M = mask_t<V>;
+    const V inf = inf_v<V>();
+    const V zero(0);
+    TorusPieces<V> tp;
+    if (!torus_pieces(o, d, minor, t_min, t_max, tp)) return inf;
+    M valid = tp.valid;
+    const Vec3T<V>& p0 = tp.p0;
+    const Vec3T<V>& D = tp.D;
+    const V& r2 = tp.r2;
+    const V* pts = tp.pts;
+    const V* fpts = tp.fpts;
+    const M* neg = tp.neg;
+    const V tc = tp.tc, len = tp.len;
+
+    // 5. First monotone piece with a sign change of F, then solve it.
+    auto ffun = [&](const V& s, V& f, V& df) { torus_f(p0, D, r2, s, f, df); };
     V a = zero, bb = zero, fa = zero, fb = zero;
     M neg_a = neg[0];
     M found = neg[0] & !neg[0];  // all false
@@ -309,6 +352,48 @@ V torus_hit_t(const Vec3T<V>& o, const Vec3T<V>& d, V minor, V t_min, V t_max) {
     const V t = (s_hit[0] + tc) / len;
     const M hit = valid & (t > t_min) & (t < t_max);
     return simd::select(hit, t, inf);
+}
+
+/// The torus as a solid for CSG (minor <= 1: the tube's inside, where F < 0) over the whole
+/// line o + t d (every t): its at most two spans, in order, each [+inf, -inf] where there is
+/// none. Every sign change of F on the monotone pieces is a crossing, solved as torus_hit_t
+/// solves its first (the same bracket, start and tolerance); they alternate in and out,
+/// starting in, as the pieces' outer ends lie outside the torus. An odd count (rounding at a
+/// grazing line) leaves the last span open: empty.
+template <class V>
+std::array<SpanT<V>, 2> torus_spans(const Vec3T<V>& o, const Vec3T<V>& d, V minor) {
+    using namespace torus_detail;
+    using S = simd::scalar_t<V>;
+    using M = mask_t<V>;
+    const V inf = inf_v<V>();
+    std::array<SpanT<V>, 2> out{{{inf, -inf}, {inf, -inf}}};
+    TorusPieces<V> tp;
+    if (!torus_pieces(o, d, minor, -inf, inf, tp)) return out;
+    V a[4], b[4], start[4], root[4];
+    M neg_a[4], change[4];
+    M any_change = tp.valid & !tp.valid;
+    for (int i = 0; i < 4; ++i) {
+        change[i] = tp.valid & simd::mask_xor(tp.neg[i], tp.neg[i + 1]);
+        any_change = any_change | change[i];
+        a[i] = tp.pts[i];
+        b[i] = tp.pts[i + 1];
+        neg_a[i] = tp.neg[i];
+        start[i] = false_position(tp.pts[i], tp.pts[i + 1], tp.fpts[i], tp.fpts[i + 1], change[i]);
+    }
+    if (!simd::any(any_change)) return out;
+    auto ffun = [&](const V& s, V& f, V& df) { torus_f(tp.p0, tp.D, tp.r2, s, f, df); };
+    bracket_solve(a, b, neg_a, change, start, kRootTol<S>, ffun, kRootIters, root);
+    // The k-th crossing of a lane is end k: enter, exit, enter, exit.
+    V ends[4] = {inf, -inf, inf, -inf};
+    V count(0);
+    for (int i = 0; i < 4; ++i) {
+        const V t = (root[i] + tp.tc) / tp.len;
+        for (int k = 0; k < 4; ++k) ends[k] = simd::select(change[i] & (count == V(S(k))), t, ends[k]);
+        count = count + simd::select(change[i], V(1), V(0));
+    }
+    out[0] = {ends[0], ends[1]};
+    out[1] = {ends[2], ends[3]};
+    return out;
 }
 
 /// Outward normal (not necessarily unit length) at a point p on (or very near) the torus
@@ -339,6 +424,12 @@ struct TorusMath {
     static constexpr std::string_view name = "torus";
     static constexpr ShapeParam param{"minor", 0.25};  ///< the tube radius
     using Compute = double;
+    /// As a CSG solid (minor <= 1) a line meets it in up to two spans (torus_spans).
+    static constexpr int kCsgSpans = 2;
+    template <class V>
+    static std::array<SpanT<V>, 2> spans(const Vec3T<V>& o, const Vec3T<V>& d, V minor) {
+        return torus_spans(o, d, minor);
+    }
     /// The ring's box: |x|, |z| <= 1 + minor, |y| <= minor.
     static constexpr CanonicalBounds bounds(double minor) {
         return {CanonicalBounds::Form::Box, {-1 - minor, -minor, -1 - minor}, {1 + minor, minor, 1 + minor}};

@@ -22,14 +22,15 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
         v.bounded = box.bounded();
         if (v.bounded) v.box = padded_bounds(box.lo, box.hi, eye);
         v.layout = csg_slot_layout(scene, o);
-        const std::uint32_t lo = o.first_shape, hi = o.first_shape + o.shape_count;
+        const std::uint32_t lo = o.first_shape;
         const CsgNode& root = nodes_[o.root];
         v.op = root.op;
+        v.inner_surfaces = csg_shows_inner_surfaces(nodes_.data(), o.root);
         // (children 0 and 1 are its shapes lo and lo + 1, in the kernels' lane arrays)
         v.pair = root.children.size() == 2 && !root.children[0].is_node && !root.children[1].is_node &&
                  root.children[0].index == lo && root.children[1].index == lo + 1;
-        for (std::uint32_t s = lo; s < hi; ++s) v.has_mesh = v.has_mesh || scene.csg_shapes[s].kind == ShapeKind::Mesh;
-        v.pair = v.pair && !v.has_mesh;
+        v.multi_slot = v.layout.slots() > v.layout.shapes;
+        v.pair = v.pair && !v.multi_slot;
         objects_.push_back(v);
     }
     records_.resize(2 * std::size_t(shapes));

@@ -50,7 +50,8 @@ Expected scalar_closest(const CsgView& v, const Vec3f& o, const Vec3f& d, float 
                 return std::tuple{ShapeKind(xf.kind), xf.param, v.meshes[shape]};
             },
             line, ends.data(), live.data());
-        const CsgFirst<float> at = csg_first_boundary(v.nodes, ob.root, ob.layout, line, live.data(), n, 0.f, e.t);
+        const CsgFirst<float> at = csg_first_boundary(v.nodes, ob.root, ob.layout, line, live.data(), n, 0.f, e.t,
+                                                      csg_shows_inner_surfaces(v.nodes, ob.root));
         if (!(at.t < e.t)) continue;
         e.t = at.t;
         const auto slot = std::size_t(at.slot);
@@ -88,6 +89,14 @@ const char* const kScenes[] = {
     "csg difference translate=-1,-1,1\n sphere\n sphere\nend\n",
     "csg difference\n cube\n cube translate=0,0,1\nend\ncsg intersection translate=0,0,-2\n cube\n cube translate=1,0,0\nend\n"
     "csg union translate=0,2,0\n cube\n cube translate=2,0,0\nend\n",
+    // A union's inner surfaces (a root of three, walked in lanes), and a subtracted union's none.
+    "csg union\n sphere translate=-0.5,0,0\n sphere translate=0.5,0,0\n csg difference\n"
+    "  cube scale=0.6 translate=0,0.8,0\n  csg union\n   sphere scale=0.4 translate=0,1,0\n"
+    "   cylinder scale=0.2,2,0.2\n  end\n end\nend\n",
+    // Tori: a ring cut, a slab minus a fat ring, a union with one (two slots each, in double lanes).
+    "csg difference\n torus minor=0.5\n sphere scale=0.3 translate=1,0,0\nend\n"
+    "csg difference translate=0,0,-2\n cube scale=1.2,0.4,1.2\n torus minor=1 rotate_x=20\nend\n"
+    "csg union translate=1,1,1\n torus minor=0.3 rotate_z=80\n torus minor=0.3\n sphere scale=0.5\nend\n",
     // A closed mesh (1,280 triangles) minus a sphere, and in a tree of three: walked by packets.
     "csg difference\n mesh file=" STREAMRT_SOURCE_DIR "/scenes/csg/lumpy.obj\n"
     " sphere scale=0.75 translate=0.55,0.75,0.55\nend\n"

@@ -39,4 +39,19 @@ inline const char* const kDie =
     "  sphere scale=0.5,0.5,0.5 translate=0,0,1.2\n"
     "end\n";
 
+// Two unit spheres centred at x = -0.5 and x = +0.5, a block's children: along the x axis the
+// first spans [-1.5, 0.5], the second [-0.5, 1.5].
+inline const char* const kTwoSpheres =
+    "  sphere translate=-0.5,0,0\n"
+    "  sphere translate=0.5,0,0\n";
+
+// A ring with a bite: a torus (tube radius 0.5) minus a sphere of radius 0.3 centred on the
+// tube's circle at x = 1. Along the x axis the torus spans [-1.5, -0.5] and [0.5, 1.5], the
+// sphere [0.7, 1.3].
+inline const char* const kRingCut =
+    "csg difference\n"
+    "  torus minor=0.5\n"
+    "  sphere scale=0.3 translate=1,0,0\n"
+    "end\n";
+
 }  // namespace streamrt::csg_cases

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "driver/render.h"
@@ -130,6 +131,65 @@ TEST_CASE("csg stream: a ray along a lens's axis meets the two caps at their ver
         CHECK(side.t == doctest::Approx(10 - (std::sqrt(3.0) - 1.5)).epsilon(kTol));
         check_vec(side.normal, 0.5, 0, std::sqrt(3.0) / 2);
         CHECK(!stream_hit(sc, {1.33, 0, 10}, down).hit);  // beyond the rim
+    }
+}
+
+TEST_CASE("csg stream: along two overlapping spheres' axis a union meets all four surfaces, a merge the outer two") {
+    // Two shapes (the closed form in lanes) and three (the walk in lanes: a third sphere off
+    // the axis).
+    for (const std::string third : {"", "  sphere scale=0.3 translate=0,3,0\n"}) {
+        for (const std::string op : {"union", "merge"}) {
+            CAPTURE(op);
+            CAPTURE(third);
+            const Scene s = parse(with_camera("csg " + op + "\n" + kTwoSpheres + third + "end\nsphere translate=0,6,0\n"));
+            const StreamScene sc(s, accel_modes()[0]);
+            // (x of the point, x of the normal shown, the shape) of each surface from x = -5.
+            std::vector<std::tuple<double, double, int>> seen;
+            float pushed = 0.f;
+            for (StreamHit h; seen.size() < 8 && (h = stream_hit(sc, {-5, 0, 0}, {1, 0, 0}, pushed)).hit;
+                 pushed = h.t + 1e-3f)
+                seen.emplace_back(-5.0 + h.t, h.normal.x, h.id - std::int32_t(s.objects.size()));
+            const std::vector<std::tuple<double, double, int>> want =
+                op == "union" ? std::vector<std::tuple<double, double, int>>{{-1.5, -1, 0}, {-0.5, -1, 1}, {0.5, 1, 0}, {1.5, 1, 1}}
+                              : std::vector<std::tuple<double, double, int>>{{-1.5, -1, 0}, {1.5, 1, 1}};
+            REQUIRE(seen.size() == want.size());
+            for (std::size_t i = 0; i < want.size(); ++i) {
+                CAPTURE(i);
+                CHECK(std::get<0>(seen[i]) == doctest::Approx(std::get<0>(want[i])).epsilon(kTol));
+                CHECK(std::get<1>(seen[i]) == doctest::Approx(std::get<1>(want[i])).epsilon(kTol));
+                CHECK(std::get<2>(seen[i]) == std::get<2>(want[i]));
+            }
+        }
+    }
+}
+
+TEST_CASE("csg stream: a torus is a solid: along the ring's diameter, its four surfaces and the bite's two") {
+    const Scene s = parse(with_camera(std::string(kRingCut) + "sphere translate=0,6,0\n"));
+    const auto n_obj = std::int32_t(s.objects.size()), shapes = std::int32_t(s.csg_shapes.size());
+    // (x, x of the normal shown, the record: a shape's, or its turned-round one past `shapes`).
+    const std::vector<std::tuple<double, double, int>> want{
+        {-1.5, -1, 0}, {-0.5, 1, 0}, {0.5, -1, 0}, {0.7, 1, 1 + shapes}, {1.3, -1, 1 + shapes}, {1.5, 1, 0}};
+    for (const accel::AccelConfig& a : accel_modes()) {
+        CAPTURE(int(a.mode));
+        const StreamScene sc(s, a);
+        std::size_t n = 0;
+        float pushed = 0.f;
+        for (StreamHit h; n < 8 && (h = stream_hit(sc, {-5, 0, 0}, {1, 0, 0}, pushed)).hit; pushed = h.t + 1e-3f, ++n) {
+            REQUIRE(n < want.size());
+            CAPTURE(n);
+            CHECK(-5.0 + h.t == doctest::Approx(std::get<0>(want[n])).epsilon(kTol));
+            CHECK(h.normal.x == doctest::Approx(std::get<1>(want[n])).epsilon(kTol));
+            CHECK(h.id - n_obj == std::get<2>(want[n]));
+        }
+        CHECK(n == want.size());
+        CHECK(!stream_hit(sc, {0, 5, 0}, {0, -1, 0}).hit);
+        CHECK(stream_blocked(sc, {-5, 0, 0}, {1, 0, 0}, 4.0f));   // the tube at x = -1.5
+        CHECK(!stream_blocked(sc, {0, 5, 0}, {0, -1, 0}, 10.f));  // the hole
+        CHECK(!stream_blocked(sc, {1, 5, 0}, {0, -1, 0}, 4.4f));  // down to y = 0.6, above the tube
+        CHECK(stream_blocked(sc, {1, 5, 0}, {0, -1, 0}, 4.6f));   // the tube's top at y = 0.5
+        // From the bite's centre (removed): free up to x = 1.3, where the tube is left again.
+        CHECK(!stream_blocked(sc, {1, 0, 0}, {1, 0, 0}, 0.25f));
+        CHECK(stream_blocked(sc, {1, 0, 0}, {1, 0, 0}, 0.4f));
     }
 }
 
@@ -279,6 +339,19 @@ TEST_CASE("csg stream: a glass die and a pipe at every degree match the recursiv
         CHECK(d.psnr >= (degree == 6 ? 30.0 : kMinPsnr));
         if (degree < 6) CHECK(d.share_over <= 0.01);
         CHECK(bit_identical(stream, render(s, EngineKind::Stream, 2)));
+    }
+}
+
+TEST_CASE("csg stream: an opaque union is its merge pixel for pixel, and a glass one is not") {
+    const std::string spheres = std::string(kTwoSpheres) + "  cube scale=0.5 translate=0,0.6,0\n";
+    for (const EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
+        CAPTURE(int(engine));
+        const auto picture = [&](const std::string& op, const std::string& look) {
+            return render(parse(lit_scene("csg " + op + " " + look + "\n" + spheres + "end\n", 5)), engine);
+        };
+        const std::string clay = "color=0.8,0.3,0.2 refl=0.3", glass = "color=1,1,1 ambi=0 diff=0 trans=0.9 ior=1.5";
+        CHECK(bit_identical(picture("union", clay), picture("merge", clay)));
+        CHECK(!bit_identical(picture("union", glass), picture("merge", glass)));
     }
 }
 

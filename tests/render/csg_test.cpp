@@ -9,6 +9,8 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "baseline/recursive_renderer.h"
 #include "driver/render.h"
@@ -61,6 +63,61 @@ TEST_CASE("csg: a ray parallel to a lens's axis meets the caps where the spheres
     check_vec(out.normal, 0.5, 0, -std::sqrt(3.0) / 2);
     // Beyond the rim (|x| > sqrt(4 - 1.5^2) = 1.3229) the spheres do not overlap.
     CHECK(!hit_of(s, {1.33, 0, 10}, {0, 0, -1}, in));
+}
+
+TEST_CASE("csg: along two overlapping spheres' axis a union meets all four surfaces, a merge the outer two") {
+    // (x of the point, x of the normal shown, the shape) of each surface from x = -5 along +x.
+    using Surface = std::tuple<double, double, int>;
+    const auto surfaces = [](const std::string& op) {
+        const Scene s = parse("csg " + op + "\n" + kTwoSpheres + "end\n");
+        std::vector<Surface> seen;
+        HitD h;
+        for (double t_min = 0; seen.size() < 8 && hit_of(s, {-5, 0, 0}, {1, 0, 0}, h, t_min); t_min = h.t + 1e-9) {
+            CHECK(h.point.y == 0.0);
+            CHECK(h.normal.y == doctest::Approx(0.0));
+            seen.emplace_back(h.point.x, h.normal.x, int(std::size_t(h.object) - s.objects.size()));
+        }
+        return seen;
+    };
+    const std::vector<Surface> uni = surfaces("union"), merged = surfaces("merge");
+    // Into the first sphere, into the second (inside the first), out of the first, out of the
+    // second: each normal the outward one of its own sphere.
+    const std::vector<Surface> four{{-1.5, -1, 0}, {-0.5, -1, 1}, {0.5, 1, 0}, {1.5, 1, 1}};
+    const std::vector<Surface> two{{-1.5, -1, 0}, {1.5, 1, 1}};
+    REQUIRE(uni.size() == four.size());
+    REQUIRE(merged.size() == two.size());
+    for (std::size_t i = 0; i < four.size(); ++i) {
+        CAPTURE(i);
+        CHECK(std::get<0>(uni[i]) == doctest::Approx(std::get<0>(four[i])).epsilon(1e-12));
+        CHECK(std::get<1>(uni[i]) == doctest::Approx(std::get<1>(four[i])).epsilon(1e-12));
+        CHECK(std::get<2>(uni[i]) == std::get<2>(four[i]));
+    }
+    for (std::size_t i = 0; i < two.size(); ++i) {
+        CHECK(std::get<0>(merged[i]) == doctest::Approx(std::get<0>(two[i])).epsilon(1e-12));
+        CHECK(std::get<1>(merged[i]) == doctest::Approx(std::get<1>(two[i])).epsilon(1e-12));
+        CHECK(std::get<2>(merged[i]) == std::get<2>(two[i]));
+    }
+}
+
+TEST_CASE("csg: a torus is a solid: along the ring's diameter, its four surfaces and the bite's two") {
+    const Scene s = parse(kRingCut);
+    // (x, x of the normal shown, the shape): into the tube, out at its inner equator (the
+    // normal towards the ring's centre), in again, out into the bite (the sphere's surface
+    // turned round), back out of the bite, out of the tube.
+    const std::vector<std::tuple<double, double, int>> want{{-1.5, -1, 0}, {-0.5, 1, 0}, {0.5, -1, 0},
+                                                            {0.7, 1, 1},   {1.3, -1, 1}, {1.5, 1, 0}};
+    std::size_t n = 0;
+    HitD h;
+    for (double t_min = 0; n < 8 && hit_of(s, {-5, 0, 0}, {1, 0, 0}, h, t_min); t_min = h.t + 1e-9, ++n) {
+        REQUIRE(n < want.size());
+        CAPTURE(n);
+        CHECK(h.point.x == doctest::Approx(std::get<0>(want[n])).epsilon(1e-12));
+        CHECK(h.normal.x == doctest::Approx(std::get<1>(want[n])).epsilon(1e-9));
+        CHECK(int(std::size_t(h.object) - s.objects.size()) == std::get<2>(want[n]));
+    }
+    CHECK(n == want.size());
+    // Down the ring's axis, through the hole: nothing.
+    CHECK(!hit_of(s, {0, 5, 0}, {0, -1, 0}, h));
 }
 
 TEST_CASE("csg: a ray through a pipe's hole hits nothing, and its walls face out of the pipe") {
@@ -186,7 +243,8 @@ std::string walk(const Scene& scene, std::initializer_list<std::pair<double, dou
         live[std::size_t(n)] = std::uint8_t(n);
         ++n;
     }
-    const CsgFirst<double> at = csg_first_boundary(scene.csg_nodes.data(), o.root, layout, line, live.data(), n, t_min, t_max);
+    const CsgFirst<double> at = csg_first_boundary(scene.csg_nodes.data(), o.root, layout, line, live.data(), n, t_min,
+                                                   t_max, csg_shows_inner_surfaces(scene.csg_nodes.data(), o.root));
     if (!(at.t < t_max)) return "none";
     std::ostringstream s;
     s << at.t << " " << at.slot << (at.at_exit ? " x " : " e ") << (at.entering ? "in" : "out");
@@ -196,12 +254,12 @@ std::string walk(const Scene& scene, std::initializer_list<std::pair<double, dou
 }  // namespace
 
 TEST_CASE("csg: the walk along a line over spans given by hand") {
-    const Scene uni = parse("csg union\n sphere\n sphere\nend\n");
+    const Scene merge = parse("csg merge\n sphere\n sphere\nend\n");
     const Scene inter = parse("csg intersection\n sphere\n sphere\nend\n");
     const Scene diff = parse("csg difference\n sphere\n sphere\nend\n");
     // Overlapping spans [1, 4] and [2, 6].
-    CHECK(walk(uni, {{1, 4}, {2, 6}}) == "1 0 e in");
-    CHECK(walk(uni, {{1, 4}, {2, 6}}, 1.5) == "6 1 x out");  // no inner surface at 4 (or 2)
+    CHECK(walk(merge, {{1, 4}, {2, 6}}) == "1 0 e in");
+    CHECK(walk(merge, {{1, 4}, {2, 6}}, 1.5) == "6 1 x out");  // no inner surface at 4 (or 2)
     CHECK(walk(inter, {{1, 4}, {2, 6}}) == "2 1 e in");
     CHECK(walk(inter, {{1, 4}, {2, 6}}, 2) == "4 0 x out");
     CHECK(walk(diff, {{1, 4}, {2, 6}}) == "1 0 e in");
@@ -209,23 +267,61 @@ TEST_CASE("csg: the walk along a line over spans given by hand") {
     CHECK(walk(diff, {{2, 6}, {1, 4}}) == "4 1 x in");      // its exit opens it
     CHECK(walk(diff, {{2, 6}, {1, 4}}, 0, 3.5) == "none");
     // Spans that touch join: no surface where they meet.
-    CHECK(walk(uni, {{0.5, 2}, {2, 3}}, 1) == "3 1 x out");
+    CHECK(walk(merge, {{0.5, 2}, {2, 3}}, 1) == "3 1 x out");
     CHECK(walk(inter, {{0.5, 2}, {2, 3}}) == "none");
     // Coinciding ends: the class after both; the first shape's surface shown.
-    CHECK(walk(uni, {{1, 3}, {1, 5}}) == "1 0 e in");
+    CHECK(walk(merge, {{1, 3}, {1, 5}}) == "1 0 e in");
     CHECK(walk(inter, {{1, 3}, {1, 5}}) == "1 0 e in");
     CHECK(walk(diff, {{1, 3}, {1, 2}}) == "2 1 x in");  // the base's face removed with the other's
     CHECK(walk(diff, {{1, 3}, {0, 3}}) == "none");
     // A span of length 0 (a tangent line) holds nothing; an empty one (a miss) neither.
     CHECK(walk(diff, {{1, 3}, {2, 2}}) == "1 0 e in");
     CHECK(walk(diff, {{1, 3}, {2, 2}}, 1) == "3 0 x out");
-    CHECK(walk(uni, {{kInf, -kInf}, {2, 3}}) == "2 1 e in");
+    CHECK(walk(merge, {{kInf, -kInf}, {2, 3}}) == "2 1 e in");
     // A line starting inside the result: the first way out.
-    CHECK(walk(uni, {{-1, 3}, {2, 5}}) == "5 1 x out");
+    CHECK(walk(merge, {{-1, 3}, {2, 5}}) == "5 1 x out");
     // An infinite end (a half-space) is no surface.
     CHECK(walk(inter, {{-kInf, 3}, {1, kInf}}) == "1 1 e in");
     CHECK(walk(inter, {{-kInf, 3}, {1, kInf}}, 1) == "3 0 x out");
-    CHECK(walk(uni, {{-kInf, 3}, {1, kInf}}) == "none");
+    CHECK(walk(merge, {{-kInf, 3}, {1, kInf}}) == "none");
+}
+
+TEST_CASE("csg: a union keeps its children's inner surfaces, unless it is subtracted") {
+    const Scene uni = parse("csg union\n sphere\n sphere\nend\n");
+    // Overlapping spans [1, 4] and [2, 6]: every end is a surface, each facing out of its shape.
+    CHECK(walk(uni, {{1, 4}, {2, 6}}) == "1 0 e in");
+    CHECK(walk(uni, {{1, 4}, {2, 6}}, 1.5) == "2 1 e in");
+    CHECK(walk(uni, {{1, 4}, {2, 6}}, 2) == "4 0 x out");
+    CHECK(walk(uni, {{1, 4}, {2, 6}}, 4) == "6 1 x out");
+    // Touching spans: the first shape's exit where they meet; coinciding enters: the first's.
+    CHECK(walk(uni, {{0.5, 2}, {2, 3}}, 1) == "2 0 x out");
+    CHECK(walk(uni, {{1, 3}, {1, 5}}) == "1 0 e in");
+    CHECK(walk(uni, {{1, 3}, {1, 5}}, 1) == "3 0 x out");
+    // Inside a half-space, the other shape's enter is a surface; an infinite end still is not.
+    CHECK(walk(uni, {{-kInf, 3}, {1, kInf}}) == "1 1 e in");
+    CHECK(walk(uni, {{-kInf, 3}, {1, kInf}}, 1) == "3 0 x out");
+    CHECK(walk(uni, {{-kInf, 3}, {1, kInf}}, 3) == "none");
+
+    // Subtracted, a union is the intersection of what it leaves: no inner surface. The base
+    // [1, 10] minus the union of [2, 5] and [4, 7]: out at 2, back in at 7 only.
+    const Scene cut = parse("csg difference\n sphere\n csg union\n  sphere\n  sphere\n end\nend\n");
+    CHECK(walk(cut, {{1, 10}, {2, 5}, {4, 7}}, 1) == "2 1 e out");
+    CHECK(walk(cut, {{1, 10}, {2, 5}, {4, 7}}, 2) == "7 2 x in");
+    // Twice subtracted, it keeps them: the base minus (a cutter minus the union).
+    const Scene twice =
+        parse("csg difference\n sphere\n csg difference\n  sphere\n  csg union\n   sphere\n   sphere\n  end\n end\nend\n");
+    CHECK(walk(twice, {{1, 10}, {1.5, 9}, {2, 5}, {4, 7}}, 1.5) == "2 2 e in");
+    CHECK(walk(twice, {{1, 10}, {1.5, 9}, {2, 5}, {4, 7}}, 2) == "4 3 e in");
+    CHECK(walk(twice, {{1, 10}, {1.5, 9}, {2, 5}, {4, 7}}, 4) == "5 2 x out");
+
+    // Inside an intersection, a union's inner surfaces where the other child holds the point
+    // on both sides: [1, 4.5] with the union of [2, 5] and [4, 7].
+    const Scene within = parse("csg intersection\n sphere\n csg union\n  sphere\n  sphere\n end\nend\n");
+    CHECK(walk(within, {{1, 10}, {2, 5}, {4, 7}}, 2) == "4 2 e in");
+    CHECK(walk(within, {{1, 10}, {2, 5}, {4, 7}}, 4) == "5 1 x out");
+    CHECK(walk(within, {{1, 10}, {2, 5}, {4, 7}}, 5) == "7 2 x out");
+    CHECK(walk(within, {{1, 4.5}, {2, 5}, {4, 7}}, 4) == "4.5 0 x out");  // 5 lies outside the first child
+    CHECK(walk(within, {{1, 4}, {2, 5}, {4, 7}}, 2) == "4 0 x out");      // 4 ends the first child too
 }
 
 namespace {

@@ -115,9 +115,11 @@ TEST_CASE("csg parser: every refusal at its line and column") {
     expect_error("csg union\nend\n", 1, 1, "empty csg union block");
     expect_error("csg union\n  sphere\n  csg merge\n  end\nend\n", 3, 3, "empty csg merge block");
     expect_error("csg difference\n  sphere\nend\n", 1, 1, "csg difference needs at least two children");
-    // Children without an inside, or not yet allowed.
+    // Children without an inside; a torus whose tube overlaps itself (at its minor= value).
     expect_error("csg union\n  sphere\n  disk\nend\n", 3, 3, "a disk has no inside");
-    expect_error("csg union\n  sphere\n  torus\nend\n", 3, 3, "a torus cannot be part of a csg block yet");
+    expect_error("csg union\n  sphere\n  torus scale=2 minor=1.5\nend\n", 3, 23,
+                 "a torus in a csg block needs minor <= 1 (a thicker tube overlaps itself: its inner surface bounds no "
+                 "solid), got 1.5");
     expect_error("csg union\n  sphere name=ball\nend\n", 2, 10, "takes no name=");
     expect_error("csg union\n  light point pos=0,0,0\nend\n", 2, 3, "'light' cannot be inside a csg block");
     // Keys a block does not take, and a child's own key checks.
@@ -143,5 +145,14 @@ TEST_CASE("csg parser: an object holds at most 64 shapes, nested blocks included
     std::string text = "csg union\n  csg union\n";
     for (int i = 0; i < 64; ++i) text += "    sphere\n";
     CHECK(parse(text + "  end\nend\n").csg_shapes.size() == 64);
-    expect_error(text + "  cube\n  end\nend\n", 67, 3, "a csg object holds at most 64 shapes, a mesh counting as 8 (its block is at t.cfg:1:1)");
+    expect_error(text + "  cube\n  end\nend\n", 67, 3,
+                 "a csg object holds at most 64 shapes, a mesh counting as 8 and a torus as 2 (its block is at t.cfg:1:1)");
+    // A torus counts as two: 62 spheres and a torus fill an object, a sphere more is one too many.
+    std::string tori = "csg union\n  torus minor=1\n";
+    for (int i = 0; i < 62; ++i) tori += "  sphere\n";
+    const Scene full = parse(tori + "end\n");
+    CHECK(full.csg_shapes.size() == 63);
+    CHECK(full.csg_shapes[0].kind == ShapeKind::Torus);
+    CHECK(full.csg_shapes[0].param == 1.0);
+    expect_error(tori + "  sphere\nend\n", 65, 3, "a csg object holds at most 64 shapes");
 }

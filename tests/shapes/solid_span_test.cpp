@@ -76,6 +76,8 @@ TEST_CASE("solid shapes: which shapes a csg block may hold") {
     CHECK(shape_is_solid(ShapeKind::Cone));
     CHECK(shape_is_solid(ShapeKind::Plane));
     CHECK(!shape_is_solid(ShapeKind::Disk));
-    CHECK(!shape_is_solid(ShapeKind::Torus));
+    CHECK(shape_is_solid(ShapeKind::Torus));  // its tube's inside, in two spans
+    CHECK(shape_csg_spans(ShapeKind::Torus) == 2);
+    CHECK(shape_csg_spans(ShapeKind::Sphere) == 1);
     CHECK(!shape_is_solid(ShapeKind::Mesh));
 }

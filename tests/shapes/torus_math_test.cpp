@@ -4,6 +4,8 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
+#include <cstring>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -451,4 +453,105 @@ TEST_CASE("torus_hit_t: random rays against a long-double reference, scalar and 
     CHECK(max_rel_clean_dist < 1e-12);
     CHECK(simd_mismatch == 0);
     CHECK(max_simd_rel <= 1e-12);
+}
+
+// ---------------------------------------------------------------------------------------
+// The torus as a CSG solid (torus_spans): the tube's inside along the whole line.
+
+TEST_CASE("torus_spans: along the x axis the tube's two spans, none through the hole") {
+    using streamrt::torus_spans;
+    // R = 1, r = 0.5: the axis y = z = 0 crosses the tube at x = -1.5, -0.5, 0.5, 1.5.
+    const auto s = torus_spans<double>({-5, 0, 0}, {2, 0, 0}, 0.5);  // t in units of |d| = 2
+    CHECK(s[0].enter == doctest::Approx(1.75).epsilon(1e-12));
+    CHECK(s[0].exit == doctest::Approx(2.25).epsilon(1e-12));
+    CHECK(s[1].enter == doctest::Approx(2.75).epsilon(1e-12));
+    CHECK(s[1].exit == doctest::Approx(3.25).epsilon(1e-12));
+    // Over the whole line: an origin past the torus sees the same spans behind it.
+    const auto back = torus_spans<double>({5, 0, 0}, {1, 0, 0}, 0.5);
+    CHECK(back[0].enter == doctest::Approx(-6.5).epsilon(1e-12));
+    CHECK(back[1].exit == doctest::Approx(-3.5).epsilon(1e-12));
+    // Down the axis of the ring, through the hole: nothing. Through the tube's top at
+    // x = 1 straight down: one span, |y| <= 0.5.
+    const auto hole = torus_spans<double>({0, 3, 0}, {0, -1, 0}, 0.5);
+    CHECK(!(hole[0].enter < hole[0].exit));
+    CHECK(!(hole[1].enter < hole[1].exit));
+    const auto top = torus_spans<double>({1, 3, 0}, {0, -1, 0}, 0.5);
+    CHECK(top[0].enter == doctest::Approx(2.5).epsilon(1e-12));
+    CHECK(top[0].exit == doctest::Approx(3.5).epsilon(1e-12));
+    CHECK(!(top[1].enter < top[1].exit));
+}
+
+TEST_CASE("torus_spans: random lines against the long-double reference, SIMD lanes to the bit") {
+    using streamrt::SpanT;
+    using streamrt::torus_spans;
+    using B = xsimd::batch<double, xsimd::default_arch>;
+    constexpr size_t N = B::size;
+    Gen gen(test_seed() + 7);
+    size_t checked = 0, crossings = 0, four = 0;
+    for (double r : {1e-3, 0.25, 0.9, 1.0}) {
+        for (int cat : {0, 1, 2, 5}) {
+            std::vector<Ray> rays(1200);
+            for (Ray& ray : rays) ray = gen.make(cat, r);
+            std::vector<std::array<SpanT<double>, 2>> spans(rays.size());
+            for (size_t i = 0; i < rays.size(); ++i) {
+                const Ray& ray = rays[i];
+                spans[i] = torus_spans<double>(ray.o, ray.d, r);
+                // Every crossing of the line, in order, from the reference run again past each.
+                // The line's scale: the torus's size in units of t.
+                const double size = (1 + r) / std::sqrt(dot(ray.d, ray.d));
+                std::vector<double> ref;
+                bool ambiguous = false;
+                double from = -kInf;
+                while (ref.size() < 5) {
+                    const RefResult h = reference(ray.o, ray.d, r, from, kInf);
+                    ambiguous = ambiguous || h.ambiguous_t >= 0;
+                    if (!h.hit) break;
+                    ref.push_back(double(h.t));
+                    from = double(h.t) + 1e-10 * (std::fabs(double(h.t)) + size);
+                }
+                if (ambiguous) continue;  // a grazing touch somewhere on the line
+                std::vector<double> got;
+                for (const SpanT<double>& s : spans[i])
+                    if (s.enter < s.exit) got.insert(got.end(), {s.enter, s.exit});
+                CAPTURE(r);
+                CAPTURE(cat);
+                CAPTURE(i);
+                CAPTURE(got);
+                CAPTURE(ref);
+                REQUIRE(got.size() == ref.size());
+                for (size_t k = 0; k < got.size(); ++k)
+                    CHECK(std::fabs(got[k] - ref[k]) <= 1e-7 * (std::fabs(ref[k]) + size));
+                ++checked;
+                crossings += got.size();
+                four += got.size() == 4 ? 1 : 0;
+            }
+            // SIMD lanes give each line the scalar spans, bit for bit.
+            for (size_t base = 0; base < rays.size(); base += N) {
+                alignas(64) double v[6][N];
+                for (size_t l = 0; l < N; ++l) {
+                    const Ray& ray = rays[std::min(base + l, rays.size() - 1)];
+                    const double vals[6] = {ray.o.x, ray.o.y, ray.o.z, ray.d.x, ray.d.y, ray.d.z};
+                    for (int k = 0; k < 6; ++k) v[k][l] = vals[k];
+                }
+                const auto ld = [&](int k) { return B::load_aligned(v[k]); };
+                const auto s = torus_spans<B>({ld(0), ld(1), ld(2)}, {ld(3), ld(4), ld(5)}, B(r));
+                alignas(64) double out[4][N];
+                s[0].enter.store_aligned(out[0]);
+                s[0].exit.store_aligned(out[1]);
+                s[1].enter.store_aligned(out[2]);
+                s[1].exit.store_aligned(out[3]);
+                for (size_t l = 0; l < N && base + l < rays.size(); ++l) {
+                    const auto& want = spans[base + l];
+                    CHECK(std::memcmp(&out[0][l], &want[0].enter, sizeof(double)) == 0);
+                    CHECK(std::memcmp(&out[1][l], &want[0].exit, sizeof(double)) == 0);
+                    CHECK(std::memcmp(&out[2][l], &want[1].enter, sizeof(double)) == 0);
+                    CHECK(std::memcmp(&out[3][l], &want[1].exit, sizeof(double)) == 0);
+                }
+            }
+        }
+    }
+    MESSAGE("torus_spans: lines checked " << checked << ", crossings " << crossings << ", lines crossing four times "
+                                          << four);
+    CHECK(checked >= 10000);
+    CHECK(four >= 500);
 }
