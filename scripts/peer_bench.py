@@ -85,6 +85,7 @@ SCENES = {
     "csg_tree": os.path.join(pc.ROOT, "scenes", "csg", "tree.cfg"),
     "csg_mesh_cut": os.path.join(pc.ROOT, "scenes", "csg", "mesh_cut.cfg"),
     "csg_glass_merge": os.path.join(pc.ROOT, "scenes", "csg", "glass_merge.cfg"),
+    "csg_field": os.path.join(pc.ROOT, "scenes", "csg", "field.cfg"),
 }
 CSG_SCENES = [k for k in SCENES if k.startswith("csg_")]
 MODES = {

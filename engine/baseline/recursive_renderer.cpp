@@ -60,6 +60,7 @@ RecursiveRenderer::RecursiveRenderer(const Scene& scene, const RenderSettings& s
         csg_layouts_.push_back(csg_slot_layout(scene, o));
         csg_inner_.push_back(csg_shows_inner_surfaces(scene.csg_nodes.data(), o.root) ? 1 : 0);
     }
+    csg_tree_ = CsgHierarchy::build_for(csg_boxes_, accel_config_);
     for (const Material& m : scene.materials) {
         materials_.push_back(MaterialT<double>::from(m));
         if (m.texture >= 0) materials_.back().texture = scene.textures[std::size_t(m.texture)]->view();
@@ -149,14 +150,25 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
         for (std::size_t i = 0; i < csg_base_; ++i)
             if (test_object(i, ray, t_min, best_t, cand)) best = int(i);
     }
-    // CSG objects, after the hierarchy (each culled by its result's box; not in the hierarchy yet).
+    // CSG objects after the others, with the closest hit so far: through their own hierarchy
+    // (render/csg_hierarchy.h) or in a list, each culled by its result's box.
     bool flip = false;
-    for (std::size_t k = 0; k < scene_->csg_objects.size(); ++k) {
+    const auto csg = [&](std::size_t k, double& tm) {
         bool flip_k = false;
-        if (const int i = test_csg(k, ray, t_min, best_t, cand, flip_k); i >= 0) {
+        if (const int i = test_csg(k, ray, t_min, tm, cand, flip_k); i >= 0) {
             best = i;
             flip = flip_k;
         }
+    };
+    if (csg_tree_) {
+        for (const std::uint32_t k : csg_tree_->unbounded) csg(k, best_t);
+        const accel::Bvh& h = csg_tree_->bvh;
+        accel::traverse_closest<double>(h, ray.origin, ray.dir, best_t,
+                                        [&](std::uint32_t first, std::uint32_t count, double& tm) {
+                                            for (std::uint32_t k = first; k < first + count; ++k) csg(h.prim_index[k], tm);
+                                        });
+    } else {
+        for (std::size_t k = 0; k < scene_->csg_objects.size(); ++k) csg(k, best_t);
     }
     if (best < 0) return false;
     const PreparedObject& ob = objects_[std::size_t(best)];
@@ -185,10 +197,23 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
         return mesh_any(ob.mesh->view(), ob.mesh->bvh, apply_point(RowsOf{ob.mi}, ray.origin),
                         apply_vector(RowsOf{ob.mi}, ray.dir), 0.0, tm);
     };
-    for (std::size_t k = 0; k < scene_->csg_objects.size(); ++k) {
-        double tm = t_max;
+    const auto csg_blocks = [&](std::size_t k, double tm) {
         bool flip = false;
-        if (test_csg(k, ray, 0.0, tm, o, flip) >= 0) return true;
+        return test_csg(k, ray, 0.0, tm, o, flip) >= 0;
+    };
+    if (csg_tree_) {
+        for (const std::uint32_t k : csg_tree_->unbounded)
+            if (csg_blocks(k, t_max)) return true;
+        const accel::Bvh& h = csg_tree_->bvh;
+        if (accel::traverse_any<double>(h, ray.origin, ray.dir, t_max, [&](std::uint32_t first, std::uint32_t count, double tm) {
+                for (std::uint32_t k = first; k < first + count; ++k)
+                    if (csg_blocks(h.prim_index[k], tm)) return true;
+                return false;
+            }))
+            return true;
+    } else {
+        for (std::size_t k = 0; k < scene_->csg_objects.size(); ++k)
+            if (csg_blocks(k, t_max)) return true;
     }
     if (bvh_) {
         for (std::uint32_t i : bvh_->unbounded) {
@@ -318,6 +343,7 @@ void RecursiveRenderer::update(const Scene& scene, const FrameChange& change) {
             objects_[csg_base_ + s].mi = affine_inverse(scene.csg_shapes[s].md);
         csg_boxes_[k] = csg_node_box(scene, o.root);
     }
+    if (!change.csg.empty()) csg_tree_ = CsgHierarchy::build_for(csg_boxes_, accel_config_);  // a few boxes: rebuilt
     if (change.lights) {
         lights_.clear();
         for (const Light& l : scene.lights) lights_.push_back(LightT<double>::from(rendered_light(l, settings_)));

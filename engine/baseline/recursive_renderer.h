@@ -11,6 +11,7 @@
 #include "image/framebuffer.h"
 #include "parallel/parallelism.h"
 #include "render/camera_rays.h"
+#include "render/csg_hierarchy.h"
 #include "render/csg_spans.h"
 #include "render/render_stats.h"
 #include "render/sampling.h"
@@ -113,6 +114,7 @@ class RecursiveRenderer {
     std::vector<CsgBox> csg_boxes_;        ///< per CSG object: its result's box (csg_node_box)
     std::vector<CsgSlotLayout> csg_layouts_;  ///< per CSG object: its shapes' slots
     std::vector<std::uint8_t> csg_inner_;      ///< per CSG object: shows inner surfaces (csg_shows_inner_surfaces)
+    std::unique_ptr<const CsgHierarchy> csg_tree_;  ///< over the CSG objects' boxes; null: tested in a list
     std::vector<MaterialT<double>> materials_;  ///< per scene material
     std::vector<LightT<double>> lights_;
 };

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "accel/bvh.h"
 #include "kernels/kernel_object.h"
 #include "mesh/mesh.h"
 #include "kernels/ray_stream.h"
@@ -45,6 +46,14 @@ struct CsgView {
     /// changes no boundary inside it); bounded false: a half-space, never skipped.
     const ObjectBounds* shape_boxes;
     const std::uint8_t* shape_bounded;
+    /// The objects' hierarchy (render/csg_hierarchy.h; indices into `objects`), when `tree`:
+    /// its nodes (null when no object is bounded), leaf order, and the unbounded objects.
+    /// Without it, the objects are tested in a list.
+    const accel::WideNode* tree_nodes;
+    const std::uint32_t* tree_prims;
+    const std::uint32_t* tree_unbounded;
+    std::size_t tree_unbounded_count;
+    bool tree;
 };
 
 /// Closest hit (see ClosestHitFn), through CSG objects; any hit (see AnyHitFn) likewise.

@@ -6,17 +6,20 @@
 namespace streamrt {
 
 std::unique_ptr<const StreamCsg> StreamCsg::build_for(const Scene& scene, std::int32_t first_id,
-                                                      const glm::dvec3& eye) {
+                                                      const glm::dvec3& eye, const accel::AccelConfig& config) {
     if (scene.csg_objects.empty()) return nullptr;
-    return std::make_unique<const StreamCsg>(scene, first_id, eye);
+    return std::make_unique<const StreamCsg>(scene, first_id, eye, config);
 }
 
-StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3& eye)
+StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3& eye,
+                     const accel::AccelConfig& config)
     : nodes_(scene.csg_nodes), scene_objects_(scene.csg_objects.size()) {
     const auto shapes = std::int32_t(scene.csg_shapes.size());
+    std::vector<CsgBox> boxes;  // per view
     for (const CsgObject& o : scene.csg_objects) {
         const CsgBox box = csg_node_box(scene, o.root);
         if (box.empty()) continue;  // children that cannot overlap: nothing to hit
+        boxes.push_back(box);
         CsgObjectView v{};
         v.root = o.root;
         v.bounded = box.bounded();
@@ -49,6 +52,7 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
             surfaces_[at] = {{s.color.x, s.color.y, s.color.z}, s.material};
         }
     }
+    tree_ = CsgHierarchy::build_for(boxes, config, eye);
     view_ = {.nodes = nodes_.data(),
              .objects = objects_.data(),
              .count = objects_.size(),
@@ -57,7 +61,12 @@ StreamCsg::StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3
              .shapes = shapes,
              .meshes = meshes_.data(),
              .shape_boxes = shape_boxes_.data(),
-             .shape_bounded = shape_bounded_.data()};
+             .shape_bounded = shape_bounded_.data(),
+             .tree_nodes = tree_ && !tree_->bvh.empty() ? tree_->bvh.nodes.data() : nullptr,
+             .tree_prims = tree_ ? tree_->bvh.prim_index.data() : nullptr,
+             .tree_unbounded = tree_ ? tree_->unbounded.data() : nullptr,
+             .tree_unbounded_count = tree_ ? tree_->unbounded.size() : 0,
+             .tree = tree_ != nullptr};
 }
 
 }  // namespace streamrt

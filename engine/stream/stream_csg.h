@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "kernels/csg_view.h"
+#include "render/csg_hierarchy.h"
 #include "kernels/kernel_object.h"
 #include "kernels/kernel_table.h"
 #include "kernels/ray_stream.h"
@@ -20,9 +21,11 @@ namespace streamrt {
 class StreamCsg {
   public:
     /// Null for a scene without CSG. `first_id`: the id of the first CSG shape's record (the
-    /// scene objects' count); the engine's origin is at `eye` (camera-relative rendering).
-    static std::unique_ptr<const StreamCsg> build_for(const Scene& scene, std::int32_t first_id, const glm::dvec3& eye);
-    StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3& eye);
+    /// scene objects' count); the engine's origin is at `eye` (camera-relative rendering);
+    /// `config` decides whether the objects get their hierarchy (CsgHierarchy::build_for).
+    static std::unique_ptr<const StreamCsg> build_for(const Scene& scene, std::int32_t first_id, const glm::dvec3& eye,
+                                                      const accel::AccelConfig& config);
+    StreamCsg(const Scene& scene, std::int32_t first_id, const glm::dvec3& eye, const accel::AccelConfig& config);
     StreamCsg(const StreamCsg&) = delete;  // view() points into the members
     StreamCsg& operator=(const StreamCsg&) = delete;
 
@@ -52,6 +55,7 @@ class StreamCsg {
     std::vector<const Mesh*> meshes_;  ///< per CSG shape: its mesh, or null (held by the scene's meshes)
     std::vector<ObjectBounds> shape_boxes_;     ///< per CSG shape (CsgView::shape_boxes)
     std::vector<std::uint8_t> shape_bounded_;
+    std::unique_ptr<const CsgHierarchy> tree_;  ///< over objects_, relative to the eye; null: a list
     std::size_t scene_objects_ = 0;
     CsgView view_{};
 };

@@ -36,7 +36,9 @@ std::vector<std::string> StreamRenderer::built_stages() const {
             first = false;
         }
     b.push_back(kernels + "]");
-    if (scene_.csg) b.push_back("csg(simd spans, " + std::to_string(scene_.csg->object_count()) + " objects)");
+    if (scene_.csg)
+        b.push_back("csg(simd spans, " + std::to_string(scene_.csg->object_count()) + " objects" +
+                    (scene_.csg->view().tree ? ", hierarchy)" : ")"));
     const char* how = shade_mode_ == ShadeMode::Sorted     ? ",simd,sorted)"
                       : shade_mode_ == ShadeMode::Gathered ? ",simd,gathered)"
                                                            : ",scalar)";

@@ -63,7 +63,7 @@ StreamScene::StreamScene(const Scene& scene, const RenderSettings& render_settin
     const std::size_t n = scene.objects.size();
     std::fill(std::begin(group_bounded), std::end(group_bounded), true);
     if (!accel) convert_flat(scene);
-    csg = StreamCsg::build_for(scene, std::int32_t(n), eye);
+    csg = StreamCsg::build_for(scene, std::int32_t(n), eye, accel_config_);
     link_objects(n);
     fill_surfaces(scene);
 
@@ -168,7 +168,7 @@ void StreamScene::update(const Scene& scene, const FrameChange& change) {
         }
     if (!shifted && change.objects.empty() && change.csg.empty()) return;
     // CSG records follow the eye and a keyed block: rebuilt whole (a few per object).
-    if ((shifted || !change.csg.empty()) && csg) csg = StreamCsg::build_for(scene, std::int32_t(scene.objects.size()), eye);
+    if ((shifted || !change.csg.empty()) && csg) csg = StreamCsg::build_for(scene, std::int32_t(scene.objects.size()), eye, accel_config_);
     if (!accel) {
         convert_flat(scene);  // O(N): few objects, unless --accel flat forces the flat loops
         link_objects(scene.objects.size());

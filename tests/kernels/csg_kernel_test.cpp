@@ -105,13 +105,30 @@ const char* const kScenes[] = {
     " cylinder scale=0.3,1.5,0.3\nend\n",
 };
 
+/// kScenes and a field of CSG objects past AccelConfig::min_objects, walked through their
+/// hierarchy (render/csg_hierarchy.h): 3 x 3 dice and tori cut flat, and a wall with a dent
+/// (a half-space minus a sphere: an unbounded box, tested beside the tree).
+std::vector<std::string> scenes() {
+    std::vector<std::string> all(std::begin(kScenes), std::end(kScenes));
+    std::string field;
+    for (int i = 0; i < 9; ++i) {
+        const std::string at = " translate=" + std::to_string(i % 3 - 1) + "," + std::to_string(i / 3 - 1) + ",0\n";
+        field += i % 2 ? "csg difference scale=0.35" + at + " cube\n sphere scale=0.5 translate=0,0,1.2\nend\n"
+                       : "csg intersection scale=0.35" + at + " torus minor=0.5\n cube scale=2,0.3,2\nend\n";
+    }
+    field += "csg difference rotate_x=90 translate=0,0,-3\n plane\n sphere scale=1.5\nend\n";
+    all.push_back(field);
+    return all;
+}
+
 }  // namespace
 
 TEST_CASE("csg kernels: every lane's closest and any hit equal the scalar walk, every ISA") {
-    for (const char* text : kScenes) {
+    for (const std::string& text : scenes()) {
         const Scene s = parse_scene(std::string("camera eye=0,0,8 look=0,0,0\nsphere translate=9,0,0\n") + text, "t.cfg");
         const StreamScene sc(s);
         REQUIRE(sc.csg);
+        CHECK(sc.csg->view().tree == (s.csg_objects.size() >= 8));
         const CsgView& v = sc.csg->view();
         for (std::size_t n : {std::size_t(1), std::size_t(7), std::size_t(9), std::size_t(37), std::size_t(1000)}) {
             const unsigned seed = 4049u + unsigned(n);

@@ -298,6 +298,38 @@ std::string lit_scene(const std::string& objects, int degree) {
 
 }  // namespace
 
+TEST_CASE("csg stream: a field of CSG objects through their hierarchy gives the list's picture, both engines") {
+    // 4 x 4 dice and rings cut flat, lit and mirrored, and a wall with a dent (a half-space
+    // minus a sphere: unbounded, tested beside the tree).
+    std::string objects;
+    for (int i = 0; i < 16; ++i) {
+        const std::string at = " translate=" + std::to_string(0.9 * (i % 4) - 1.35) + "," +
+                               std::to_string(0.9 * (i / 4) - 1.35) + ",0 rotate_y=" + std::to_string(17 * i) + "\n";
+        objects += i % 2 ? "csg difference scale=0.35 refl=0.3" + at + " cube\n sphere scale=0.5 translate=0,0,1.2\nend\n"
+                         : "csg intersection scale=0.35" + at + " torus minor=0.5\n cube scale=2,0.3,2\nend\n";
+    }
+    objects += "csg difference rotate_x=90 translate=0,0,-3 color=0.2,0.6,0.9\n plane\n sphere scale=1.5\nend\n";
+    const Scene s = parse(lit_scene(objects, 5));
+    for (const EngineKind engine : {EngineKind::Stream, EngineKind::Recursive}) {
+        CAPTURE(int(engine));
+        const auto picture = [&](accel::AccelMode mode) {
+            Parallelism par(2);
+            EngineOptions opt;
+            opt.accel.mode = mode;
+            return render_scene(s, engine, par, nullptr, opt).image;
+        };
+        const Framebuffer listed = picture(accel::AccelMode::Flat);
+        CHECK(bit_identical(picture(accel::AccelMode::Auto), listed));  // 17 objects: the hierarchy
+        CHECK(bit_identical(picture(accel::AccelMode::Bvh), listed));
+        CHECK(!bit_identical(listed, render(parse(lit_scene("", 5)), engine)));
+    }
+    // And the hierarchy is what the stream engine walks.
+    const StreamScene sc(s);
+    REQUIRE(sc.csg);
+    CHECK(sc.csg->view().tree);
+    CHECK(sc.csg->view().tree_unbounded_count == 1);
+}
+
 TEST_CASE("csg stream: every scene of scenes/csg matches the recursive engine") {
     const auto files = csg_scene_files();
     REQUIRE(files.size() >= 2);
