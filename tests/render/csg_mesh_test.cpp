@@ -161,3 +161,46 @@ TEST_CASE("csg mesh: the mesh cube minus a sphere gives the canonical cube's pic
         }
     }
 }
+
+TEST_CASE("csg mesh: one file serves a plain mesh and CSG children, instances of the same triangles") {
+    const fs::path dir = mesh_dir();
+    const std::string objects =
+        "mesh file=cube.obj translate=-2.5,0,0\n"
+        "csg difference\n  mesh file=cube.obj\n  sphere scale=1.3\nend\n"
+        "csg intersection translate=2.5,0,0\n  mesh file=./cube.obj scale=0.9\n  sphere scale=1.2\nend\n";
+    const Scene s = parse_in(dir, objects);
+    // Read once: the plain object and both CSG children point at the same triangles.
+    REQUIRE(s.meshes.size() == 1);
+    REQUIRE(s.csg_shapes.size() == 4);
+    CHECK(s.objects[0].mesh == 0);
+    CHECK(s.csg_shapes[0].mesh == 0);
+    CHECK(s.csg_shapes[2].mesh == 0);
+    // Each placed by its own Md: the plain cube's face z = 1; nothing down the difference's axis
+    // (the sphere holds the cube there); the intersection's face z = 0.9, normal +z.
+    HitD h;
+    REQUIRE(hit_of(s, {-2.5, 0, 5}, {0, 0, -1}, h));
+    CHECK(h.t == doctest::Approx(4.0).epsilon(1e-12));
+    CHECK(!hit_of(s, {0, 0, 5}, {0, 0, -1}, h));
+    REQUIRE(hit_of(s, {2.5, 0, 5}, {0, 0, -1}, h));
+    CHECK(h.t == doctest::Approx(4.1).epsilon(1e-12));
+    CHECK(h.normal.z == doctest::Approx(1.0).epsilon(1e-12));
+    // The stream engine sees the same three objects.
+    const Scene lit = parse_in(dir, "image width=64 height=24 degree=5\ncamera eye=0,2,9 look=0,0,0 fov=40\n"
+                                    "light point pos=5,8,6\n" + objects);
+    Parallelism par(1);
+    const Framebuffer stream = render_scene(lit, EngineKind::Stream, par).image;
+    const Framebuffer recursive = render_scene(lit, EngineKind::Recursive, par).image;
+    int differ = 0, covered = 0;
+    for (int y = 0; y < stream.height; ++y)
+        for (int x = 0; x < stream.width; ++x) {
+            bool d = false, any = false;
+            for (int c = 0; c < 3; ++c) {
+                d = d || std::abs(stream.pixel(x, y)[c] - recursive.pixel(x, y)[c]) > 1e-3f;
+                any = any || recursive.pixel(x, y)[c] > 0.f;
+            }
+            differ += d;
+            covered += any;
+        }
+    CHECK(differ <= 2);
+    CHECK(covered > 150);  // the three objects cover 185 of the 1,536 pixels
+}
