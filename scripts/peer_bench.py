@@ -86,6 +86,8 @@ SCENES = {
     "csg_mesh_cut": os.path.join(pc.ROOT, "scenes", "csg", "mesh_cut.cfg"),
     "csg_glass_merge": os.path.join(pc.ROOT, "scenes", "csg", "glass_merge.cfg"),
     "csg_field": os.path.join(pc.ROOT, "scenes", "csg", "field.cfg"),
+    "csg_ring": os.path.join(pc.ROOT, "scenes", "csg", "ring.cfg"),
+    "csg_union_merge": os.path.join(pc.ROOT, "scenes", "csg", "union_merge.cfg"),
 }
 CSG_SCENES = [k for k in SCENES if k.startswith("csg_")]
 MODES = {
@@ -256,7 +258,7 @@ MATERIAL_KEYS = set(DEFAULT_MATERIAL) | {"fresnel", "texture", "uvscale"}
 TRANSFORM_KEYS = {"scale", "rotate_x", "rotate_y", "rotate_z", "translate"}
 
 
-SHAPES = ("sphere", "plane", "cube", "cylinder", "cone")  # canonical shapes POV-Ray has as primitives
+SHAPES = ("sphere", "plane", "cube", "cylinder", "cone", "torus")  # canonical shapes POV-Ray has as primitives
 CSG_OPS = ("union", "intersection", "difference", "merge")
 
 
@@ -336,7 +338,7 @@ def read_cfg(path, flat=False):
                 for k, v in kv:
                     if k in TRANSFORM_KEYS:
                         md = mat_mul(transform_of(k, v), md)
-                    elif flat and k not in ("color", "checker", "cell", "material", "file", "smooth"):
+                    elif flat and k not in ("color", "checker", "cell", "material", "file", "smooth", "minor"):
                         continue
                     elif k in ("fresnel", "texture", "uvscale"):
                         if k != "fresnel" or v != "false":
@@ -349,6 +351,8 @@ def read_cfg(path, flat=False):
                         obj["file"] = os.path.normpath(os.path.join(base, v))
                     elif k == "smooth" and stmt == "mesh":
                         obj["smooth"] = v == "true"
+                    elif k == "minor" and stmt == "torus":
+                        obj["minor"] = float(v)
                     elif k not in ("material", "name"):
                         raise Unsupported("%s: %s %s= is not translated" % (where, stmt, k))
                 if stmt == "material":
@@ -550,7 +554,8 @@ def pov_texture(m, ambient, flat=False):
 
 # The canonical shapes (docs/scene-format.md, "Canonical shapes") as POV-Ray primitives, less
 # their closing brace; POV-Ray's cylinder and cone are closed solids, as streamrt's, and its
-# plane's inside is below it, as streamrt's half-space.
+# plane's inside is below it, as streamrt's half-space (the torus, with its tube radius, is
+# written by pov_object).
 POV_PRIMITIVES = {
     "sphere": "sphere { <0,0,0>, 1",
     "plane": "plane { y, 0",
@@ -585,6 +590,8 @@ def write_pov(scene, pov_path, width, height, adc_bailout, mesh_cache, flat=Fals
             # the leaves carry their own textures; the block's matrix applies after its children's
             return "%s { %s %s }" % (o["op"], " ".join(pov_object(c) for c in o["children"]), pov_matrix(o["md"]))
         tex = pov_texture(o["material"], scene["ambient"], flat)
+        if o["kind"] == "torus":  # POV-Ray's torus is streamrt's: major radius 1 around y
+            return "torus { 1, %.9g %s %s }" % (o.get("minor", 0.25), pov_matrix(o["md"]), tex)
         if o["kind"] in POV_PRIMITIVES:
             return "%s %s %s }" % (POV_PRIMITIVES[o["kind"]], pov_matrix(o["md"]), tex)
         inc, name = mesh_cache[(o["file"], o["smooth"])]

@@ -21,7 +21,7 @@ STILLS = ["soft_shadows", "dof", "fresnel", "textured", "emission"]
 # Degree 6 (docs/global-illumination.md): each at its own samples, square scenes square.
 GI_STILLS = [("gi/cornell", 256, 256), ("gi/sky_room", 320, 240), ("gi/glass_box", 256, 256)]
 STRIP_FRAMES = [0, 6, 12, 13, 18, 23]
-CSG_STILLS = ["lens", "pipe", "die", "hollow", "tree", "mesh_cut"]
+CSG_STILLS = ["lens", "pipe", "die", "hollow", "tree", "mesh_cut", "ring", "union_merge", "field"]
 
 
 def render(exe, scene, out, *extra):
