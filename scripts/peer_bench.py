@@ -979,6 +979,8 @@ def main(argv=None):
                     "table's third column (e.g. 'ratio default,primary ratio')")
     ap.add_argument("--since", metavar="UTC", help="with --table: only the runs logged at or after this UTC time "
                     "(YYYY-MM-DD or YYYY-MM-DDTHH:MM; the runs of today's engine, not of one a change replaced)")
+    ap.add_argument("--isa", help="with --table: only the runs on machines of these instruction sets, "
+                    "comma-separated (avx2, avx512: the Embree ratios depend on the packet width)")
     ap.add_argument("--dry-run", action="store_true", help="check tools, write the .pov files, render nothing")
     ap.add_argument("--out", help="output folder (default BUILD/peer)")
     ap.add_argument("--flat", action="store_true", help="only the degree-0 check: each scene's flat colours by "
@@ -999,6 +1001,9 @@ def main(argv=None):
         if args.scenes:
             wanted = set(args.scenes.split(","))
             entries = [e for e in entries if e.get("scene") in wanted]
+        if args.isa:
+            isas = set(args.isa.split(","))
+            entries = [e for e in entries if e.get("isa") in isas]
         print(table(entries, [m for m in args.metrics.split(",") if m] if args.metrics else None))
         print("\n%d entries from %s; bold: the lowest over the runs (the headline), in brackets the range" % (
             len(entries), os.path.relpath(os.path.abspath(args.log), pc.ROOT)))

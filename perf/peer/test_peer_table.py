@@ -60,3 +60,11 @@ def test_since_and_scenes():
     # A day alone, as a date: the last sphere1m run.
     assert rows(table("--since", "2026-12-03")) == [
         "| sphere1m | 1 | 1 (2026-12-03) | 1.8 - 1.8 | avx512 | **1.50x** (1.50 - 1.50) | **1.60x** (1.60 - 1.60) |"]
+
+
+# Proven against: --isa ignored (the avx512 runs kept: bunny 3 runs instead of 2, a sphere1m row).
+def test_isa():
+    # bunny's two avx2 runs of 2026-12-01: default 20.0 and 18.5, nopruning 17.5 and 17.0,
+    # loads 1.5 and 2.5; no sphere1m (avx512 only).
+    assert rows(table("--isa", "avx2")) == [
+        "| bunny | 2 | 1 (2026-12-01) | 1.5 - 2.5 | avx2 | **18.50x** (18.50 - 20.00) | **17.00x** (17.00 - 17.50) |"]
