@@ -11,6 +11,7 @@
 #include <xsimd/xsimd.hpp>
 
 #include "core/memory_advice.h"
+#include "core/default_init.h"
 #include "parallel/parallelism.h"
 
 namespace streamrt::accel {
@@ -47,13 +48,17 @@ constexpr int kMedianDepth = 40;
 /// each load as one 4-lane batch: lo's fourth lane is 0, hi's is the id (masked off).
 struct Ref {
     float lo[3];
-    float zero = 0.f;
+    float zero;  ///< always 0 (the SSE loads' fourth lane), written with the rest: no initialiser, so
+                 ///< that an array of Refs is first touched by the loop that fills it (RefVec)
     float hi[3];
     std::uint32_t id;
     float c(int a) const { return lo[a] + hi[a]; }  ///< twice the centroid
     Aabb box() const { return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
 };
 static_assert(sizeof(Ref) == 32);
+static_assert(std::is_trivially_default_constructible_v<Ref>);
+/// The builder's primitives: resize() leaves them unwritten (core/default_init.h).
+using RefVec = FillLaterVec<Ref>;
 
 /// 4-lane SSE2 batches (x, y, z, unused): the binning pass grows three boxes per primitive,
 /// two instructions each this way instead of six.
@@ -95,7 +100,7 @@ inline B4 ref_hi(const Ref& r) {
 }
 
 struct Builder {
-    std::vector<Ref>& refs;
+    RefVec& refs;
     std::unique_ptr<BinNode[]> nodes;
     std::atomic<std::uint32_t> n_nodes{0};
     BuildOptions opt;
@@ -440,13 +445,13 @@ struct Collapser {
 };
 
 /// The hierarchy over refs (the primitives with non-empty boxes, in their numbers' order).
-Bvh build_over(std::vector<Ref> refs, const BuildOptions& options, std::chrono::steady_clock::time_point start);
+Bvh build_over(RefVec refs, const BuildOptions& options, std::chrono::steady_clock::time_point start);
 
 }  // namespace
 
 Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    std::vector<Ref> refs;
+    RefVec refs;
     refs.reserve(boxes.size());
     want_huge_pages(refs.data(), refs.capacity());
     for (std::size_t i = 0; i < boxes.size(); ++i) {
@@ -459,7 +464,9 @@ Bvh Bvh::build(std::vector<Aabb> boxes, const BuildOptions& options) {
 
 Bvh Bvh::build(std::size_t n, const std::function<Aabb(std::size_t)>& box_of, const BuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    std::vector<Ref> refs(n);  // every Ref written below: value-initialised pages are touched once here anyway
+    // Every Ref is written below, in parallel: their pages are first touched (and zeroed by the
+    // kernel) there, by both threads, not by a memset on this one.
+    RefVec refs(n);
     want_huge_pages(refs.data(), refs.capacity());
     std::atomic<bool> any_empty{false};
     parallel_for_index(n, 16384, [&](std::size_t i) {
@@ -474,7 +481,7 @@ Bvh Bvh::build(std::size_t n, const std::function<Aabb(std::size_t)>& box_of, co
 
 namespace {
 
-Bvh build_over(std::vector<Ref> refs, const BuildOptions& options, std::chrono::steady_clock::time_point start) {
+Bvh build_over(RefVec refs, const BuildOptions& options, std::chrono::steady_clock::time_point start) {
     Bvh bvh;
     if (refs.empty()) return bvh;
     const std::size_t n = refs.size();
