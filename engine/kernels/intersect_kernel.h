@@ -247,7 +247,7 @@ bool mesh_closest_streamed(RayView rays, std::int32_t* object, const ObjectXf* o
 /// its Mi like the canonical shapes, walks that mesh's own hierarchy (kernels/mesh_kernel.h).
 /// With `bounds` (the flat scene's padded world boxes, stream_scene.cpp) a packet that misses
 /// a mesh's box skips its transform and root node: one slab test instead of 8 boxes and a
-/// matrix (docs/performance.md, "A mesh's box before its walk": the glass bunny's shadow
+/// matrix (docs/performance.md, "Design choices", a mesh's box before its walk: the glass bunny's shadow
 /// rays 0.81x, a scene of several meshes 0.61x).
 template <class Arch>
 void mesh_closest_impl(RayView rays, std::int32_t* object, const ObjectXf* objs, const ObjectBounds* bounds,

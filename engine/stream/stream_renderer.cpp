@@ -98,7 +98,7 @@ void StreamRenderer::render_one_tile(const Tile& tile, float* rgb, RayCounts& co
     float accum[kTileSize * kTileSize * 3] = {};
     const int pixels = tile.width() * tile.height();
     // Pixels in Z order where rays walk one hierarchy (z_order_), whose nodes a compact packet
-    // shares. The rest keep the rows (docs/performance.md, "Pixels in Z order"): a scene of a
+    // shares. The rest keep the rows (docs/performance.md, "Design choices", pixels in Z order): a scene of a
     // few shapes, tested ray by ray against each, gained nothing (its shade stage lost 2 - 4 %),
     // and in the object tree over instanced meshes compact packets reach small instances with
     // more lanes, past the single-ray hand-over's threshold (the 10,000-instance field's
