@@ -165,7 +165,8 @@ bool RecursiveRenderer::closest_hit(const RayD& ray, double t_min, double t_max,
         const accel::Bvh& h = csg_tree_->bvh;
         accel::traverse_closest<double>(h, ray.origin, ray.dir, best_t,
                                         [&](std::uint32_t first, std::uint32_t count, double& tm) {
-                                            for (std::uint32_t k = first; k < first + count; ++k) csg(h.prim_index[k], tm);
+                                            for (std::uint32_t k = first; k < first + count; ++k)
+                                                csg(h.prim_index[k], tm);
                                         });
     } else {
         for (std::size_t k = 0; k < scene_->csg_objects.size(); ++k) csg(k, best_t);
@@ -205,12 +206,12 @@ bool RecursiveRenderer::occluded(const RayD& ray, double t_max) const {
         for (const std::uint32_t k : csg_tree_->unbounded)
             if (csg_blocks(k, t_max)) return true;
         const accel::Bvh& h = csg_tree_->bvh;
-        if (accel::traverse_any<double>(h, ray.origin, ray.dir, t_max, [&](std::uint32_t first, std::uint32_t count, double tm) {
-                for (std::uint32_t k = first; k < first + count; ++k)
-                    if (csg_blocks(h.prim_index[k], tm)) return true;
-                return false;
-            }))
-            return true;
+        const auto leaf = [&](std::uint32_t first, std::uint32_t count, double tm) {
+            for (std::uint32_t k = first; k < first + count; ++k)
+                if (csg_blocks(h.prim_index[k], tm)) return true;
+            return false;
+        };
+        if (accel::traverse_any<double>(h, ray.origin, ray.dir, t_max, leaf)) return true;
     } else {
         for (std::size_t k = 0; k < scene_->csg_objects.size(); ++k)
             if (csg_blocks(k, t_max)) return true;

@@ -272,10 +272,13 @@ inline PairBoundary<B> csg_pair_boundary(CsgOp op, const B& e0, const B& x0, con
 /// and object[]; kAny: t_max = 0). Always inlined: called, it made the intersect stage of
 /// one-object scenes 3 - 5% slower (die, pipe, tree at 1280x720, 9 runs).
 template <class Arch, bool kAny>
-[[gnu::always_inline]] inline void csg_object_hits(const CsgView& csg, const CsgObjectView& ob, RayView rays, std::int32_t* object, std::size_t i,
-                            std::size_t lanes, const RayPacket<xsimd::batch<float, Arch>>& r,
-                            const Vec3T<xsimd::batch<float, Arch>>& inv, xsimd::batch<float, Arch>& t_max,
-                            CsgLine<xsimd::batch<float, Arch>>& line, CsgLaneEnds& ends, std::uint8_t* live) {
+[[gnu::always_inline]] inline void csg_object_hits(const CsgView& csg, const CsgObjectView& ob, RayView rays,
+                                                   std::int32_t* object, std::size_t i, std::size_t lanes,
+                                                   const RayPacket<xsimd::batch<float, Arch>>& r,
+                                                   const Vec3T<xsimd::batch<float, Arch>>& inv,
+                                                   xsimd::batch<float, Arch>& t_max,
+                                                   CsgLine<xsimd::batch<float, Arch>>& line, CsgLaneEnds& ends,
+                                                   std::uint8_t* live) {
     using B = xsimd::batch<float, Arch>;
     using M = xsimd::batch_bool<float, Arch>;
     if (ob.bounded && !packet_meets_box<B, float>(r, inv, ob.box, t_max)) return;
@@ -380,7 +383,8 @@ void csg_hits(const CsgView& csg, RayView rays, std::int32_t* object) {
             continue;
         }
         bool done = false;
-        for (std::size_t u = 0; u < csg.tree_unbounded_count && !done; ++u) done = visit(csg.objects[csg.tree_unbounded[u]]);
+        for (std::size_t u = 0; u < csg.tree_unbounded_count && !done; ++u)
+            done = visit(csg.objects[csg.tree_unbounded[u]]);
         if (!csg.tree_nodes) continue;
         int sp = 0;
         stack_child[sp] = 0;

@@ -103,6 +103,20 @@ M mask_select(const M& a, const M& b, const M& c) {
     return (a && b) || (!a && c);
 }
 
+template <class M>
+M csg_node_inside(const CsgNode* nodes, std::uint32_t node, const CsgSlotLayout& layout, const M* in_slot);
+
+/// Whether the points of the line where in_slot holds (per slot) are inside child `c` of a
+/// node: a nested node's result, or a shape's (any of its slots).
+template <class M>
+M csg_child_inside(const CsgNode* nodes, const CsgNode::Child& c, const CsgSlotLayout& layout, const M* in_slot) {
+    if (c.is_node) return csg_node_inside(nodes, c.index, layout, in_slot);
+    M m(false);
+    const std::size_t s = c.index - layout.first_shape;
+    for (int j = layout.first_slot[s]; j < layout.first_slot[s + 1]; ++j) m = m || in_slot[j];
+    return m;
+}
+
 /// Whether the points of the line where in_slot holds (per slot) are in the result of node
 /// `node`: a union (and a merge) of its children, an intersection, or the first child minus
 /// the others.
@@ -112,13 +126,7 @@ M csg_node_inside(const CsgNode* nodes, std::uint32_t node, const CsgSlotLayout&
     M r(false);
     bool first = true;
     for (const CsgNode::Child& c : n.children) {
-        M m(false);
-        if (c.is_node) {
-            m = csg_node_inside(nodes, c.index, layout, in_slot);
-        } else {
-            const std::size_t s = c.index - layout.first_shape;
-            for (int j = layout.first_slot[s]; j < layout.first_slot[s + 1]; ++j) m = m || in_slot[j];
-        }
+        const M m = csg_child_inside(nodes, c, layout, in_slot);
         if (first) {
             r = m;
             first = false;
@@ -172,12 +180,7 @@ CsgSurface<M> csg_node_surface(const CsgNode* nodes, std::uint32_t node, const C
     CsgSurface<M> r{simd::mask_xor(csg_node_inside(nodes, node, layout, before), now), now};
     const bool keeps_all = n.op == CsgOp::Union && !inverted;
     const auto child_inside = [&](std::size_t i, const M* in) {
-        const CsgNode::Child& c = n.children[i];
-        if (c.is_node) return csg_node_inside(nodes, c.index, layout, in);
-        M m(false);
-        const std::size_t s = c.index - layout.first_shape;
-        for (int j = layout.first_slot[s]; j < layout.first_slot[s + 1]; ++j) m = m || in[j];
-        return m;
+        return csg_child_inside(nodes, n.children[i], layout, in);
     };
     for (std::size_t i = 0; i < n.children.size(); ++i) {
         const CsgNode::Child& c = n.children[i];

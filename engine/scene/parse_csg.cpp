@@ -72,8 +72,9 @@ void Parser::csg_child(Statement& st, const std::vector<Token>& toks, ShapeKind 
     csg_blocks_.front().shapes += csg_slots_of(kind);
     if (csg_blocks_.front().shapes > kMaxCsgShapes)
         st.fail_here("a csg object holds at most " + std::to_string(kMaxCsgShapes) + " shapes, a mesh counting as " +
-                     std::to_string(kMeshCsgSpans) + " and a torus as " + std::to_string(csg_slots_of(ShapeKind::Torus)) +
-                     " (its block is at " + csg_blocks_.front().at.str() + ")");
+                     std::to_string(kMeshCsgSpans) + " and a torus as " +
+                     std::to_string(csg_slots_of(ShapeKind::Torus)) + " (its block is at " +
+                     csg_blocks_.front().at.str() + ")");
     CsgBlock& block = csg_blocks_.back();
     Object obj;
     ObjectLoc loc;

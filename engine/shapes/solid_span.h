@@ -41,7 +41,7 @@ template <class Math>
 concept ConvexSolid = requires { requires Math::kConvexSolid; };
 template <class Math>
 concept Solid = ConvexSolid<Math> || requires(Vec3T<double> p, double v) { Math::inside_span(p, p, v); };
-/// A solid a line may meet in several spans (the torus: two), given by its own spans().
+/// A solid a line may meet in several spans (the torus: two, shapes/torus_math.h torus_spans).
 template <class Math>
 concept MultiSpanSolid = requires { requires Math::kCsgSpans > 1; };
 

@@ -426,10 +426,6 @@ struct TorusMath {
     using Compute = double;
     /// As a CSG solid (minor <= 1) a line meets it in up to two spans (torus_spans).
     static constexpr int kCsgSpans = 2;
-    template <class V>
-    static std::array<SpanT<V>, 2> spans(const Vec3T<V>& o, const Vec3T<V>& d, V minor) {
-        return torus_spans(o, d, minor);
-    }
     /// The ring's box: |x|, |z| <= 1 + minor, |y| <= minor.
     static constexpr CanonicalBounds bounds(double minor) {
         return {CanonicalBounds::Form::Box, {-1 - minor, -minor, -1 - minor}, {1 + minor, minor, 1 + minor}};

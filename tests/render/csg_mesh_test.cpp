@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "baseline/recursive_renderer.h"
 #include "driver/render.h"
@@ -54,6 +55,25 @@ fs::path mesh_dir() {
 }
 
 Scene parse_in(const fs::path& dir, const std::string& text) { return parse_scene(text, (dir / "t.cfg").string()); }
+
+/// The pixels of `a` with a channel more than `tol` from `b`'s, and the pixels `b` covers
+/// (a channel above 0: not the black background).
+std::pair<int, int> pixels_apart(const Framebuffer& a, const Framebuffer& b, float tol) {
+    REQUIRE(a.width == b.width);
+    REQUIRE(a.height == b.height);
+    int differ = 0, covered = 0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) {
+            bool d = false, any = false;
+            for (int c = 0; c < 3; ++c) {
+                d = d || std::abs(a.pixel(x, y)[c] - b.pixel(x, y)[c]) > tol;
+                any = any || b.pixel(x, y)[c] > 0.f;
+            }
+            differ += d;
+            covered += any;
+        }
+    return {differ, covered};
+}
 
 
 }  // namespace
@@ -141,18 +161,7 @@ TEST_CASE("csg mesh: the mesh cube minus a sphere gives the canonical cube's pic
             CAPTURE(base_name);
             CAPTURE(int(engine));
             const Framebuffer mesh = picture(base);
-            REQUIRE(mesh.width == canonical.width);
-            int differ = 0, covered = 0;
-            for (int y = 0; y < mesh.height; ++y)
-                for (int x = 0; x < mesh.width; ++x) {
-                    bool d = false, any = false;
-                    for (int c = 0; c < 3; ++c) {
-                        d = d || std::abs(mesh.pixel(x, y)[c] - canonical.pixel(x, y)[c]) > 1e-4f;
-                        any = any || canonical.pixel(x, y)[c] > 0.f;
-                    }
-                    differ += d;
-                    covered += any;
-                }
+            const auto [differ, covered] = pixels_apart(mesh, canonical, 1e-4f);
             // The same surfaces, lit alike; only a few pixels along edges, where the mesh's
             // and the cube's rounding send a refracted ray the other way, may differ (5 of
             // 1,728 on each engine; a normal facing the wrong way: hundreds).
@@ -190,17 +199,7 @@ TEST_CASE("csg mesh: one file serves a plain mesh and CSG children, instances of
     Parallelism par(1);
     const Framebuffer stream = render_scene(lit, EngineKind::Stream, par).image;
     const Framebuffer recursive = render_scene(lit, EngineKind::Recursive, par).image;
-    int differ = 0, covered = 0;
-    for (int y = 0; y < stream.height; ++y)
-        for (int x = 0; x < stream.width; ++x) {
-            bool d = false, any = false;
-            for (int c = 0; c < 3; ++c) {
-                d = d || std::abs(stream.pixel(x, y)[c] - recursive.pixel(x, y)[c]) > 1e-3f;
-                any = any || recursive.pixel(x, y)[c] > 0.f;
-            }
-            differ += d;
-            covered += any;
-        }
+    const auto [differ, covered] = pixels_apart(stream, recursive, 1e-3f);
     CHECK(differ <= 2);
     CHECK(covered > 150);  // the three objects cover 185 of the 1,536 pixels
 }

@@ -141,7 +141,8 @@ TEST_CASE("csg stream: along two overlapping spheres' axis a union meets all fou
         for (const std::string op : {"union", "merge"}) {
             CAPTURE(op);
             CAPTURE(third);
-            const Scene s = parse(with_camera("csg " + op + "\n" + kTwoSpheres + third + "end\nsphere translate=0,6,0\n"));
+            const Scene s =
+                parse(with_camera("csg " + op + "\n" + kTwoSpheres + third + "end\nsphere translate=0,6,0\n"));
             const StreamScene sc(s, accel_modes()[0]);
             // (x of the point, x of the normal shown, the shape) of each surface from x = -5.
             std::vector<std::tuple<double, double, int>> seen;
