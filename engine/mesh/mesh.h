@@ -27,7 +27,7 @@ inline constexpr std::uint32_t kDefaultSingleRayLanes = 0;
 struct Mesh {
     std::string name;                   ///< the file it came from, for messages
     std::vector<float> positions;       ///< 3 per vertex the triangles use (MeshView::positions)
-    std::vector<std::uint32_t> index;   ///< 3 vertex numbers per triangle, leaf order
+    FillLaterVec<std::uint32_t> index;  ///< 3 vertex numbers per triangle, leaf order (written once, in parallel)
     std::vector<float> vertex_normals;  ///< 3 per vertex
     std::vector<float> corner_uv;       ///< 6 per triangle (MeshView::uv), leaf order; empty: none
     std::vector<float> vertex_colors;   ///< 3 per vertex (MeshView::vertex_colors); empty: none
