@@ -317,32 +317,29 @@ template <class Arch, bool kAny>
             for (std::size_t l = 0; l < lanes; ++l)
                 if (slots[l] >= 0.f)
                     object[i + l] = base + std::int32_t(slots[l]) + (flips[l] != 0.f ? csg.shapes : 0);
-            alignas(64) float out[simd::kMaxLanes];
-            t_max.store_aligned(out);
-            for (std::size_t l = 0; l < lanes; ++l) rays.t_max[i + l] = out[l];
-            return;
-        }
-        alignas(64) float slots[simd::kMaxLanes], exits[simd::kMaxLanes], enters[simd::kMaxLanes];
-        xsimd::select(hit, slot, B(-1.f)).store_aligned(slots);
-        xsimd::select(at_exit, B(1.f), B(0.f)).store_aligned(exits);
-        xsimd::select(entering, B(1.f), B(0.f)).store_aligned(enters);
-        for (std::size_t l = 0; l < lanes; ++l) {
-            if (slots[l] < 0.f) continue;
-            const auto j = std::size_t(slots[l]);
-            const std::uint32_t shape = ob.layout.first_shape + ob.layout.shape_of[j];
-            const int end = exits[l] != 0.f ? 1 : 0;
-            const Mesh* mesh = csg.meshes[shape];
-            const bool turned = mesh && ends[j][l].turned[std::size_t(end)];
-            object[i + l] = csg.first_id + std::int32_t(shape) +
-                            (csg_flip(end == 1, enters[l] != 0.f, turned) ? csg.shapes : 0);
-            if (mesh && rays.prim) {  // the triangle, and where on it (found again)
-                const std::uint32_t tri = ends[j][l].tri[std::size_t(end)];
-                const ObjectXf& xf = csg.records[shape].xf;
-                const Vec3f ow{rays.ox[i + l], rays.oy[i + l], rays.oz[i + l]};
-                const Vec3f dw{rays.dx[i + l], rays.dy[i + l], rays.dz[i + l]};
-                rays.prim[i + l] = std::int32_t(tri);
-                mesh_crossing_uv(mesh->view(), tri, apply_point(xf.m, ow), apply_vector(xf.m, dw),
-                                 rays.bu[i + l], rays.bv[i + l]);
+        } else {  // slots mapped back to shapes; a mesh's ends keep their triangle and turn
+            alignas(64) float slots[simd::kMaxLanes], exits[simd::kMaxLanes], enters[simd::kMaxLanes];
+            xsimd::select(hit, slot, B(-1.f)).store_aligned(slots);
+            xsimd::select(at_exit, B(1.f), B(0.f)).store_aligned(exits);
+            xsimd::select(entering, B(1.f), B(0.f)).store_aligned(enters);
+            for (std::size_t l = 0; l < lanes; ++l) {
+                if (slots[l] < 0.f) continue;
+                const auto j = std::size_t(slots[l]);
+                const std::uint32_t shape = ob.layout.first_shape + ob.layout.shape_of[j];
+                const int end = exits[l] != 0.f ? 1 : 0;
+                const Mesh* mesh = csg.meshes[shape];
+                const bool turned = mesh && ends[j][l].turned[std::size_t(end)];
+                object[i + l] = csg.first_id + std::int32_t(shape) +
+                                (csg_flip(end == 1, enters[l] != 0.f, turned) ? csg.shapes : 0);
+                if (mesh && rays.prim) {  // the triangle, and where on it (found again)
+                    const std::uint32_t tri = ends[j][l].tri[std::size_t(end)];
+                    const ObjectXf& xf = csg.records[shape].xf;
+                    const Vec3f ow{rays.ox[i + l], rays.oy[i + l], rays.oz[i + l]};
+                    const Vec3f dw{rays.dx[i + l], rays.dy[i + l], rays.dz[i + l]};
+                    rays.prim[i + l] = std::int32_t(tri);
+                    mesh_crossing_uv(mesh->view(), tri, apply_point(xf.m, ow), apply_vector(xf.m, dw),
+                                     rays.bu[i + l], rays.bv[i + l]);
+                }
             }
         }
     }

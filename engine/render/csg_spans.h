@@ -109,7 +109,8 @@ M csg_node_inside(const CsgNode* nodes, std::uint32_t node, const CsgSlotLayout&
 /// Whether the points of the line where in_slot holds (per slot) are inside child `c` of a
 /// node: a nested node's result, or a shape's (any of its slots).
 template <class M>
-M csg_child_inside(const CsgNode* nodes, const CsgNode::Child& c, const CsgSlotLayout& layout, const M* in_slot) {
+[[gnu::always_inline]] inline M csg_child_inside(const CsgNode* nodes, const CsgNode::Child& c, const CsgSlotLayout& layout,
+                                                 const M* in_slot) {
     if (c.is_node) return csg_node_inside(nodes, c.index, layout, in_slot);
     M m(false);
     const std::size_t s = c.index - layout.first_shape;
